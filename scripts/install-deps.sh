@@ -1,0 +1,25 @@
+#!/usr/bin/env bash
+# Installs, with apt-get, exactly the Debian packages vmpray needs that are
+# missing. Idempotent: a second run installs nothing. Run as root.
+set -euo pipefail
+packages=(
+  cmake ninja-build g++ pkg-config
+  libboost-fiber-dev libboost-context-dev libboost-program-options-dev
+  libgtest-dev libgmock-dev libbenchmark-dev
+  libpng-dev zlib1g-dev
+)
+if [[ "${1:-}" == "--dev" ]]; then   # sanitizers' clang runtime and the fuzzer
+  packages+=(clang-14 libclang-rt-14-dev)
+fi
+missing=()
+for p in "${packages[@]}"; do
+  dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
+done
+if ((${#missing[@]} == 0)); then
+  exit 0
+fi
+echo "install-deps: installing ${missing[*]}" >&2
+sudo_cmd=()
+if [[ $(id -u) -ne 0 ]]; then sudo_cmd=(sudo); fi
+"${sudo_cmd[@]}" apt-get update -qq
+DEBIAN_FRONTEND=noninteractive "${sudo_cmd[@]}" apt-get install -y -qq --no-install-recommends "${missing[@]}"
