@@ -1,0 +1,208 @@
+// NFF parser: the reference SPD files parse with the right counts, the
+// format's token-level rules hold, and each malformed input gives one clear
+// error naming its line.
+#include "tracer/nff.hpp"
+
+#include <gtest/gtest.h>
+#include <zlib.h>
+
+#include <sstream>
+#include <string>
+
+#include "scene_stats.hpp"
+
+namespace tracer {
+namespace {
+
+using testing::scene_stats;
+
+struct ReferenceFile {
+  const char* name;
+  std::size_t polygons, patches, spheres, cones, lights, materials;
+  Vec3d lo, hi;
+};
+
+class NffReference : public ::testing::TestWithParam<ReferenceFile> {};
+
+TEST_P(NffReference, ParsesWithExpectedCountsAndBounds) {
+  const ReferenceFile& ref = GetParam();
+  Scene scene = load_nff_file(std::string(VMPRAY_SHARED_SCENES) + "/" + ref.name);
+  auto s = scene_stats(scene);
+  EXPECT_EQ(s.polygons, ref.polygons);
+  EXPECT_EQ(s.patches, ref.patches);
+  EXPECT_EQ(s.spheres, ref.spheres);
+  EXPECT_EQ(s.cones, ref.cones);
+  EXPECT_EQ(scene.lights.size(), ref.lights);
+  EXPECT_EQ(scene.materials.size(), ref.materials);
+  for (int axis = 0; axis < 3; ++axis) {
+    EXPECT_NEAR(s.lo[axis], ref.lo[axis], 1e-6) << "axis " << axis;
+    EXPECT_NEAR(s.hi[axis], ref.hi[axis], 1e-6) << "axis " << axis;
+  }
+  EXPECT_EQ(scene.camera.width, 512);
+  EXPECT_EQ(scene.camera.height, 512);
+}
+
+INSTANTIATE_TEST_SUITE_P(
+    SpdFiles, NffReference,
+    ::testing::Values(
+        ReferenceFile{"balls-s1.nff", 1, 0, 10, 0, 3, 2, {-12, -12, -0.5}, {12, 12, 0.710998}},
+        ReferenceFile{"gears-s1.nff", 147, 0, 0, 0, 5, 2, {-2, -2, 0}, {2, 2, 1}},
+        ReferenceFile{"mount-s1.nff", 8, 0, 4, 0, 1, 2, {-1.15961, -1, -0.5481}, {1, 1.15961, 1.37821}},
+        ReferenceFile{"rings-s1.nff", 1, 0, 30, 30, 3, 7, {-4.27965, 1.65358, -2.77965}, {2.27965, 5.22625, 3.77965}},
+        ReferenceFile{"tetra-s1.nff", 4, 0, 0, 0, 1, 1, {-1, -1, -1}, {1, 1, 1}},
+        ReferenceFile{"tree-s1.nff", 1, 0, 3, 3, 7, 2, {-50, -50, 0}, {50, 50, 1.701755}},
+        ReferenceFile{"mount-s6-t6.nff.gz", 8192, 1728, 0, 0, 1, 2, {-1.15961, -1, -0.702953}, {1, 1.15961, 1.37821}},
+        ReferenceFile{"rings-s4-t1.nff.gz", 1, 18000, 0, 0, 3, 181, {-7.5593, 1.65721, -6.0593}, {5.5593, 13.0656, 7.0593}},
+        ReferenceFile{"teapot-s7.nff.gz", 49, 3080, 0, 0, 2, 3, {-4, -4, 0}, {4, 4, 3.15}},
+        ReferenceFile{"teapot-s8.nff.gz", 64, 4032, 0, 0, 2, 3, {-4, -4, 0}, {4, 4, 3.15}},
+        ReferenceFile{"tetra-s9.nff.gz", 262144, 0, 0, 0, 1, 1, {-1, -1, -1}, {1, 1, 1}}),
+    [](const auto& info) {
+      std::string name = info.param.name;
+      for (char& c : name) c = std::isalnum(static_cast<unsigned char>(c)) ? c : '_';
+      return name;
+    });
+
+Scene parse(const std::string& text) { return parse_nff(std::string_view(text), "t.nff"); }
+
+std::string error_of(const std::string& text) {
+  try {
+    parse(text);
+  } catch (const SceneError& e) {
+    return e.what();
+  }
+  return "(no error)";
+}
+
+const char* kView =
+    "v\nfrom 0 0 5\nat 0 0 0\nup 0 1 0\nangle 40\nhither 0.5\nresolution 64 32\n";
+
+TEST(Nff, ReadsCameraBackgroundLightAndMaterial) {
+  Scene s = parse(std::string(kView) + "b 0.1 0.2 0.3\nl 1 2 3\nf 1 0.5 0 0.7 0.3 20 0.1 1.5\ns 0 0 0 1\n");
+  EXPECT_EQ(s.camera.from, (Vec3d{0, 0, 5}));
+  EXPECT_EQ(s.camera.up, (Vec3d{0, 1, 0}));
+  EXPECT_DOUBLE_EQ(s.camera.angle_deg, 40);
+  EXPECT_DOUBLE_EQ(s.camera.hither, 0.5);
+  EXPECT_EQ(s.camera.width, 64);
+  EXPECT_EQ(s.camera.height, 32);
+  EXPECT_EQ(s.background, (Color{0.1f, 0.2f, 0.3f}));
+  ASSERT_EQ(s.lights.size(), 1u);
+  EXPECT_EQ(s.lights[0].color, (Color{1, 1, 1}));
+  ASSERT_EQ(s.materials.size(), 1u);
+  EXPECT_DOUBLE_EQ(s.materials[0].shine, 20);
+  EXPECT_DOUBLE_EQ(s.materials[0].ior, 1.5);
+}
+
+TEST(Nff, ReadsTokensNotLines) {
+  Scene s = parse("c\n0 0 0 1\n0 0 2 0.5\np 3 0 0 0 1 0 0 0 1 0 s 0 0 0\n 2");
+  ASSERT_EQ(s.objects.size(), 3u);
+  auto& cone = std::get<Cone>(s.objects[0].shape);
+  EXPECT_EQ(cone.apex, (Vec3d{0, 0, 2}));
+  EXPECT_DOUBLE_EQ(cone.apex_radius, 0.5);
+  EXPECT_EQ(std::get<Polygon>(s.objects[1].shape).vertices.size(), 3u);
+  EXPECT_DOUBLE_EQ(std::get<Sphere>(s.objects[2].shape).radius, 2);
+}
+
+TEST(Nff, LightColourIsOptional) {
+  Scene s = parse("l 1 2 3 0.5 0.25 1\nl 4 5 6\ns 0 0 0 1");
+  ASSERT_EQ(s.lights.size(), 2u);
+  EXPECT_EQ(s.lights[0].color, (Color{0.5f, 0.25f, 1}));
+  EXPECT_EQ(s.lights[1].position, (Vec3d{4, 5, 6}));
+  EXPECT_EQ(s.lights[1].color, (Color{1, 1, 1}));
+}
+
+TEST(Nff, ObjectsBeforeAnyMaterialGetTheDefault) {
+  Scene s = parse("s 0 0 0 1\nf 1 0 0 1 0 1 0 1\ns 1 1 1 1\n");
+  ASSERT_EQ(s.materials.size(), 2u);
+  EXPECT_EQ(s.materials[0].color, (Color{1, 1, 1}));
+  EXPECT_DOUBLE_EQ(s.materials[0].kd, 1);
+  EXPECT_EQ(s.objects[0].material, 0u);
+  EXPECT_EQ(s.objects[1].material, 1u);
+}
+
+TEST(Nff, CommentsRunToEndOfLine) {
+  Scene s = parse("# a comment s 1 1 1 1\ns 0 0 0 1 # another\n#\n");
+  EXPECT_EQ(s.objects.size(), 1u);
+}
+
+TEST(Nff, NegativeRadiusIsLegal) {
+  Scene s = parse("s 0 0 0 -1");
+  EXPECT_DOUBLE_EQ(std::get<Sphere>(s.objects[0].shape).radius, -1);
+}
+
+TEST(Nff, NonConvexPolygonWithManyVerticesKeepsThemAll) {
+  Scene s = parse("p 5\n0 0 0\n2 0 0\n2 2 0\n1 0.5 0\n0 2 0\n");
+  EXPECT_EQ(std::get<Polygon>(s.objects[0].shape).vertices.size(), 5u);
+}
+
+std::string gzip(const std::string& text) {
+  z_stream zs{};
+  deflateInit2(&zs, Z_DEFAULT_COMPRESSION, Z_DEFLATED, 16 + MAX_WBITS, 8, Z_DEFAULT_STRATEGY);
+  std::string out(deflateBound(&zs, text.size()) + 64, '\0');
+  zs.next_in = reinterpret_cast<Bytef*>(const_cast<char*>(text.data()));
+  zs.avail_in = static_cast<uInt>(text.size());
+  zs.next_out = reinterpret_cast<Bytef*>(out.data());
+  zs.avail_out = static_cast<uInt>(out.size());
+  deflate(&zs, Z_FINISH);
+  out.resize(zs.total_out);
+  deflateEnd(&zs);
+  return out;
+}
+
+TEST(Nff, GzipIsDetectedByMagicBytes) {
+  std::istringstream in(gzip("s 0 0 0 1\ns 1 1 1 2\n"));
+  Scene s = parse_nff(in, "x.nff");
+  EXPECT_EQ(s.objects.size(), 2u);
+}
+
+TEST(NffError, TruncatedGzipNamesTheSource) {
+  std::string z = gzip(std::string(5000, ' ') + "s 0 0 0 1\n");
+  EXPECT_NE(error_of(z.substr(0, z.size() / 2)).find("t.nff: "), std::string::npos);
+}
+
+TEST(NffError, MissingFileNamesIt) {
+  EXPECT_THROW(load_nff_file("/nonexistent/scene.nff"), SceneError);
+}
+
+struct BadInput {
+  const char* label;
+  std::string text;
+  std::string expected;  // the whole message must start with this
+};
+
+class NffBadInput : public ::testing::TestWithParam<BadInput> {};
+
+TEST_P(NffBadInput, GivesOneLineErrorWithLineNumber) {
+  std::string message = error_of(GetParam().text);
+  EXPECT_EQ(message.rfind(GetParam().expected, 0), 0u) << message;
+  EXPECT_EQ(message.find('\n'), std::string::npos) << message;
+}
+
+INSTANTIATE_TEST_SUITE_P(
+    Malformed, NffBadInput,
+    ::testing::Values(
+        BadInput{"TruncatedLine", "s 0 0 0 1\ns 0 0", "t.nff:2: expected a finite number (sphere centre), got end of file"},
+        BadInput{"BadNumber", "\n\ns 0 0 x2 1", "t.nff:3: expected a finite number (sphere centre), got 'x2'"},
+        BadInput{"TrailingGarbageInNumber", "s 0 0 0 1.5.2", "t.nff:1: expected a finite number (sphere radius), got '1.5.2'"},
+        BadInput{"UnknownKeyword", "s 0 0 0 1\nsphere 1 2 3", "t.nff:2: expected an entity keyword (v b l f c s p pp), got 'sphere'"},
+        BadInput{"TooFewVertices", "p 2\n0 0 0\n1 0 0\n", "t.nff:1: expected polygon vertex count (an integer in 3.."},
+        BadInput{"NegativeCount", "pp -4\n", "t.nff:1: expected patch vertex count (an integer in 3.."},
+        BadInput{"CountLargerThanFile", "p 1000000000000\n0 0 0\n1 0 0\n", "t.nff:3: expected a finite number (polygon vertex), got end of file"},
+        BadInput{"NaN", "s 0 nan 0 1", "t.nff:1: expected a finite number (sphere centre), got 'nan'"},
+        BadInput{"Infinity", "l 0 0 -inf", "t.nff:1: expected a finite number (light position), got '-inf'"},
+        BadInput{"Overflow", "s 0 0 0 1e999", "t.nff:1: expected a finite number (sphere radius), got '1e999'"},
+        BadInput{"ZeroRadius", "\ns 1 2 3 0", "t.nff:2: sphere radius is zero"},
+        BadInput{"ZeroUp", "v from 0 0 1 at 0 0 0 up 0 0 0 angle 45 hither 1 resolution 8 8", "t.nff:1: 'up' must be non-zero"},
+        BadInput{"UpAlongView", "v from 0 0 1 at 0 0 0 up 0 0 3 angle 45 hither 1 resolution 8 8", "t.nff:1: 'up' must be non-zero"},
+        BadInput{"FromEqualsAt", "v\nfrom 1 1 1\nat 1 1 1\n", "t.nff:3: 'at' must differ from 'from'"},
+        BadInput{"MissingViewField", "v\nfrom 0 0 1\nat 0 0 0\nangle 45", "t.nff:4: expected 'up', got 'angle'"},
+        BadInput{"HugeResolution", "v from 0 0 1 at 0 0 0 up 0 1 0 angle 45 hither 1 resolution 100000 8", "t.nff:1: expected image width (an integer in 1..16384), got '100000'"},
+        BadInput{"BadAngle", "v from 0 0 1 at 0 0 0 up 0 1 0 angle 180 hither 1 resolution 8 8", "t.nff:1: 'angle' must lie"},
+        BadInput{"ZeroConeAxis", "c 1 1 1 0.5\n1 1 1 0.5", "t.nff:2: cone base and apex coincide"},
+        BadInput{"CollinearFirstCorner", "p 4\n0 0 0\n1 0 0\n2 0 0\n0 1 0\n", "t.nff:5: polygon's first three vertices are collinear"},
+        BadInput{"ZeroPatchNormal", "pp 3\n0 0 0 0 0 1\n1 0 0 0 0 0\n", "t.nff:3: patch vertex normal has zero length"},
+        BadInput{"ShortMaterial", "f 1 1 1 1 0 1 0\ns 0 0 0 1", "t.nff:2: expected a finite number (index of refraction), got 's'"},
+        BadInput{"BinaryGarbage", std::string("s 0 0 0 1\n\x01\x02\xff", 13), "t.nff:2: expected an entity keyword (v b l f c s p pp), got '\\x01\\x02\\xff'"}),
+    [](const auto& info) { return std::string(info.param.label); });
+
+}  // namespace
+}  // namespace tracer
