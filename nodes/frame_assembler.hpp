@@ -1,0 +1,35 @@
+// The frame collector's bookkeeping, without fibers: stores each arriving
+// item's colour (a pixel, or an SPD corner sample) and checks that every
+// item arrives exactly once.
+//
+// Invariants: received() counts distinct items; an item outside the frame or
+// arriving twice is a protocol error (std::logic_error), never silently
+// overwritten; complete() once received() == items().
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include "nodes/messages.hpp"
+#include "tracer/vec.hpp"
+
+namespace nodes {
+
+class FrameAssembler {
+ public:
+  explicit FrameAssembler(std::uint32_t items);
+
+  void add(const ResultView& result);
+
+  std::uint32_t items() const { return static_cast<std::uint32_t>(colors_.size()); }
+  std::uint32_t received() const { return received_; }
+  bool complete() const { return received_ == colors_.size(); }
+  const std::vector<tracer::Color>& colors() const { return colors_; }
+
+ private:
+  std::vector<tracer::Color> colors_;
+  std::vector<bool> arrived_;
+  std::uint32_t received_ = 0;
+};
+
+}  // namespace nodes

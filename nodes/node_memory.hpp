@@ -1,0 +1,108 @@
+// A processor's share of the scene database: its own pages (the pages it
+// owns) and an LRU cache of copies of remote pages. No fibers here; the
+// blocking part of the shared virtual memory is in svm.hpp.
+//
+// Pages are read-only while rendering, so a cached copy never goes stale and
+// no coherence protocol is needed: a page is fetched from its owner at most
+// once per residence in the cache, and the owner never has to invalidate it.
+//
+// Invariants:
+//  - entry_[p] says where page p lives on this node, so one array load
+//    answers every access: >= 0 own page (its index in own_), -1 not here,
+//    <= -2 cache slot (-2 - entry).
+//  - the LRU list holds exactly the occupied slots, most recent at the head;
+//    touching, installing and evicting are O(1) (eviction skips pinned
+//    slots, of which there are at most one per worker).
+//  - a pinned slot is never evicted: a worker pins the slot whose bytes it
+//    is using, so another worker of the node cannot pull them away.
+//  - resident bytes = own pages + occupied slots; slots are allocated on
+//    first use and never exceed the cache capacity.
+// A node's workers are fibers on one OS thread and run one at a time, and no
+// member function suspends, so no lock is needed.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <memory>
+#include <span>
+#include <unordered_map>
+#include <vector>
+
+namespace nodes {
+
+enum class Distribution { modulo, block };
+
+// Which node owns each page, and where in its own store the page sits.
+class PagePlacement {
+ public:
+  PagePlacement(Distribution distribution, int nodes, std::uint32_t page_count);
+
+  int owner(std::uint32_t page) const;
+  std::uint32_t own_index(std::uint32_t page) const;      // index within owner's pages
+  std::uint32_t page_of(int node, std::uint32_t index) const;  // inverse of own_index
+  std::uint32_t own_count(int node) const;
+  std::uint32_t page_count() const { return page_count_; }
+  int nodes() const { return nodes_; }
+
+ private:
+  std::uint32_t block_first(int node) const;
+
+  Distribution distribution_;
+  int nodes_;
+  std::uint32_t page_count_;
+};
+
+class NodeMemory {
+ public:
+  // own_pages: own_count(node) pages of page_size bytes, in own_index order,
+  // moved in (the host keeps no copy).
+  NodeMemory(const PagePlacement& placement, int node, std::size_t page_size,
+             std::vector<std::vector<std::byte>> own_pages, std::uint32_t cache_pages);
+
+  std::int32_t entry(std::uint32_t page) const { return entry_[page]; }
+  static bool is_slot(std::int32_t entry) { return entry <= -2; }
+  static int slot_of_entry(std::int32_t entry) { return -2 - entry; }
+
+  const std::byte* own_page(std::int32_t index) const { return own_[static_cast<std::size_t>(index)].data(); }
+  const std::byte* slot_bytes(int slot) const { return slots_[static_cast<std::size_t>(slot)].get(); }
+
+  void touch(int slot);  // make most recently used
+  void pin(int slot) { ++pins_[static_cast<std::size_t>(slot)]; }
+  void unpin(int slot) { --pins_[static_cast<std::size_t>(slot)]; }
+
+  // Copies a fetched remote page into a free slot or the least recently
+  // used unpinned one, and returns that slot. Throws std::logic_error if
+  // every slot is pinned (cannot happen: see svm.hpp).
+  int install(std::uint32_t page, std::span<const std::byte> bytes);
+
+  // Miss coalescing: begin_fetch is true for the first worker to miss on a
+  // page (it fetches); later ones add_waiter and are woken by the fetcher
+  // with the list end_fetch returns.
+  bool begin_fetch(std::uint32_t page);
+  void add_waiter(std::uint32_t page, int worker);
+  std::vector<int> end_fetch(std::uint32_t page);
+
+  std::uint32_t cache_capacity() const { return capacity_; }
+  std::size_t page_size() const { return page_size_; }
+  std::size_t own_bytes() const { return own_.size() * page_size_; }
+  std::size_t resident_bytes() const { return (own_.size() + slots_.size()) * page_size_; }
+  std::uint64_t evictions() const { return evictions_; }
+
+ private:
+  int take_slot();
+  void unlink(int slot);
+  void push_front(int slot);
+
+  std::size_t page_size_;
+  std::uint32_t capacity_;
+  std::vector<std::vector<std::byte>> own_;
+  std::vector<std::int32_t> entry_;
+  std::vector<std::unique_ptr<std::byte[]>> slots_;  // stable addresses
+  std::vector<std::uint32_t> slot_page_;
+  std::vector<int> prev_, next_, pins_;
+  int head_ = -1, tail_ = -1;  // most / least recently used occupied slot
+  std::uint64_t evictions_ = 0;
+  std::unordered_map<std::uint32_t, std::vector<int>> pending_;  // page -> waiting workers
+};
+
+}  // namespace nodes
