@@ -1,0 +1,29 @@
+// Test helper: a minimal XML well-formedness checker for the SVG and HTML the
+// viz library writes. It tracks element nesting, requires quoted attribute
+// values and known entities, and collects every attribute so tests can look
+// for NaN/inf in coordinates or at referenced files.
+#pragma once
+
+#include <map>
+#include <string>
+#include <vector>
+
+namespace viz::test {
+
+struct XmlElement {
+  std::string tag;
+  std::map<std::string, std::string> attrs;
+};
+
+struct XmlCheck {
+  bool ok = true;
+  std::string error;                  // first problem found
+  std::vector<XmlElement> elements;   // in document order
+};
+
+// `void_tags` lists HTML elements that never take a closing tag (e.g. "meta").
+XmlCheck check_xml(const std::string& text, const std::vector<std::string>& void_tags = {});
+
+std::size_t count_class(const XmlCheck& doc, const std::string& cls);
+
+}  // namespace viz::test
