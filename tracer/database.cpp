@@ -1,0 +1,238 @@
+// build_database: triangulate, build the acceleration structure, pack pages.
+#include "tracer/database.hpp"
+
+#include <algorithm>
+#include <bit>
+#include <chrono>
+#include <cmath>
+#include <cstring>
+#include <limits>
+
+#include "tracer/bvh.hpp"
+#include "tracer/grid.hpp"
+
+namespace tracer {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+double seconds_since(Clock::time_point t0) {
+  return std::chrono::duration<double>(Clock::now() - t0).count();
+}
+
+Vec3f to_f(const Vec3d& v) { return static_cast<Vec3f>(v); }
+
+// Primitives in scene order with their boxes, before any acceleration structure.
+struct Flattened {
+  std::vector<PrimRecord> prims;
+  std::vector<NormalRecord> normals;
+  std::vector<Box3f> bounds;
+};
+
+// Widen a box by a few float ulps of its coordinates, so that float rounding
+// in the intersection routines never puts a hit outside its primitive's box.
+Box3f padded(Box3f b) {
+  const float m = std::max({std::fabs(b.lo.x), std::fabs(b.lo.y), std::fabs(b.lo.z),
+                            std::fabs(b.hi.x), std::fabs(b.hi.y), std::fabs(b.hi.z)});
+  const float pad = m * 1e-6f + 1e-30f;
+  b.lo -= Vec3f{pad, pad, pad};
+  b.hi += Vec3f{pad, pad, pad};
+  return b;
+}
+
+void add_polygon(Flattened& f, const std::vector<Vec3d>& v, const std::vector<Vec3d>* normals,
+                 std::uint32_t material, std::uint32_t object) {
+  const Vec3d n = cross(v[1] - v[0], v[2] - v[0]);
+  if (!(length(n) > 0)) return;  // first three vertices collinear: no plane, nothing visible
+  const Vec3f unit_n = to_f(normalize(n));
+  for (const auto& tri : triangulate_polygon(v)) {
+    PrimRecord r{};
+    r.kind = normals ? PrimKind::smooth_triangle : PrimKind::flat_triangle;
+    r.material = material;
+    r.object = object;
+    r.p0 = to_f(v[tri[0]]);
+    r.p1 = to_f(v[tri[1]] - v[tri[0]]);
+    r.p2 = to_f(v[tri[2]] - v[tri[0]]);
+    r.p3 = unit_n;
+    if (normals) {
+      NormalRecord nr{};
+      nr.n0 = to_f(normalize((*normals)[tri[0]]));
+      nr.n1 = to_f(normalize((*normals)[tri[1]]));
+      nr.n2 = to_f(normalize((*normals)[tri[2]]));
+      r.aux = static_cast<std::uint32_t>(f.normals.size());
+      f.normals.push_back(nr);
+    }
+    Box3f b;
+    for (int k = 0; k < 3; ++k) b.extend(to_f(v[tri[k]]));
+    f.prims.push_back(r);
+    f.bounds.push_back(padded(b));
+  }
+}
+
+Flattened flatten(const Scene& scene) {
+  Flattened f;
+  for (std::uint32_t i = 0; i < scene.objects.size(); ++i) {
+    const Object& o = scene.objects[i];
+    PrimRecord r{};
+    r.material = o.material;
+    r.object = i;
+    if (const auto* s = std::get_if<Sphere>(&o.shape)) {
+      r.kind = PrimKind::sphere;
+      r.p0 = to_f(s->center);
+      r.p1.x = static_cast<float>(s->radius);
+      const float ar = std::fabs(r.p1.x);
+      f.bounds.push_back(padded({r.p0 - Vec3f{ar, ar, ar}, r.p0 + Vec3f{ar, ar, ar}}));
+      f.prims.push_back(r);
+    } else if (const auto* c = std::get_if<Cone>(&o.shape)) {
+      r.kind = PrimKind::cone;
+      r.p0 = to_f(c->base);
+      r.p1 = to_f(c->apex);
+      r.p2 = {static_cast<float>(c->base_radius), static_cast<float>(c->apex_radius), 0};
+      f.bounds.push_back(padded(cone_bounds({r.p0, r.p1, r.p2.x, r.p2.y})));
+      f.prims.push_back(r);
+    } else if (const auto* p = std::get_if<Polygon>(&o.shape)) {
+      add_polygon(f, p->vertices, nullptr, o.material, i);
+    } else if (const auto* pp = std::get_if<Patch>(&o.shape)) {
+      add_polygon(f, pp->vertices, &pp->normals, o.material, i);
+    }
+  }
+  return f;
+}
+
+// Appends sections of fixed-size records, each starting on a fresh page.
+class Packer {
+ public:
+  explicit Packer(std::uint32_t page_size) : page_size_(page_size) {}
+
+  template <class T>
+  SectionLayout add(const std::vector<T>& records, const char* what) {
+    static_assert(std::is_trivially_copyable_v<T>);
+    if (sizeof(T) > page_size_)
+      throw DatabaseError("page size " + std::to_string(page_size_) + " is too small for a " +
+                          what + " record of " + std::to_string(sizeof(T)) + " bytes");
+    SectionLayout s{static_cast<PageId>(pages_.size()), sizeof(T),
+                    static_cast<std::uint32_t>(records.size())};
+    const std::size_t bytes = records.size() * sizeof(T);
+    const std::size_t npages = (bytes + page_size_ - 1) / page_size_;
+    if (pages_.size() + npages > std::numeric_limits<PageId>::max())
+      throw DatabaseError("scene too large: more than 2^32 pages");
+    const auto* src = reinterpret_cast<const std::byte*>(records.data());
+    for (std::size_t p = 0; p < npages; ++p) {
+      std::vector<std::byte> page(page_size_, std::byte{0});
+      const std::size_t n = std::min<std::size_t>(page_size_, bytes - p * page_size_);
+      std::memcpy(page.data(), src + p * page_size_, n);
+      pages_.push_back(std::move(page));
+    }
+    payload_ += bytes;
+    return s;
+  }
+
+  std::vector<std::vector<std::byte>> take() { return std::move(pages_); }
+  std::uint64_t payload() const { return payload_; }
+
+ private:
+  std::uint32_t page_size_;
+  std::vector<std::vector<std::byte>> pages_;
+  std::uint64_t payload_ = 0;
+};
+
+// Puts primitives (and their normal records) in BVH leaf order.
+void reorder(Flattened& f, const std::vector<std::uint32_t>& order) {
+  std::vector<PrimRecord> prims;
+  std::vector<NormalRecord> normals;
+  prims.reserve(order.size());
+  for (std::uint32_t idx : order) {
+    PrimRecord r = f.prims[idx];
+    if (r.kind == PrimKind::smooth_triangle) {
+      normals.push_back(f.normals[r.aux]);
+      r.aux = static_cast<std::uint32_t>(normals.size() - 1);
+    }
+    prims.push_back(r);
+  }
+  f.prims = std::move(prims);
+  f.normals = std::move(normals);
+}
+
+std::vector<MaterialRecord> material_records(const Scene& scene) {
+  std::vector<MaterialRecord> out;
+  for (const Material& m : scene.materials)
+    out.push_back({m.color, float(m.kd), float(m.ks), float(m.shine), float(m.transmittance),
+                   float(m.ior)});
+  if (out.empty()) out.push_back({{1, 1, 1}, 1, 0, 0, 0, 1});
+  return out;
+}
+
+void fill_header(DatabaseHeader& h, const Scene& scene, const Flattened& f,
+                 const BuildOptions& opt) {
+  h.scene_name = scene.name;
+  h.camera = scene.camera;
+  h.background = scene.background;
+  // SPD's convention: each light has intensity 1/sqrt(number of lights).
+  const float intensity = scene.lights.empty() ? 1.0f : 1.0f / std::sqrt(float(scene.lights.size()));
+  for (const Light& l : scene.lights) h.lights.push_back({to_f(l.position), l.color * intensity});
+  h.page_size = opt.page_size;
+  h.page_shift = static_cast<std::uint32_t>(std::countr_zero(opt.page_size));
+  h.accel = opt.accel;
+  for (const Box3f& b : f.bounds) h.bounds.extend(b);
+  const float diag = h.bounds.empty() ? 1.0f : length(h.bounds.extent());
+  h.epsilon = std::max(diag * 2e-5f, 1e-6f);
+  h.polygon_count = scene.polygon_count();
+  h.object_count = scene.objects.size();
+  h.primitive_count = f.prims.size();
+}
+
+}  // namespace
+
+void validate_page_size(std::uint64_t page_size) {
+  if (page_size < 256 || page_size > 65536 || !std::has_single_bit(page_size))
+    throw DatabaseError("page size " + std::to_string(page_size) +
+                        " is not a power of two from 256 to 65536");
+}
+
+Database build_database(const Scene& scene, const BuildOptions& opt) {
+  validate_page_size(opt.page_size);
+  if (scene.camera.width < 1 || scene.camera.height < 1)
+    throw std::invalid_argument("image size must be at least 1x1");
+  Database db;
+  auto t0 = Clock::now();
+  Flattened f = flatten(scene);
+  if (f.prims.size() >= std::numeric_limits<std::uint32_t>::max())
+    throw DatabaseError("scene too large: more than 2^32 primitives");
+  fill_header(db.header, scene, f, opt);
+  db.stats.triangulate_seconds = seconds_since(t0);
+
+  t0 = Clock::now();
+  DatabaseHeader& h = db.header;
+  Packer packer(opt.page_size);
+  auto& sec = h.sections;
+  sec[int(Section::materials)] = packer.add(material_records(scene), "material");
+  if (opt.accel == Accel::bvh) {
+    BvhBuild bvh = build_bvh(f.bounds, opt.bvh_max_leaf);
+    reorder(f, bvh.order);
+    db.stats.accel_seconds = seconds_since(t0);
+    t0 = Clock::now();
+    h.bvh_root = bvh.nodes[0];
+    h.bvh_depth = bvh.depth;
+    db.stats.bvh_nodes = bvh.nodes.size();
+    sec[int(Section::bvh_nodes)] = packer.add(bvh.nodes, "BVH node");
+  } else {
+    GridBuild g = build_grid(f.bounds, h.bounds, opt.grid_density);
+    if (g.lists.size() >= std::numeric_limits<std::uint32_t>::max())
+      throw DatabaseError("grid too large: more than 2^32 cell references");
+    db.stats.accel_seconds = seconds_since(t0);
+    t0 = Clock::now();
+    std::copy(g.dims, g.dims + 3, h.grid_dims);
+    db.stats.grid_cells = g.cells.size();
+    db.stats.grid_references = g.lists.size();
+    sec[int(Section::grid_cells)] = packer.add(g.cells, "grid cell");
+    sec[int(Section::grid_lists)] = packer.add(g.lists, "grid list");
+  }
+  sec[int(Section::prims)] = packer.add(f.prims, "primitive");
+  sec[int(Section::normals)] = packer.add(f.normals, "normal");
+  db.stats.payload_bytes = packer.payload();
+  db.pages = packer.take();
+  h.page_count = static_cast<std::uint32_t>(db.pages.size());
+  db.stats.pack_seconds = seconds_since(t0);
+  return db;
+}
+
+}  // namespace tracer

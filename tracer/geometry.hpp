@@ -1,0 +1,81 @@
+// Ray/primitive intersection in single precision: rays, boxes, triangles,
+// spheres and cones (NFF's primitives once polygons are triangulated).
+// Invariants: every routine is a pure function of its arguments (no state),
+// so a hit distance depends only on the ray and the primitive's stored floats
+// — never on the acceleration structure or the page layout that led there.
+// A routine reports a hit only for t in the open interval (t_min, t_max).
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <optional>
+#include <vector>
+
+#include "tracer/vec.hpp"
+
+namespace tracer {
+
+struct Ray {
+  Vec3f origin;
+  Vec3f dir;  // not necessarily unit length
+};
+
+struct Box3f {
+  Vec3f lo{1e30f, 1e30f, 1e30f};
+  Vec3f hi{-1e30f, -1e30f, -1e30f};
+
+  void extend(const Vec3f& p) { lo = min(lo, p); hi = max(hi, p); }
+  void extend(const Box3f& b) { lo = min(lo, b.lo); hi = max(hi, b.hi); }
+  bool empty() const { return lo.x > hi.x; }
+  Vec3f centre() const { return (lo + hi) * 0.5f; }
+  Vec3f extent() const { return hi - lo; }
+  float half_area() const {
+    const Vec3f d = extent();
+    return empty() ? 0.0f : d.x * d.y + d.y * d.z + d.z * d.x;
+  }
+};
+
+// Reciprocal direction, precomputed once per ray for the slab tests.
+struct RayInverse {
+  Vec3f inv_dir;
+  explicit RayInverse(const Ray& r)
+      : inv_dir{1.0f / r.dir.x, 1.0f / r.dir.y, 1.0f / r.dir.z} {}
+};
+
+// Slab test: entry distance if the ray meets the box within [t_min, t_max].
+std::optional<float> intersect_box(const Ray& r, const RayInverse& inv, const Box3f& b,
+                                   float t_min, float t_max);
+
+struct TriangleHit {
+  float t, u, v;  // barycentric (u, v) of vertex 1 and 2
+};
+
+// Two-sided Moeller-Trumbore on a triangle stored as v0, e1 = v1 - v0, e2 = v2 - v0.
+std::optional<TriangleHit> intersect_triangle(const Ray& r, const Vec3f& v0, const Vec3f& e1,
+                                              const Vec3f& e2, float t_min, float t_max);
+
+// Sphere; a negative radius means only the inside is visible: hits where the
+// inward normal faces away from the ray are skipped.
+std::optional<float> intersect_sphere(const Ray& r, const Vec3f& centre, float radius,
+                                      float t_min, float t_max);
+Vec3f sphere_normal(const Vec3f& centre, float radius, const Vec3f& p);
+
+// Cone or cylinder between base and apex, no caps, radii linear along the axis.
+// Negative radii: only the inside is visible (as for spheres).
+struct ConeShape {
+  Vec3f base;
+  Vec3f apex;
+  float base_radius;
+  float apex_radius;
+};
+std::optional<float> intersect_cone(const Ray& r, const ConeShape& c, float t_min, float t_max);
+Vec3f cone_normal(const ConeShape& c, const Vec3f& p);  // unit, outward (inward if radii < 0)
+Box3f cone_bounds(const ConeShape& c);
+
+// Ear clipping of a planar polygon of any vertex count, convex or not, in the
+// plane fixed by its first three vertices; returns vertex index triples with
+// the polygon's winding. A polygon that has no ear left (self-intersecting or
+// degenerate) is finished as a fan, so every input gives n - 2 triangles.
+std::vector<std::array<std::uint32_t, 3>> triangulate_polygon(const std::vector<Vec3d>& vertices);
+
+}  // namespace tracer

@@ -1,0 +1,107 @@
+// Whitted ray tracing over a paged database: the code a processor runs to turn
+// a pixel (or an SPD corner sample) into a colour.
+//
+// Invariants:
+//  - A Tracer reads the scene only through its PageSource (plus the replicated
+//    DatabaseHeader). It copies every record out of the page (memcpy) before
+//    its next page() call, honouring the PageSource contract, and it calls
+//    page() only when a record lies outside the page it read last.
+//  - A pixel's colour depends only on (x, y), the header and the page
+//    contents: no global state, no random numbers, so an image is identical
+//    however its pixels are distributed over tracers, and for every page size.
+//  - A Tracer is single-threaded; use one per fiber or thread.
+//
+// Shading (NFF): per positional light, Kd * colour * (N.L) + Ks * (R.V)^Shine,
+// no ambient term; light intensity 1/sqrt(#lights) (SPD's convention).
+// Shadow rays: every object, transmitting ones included, blocks light fully
+// (as SPD-style renderers do); no shadow ray where N.L <= 0. Reflection
+// (weight Ks) when Ks > 0; refraction (weight T, Snell's law, IOR of the
+// material inside, 1 outside) when T > 0; under total internal reflection the
+// T weight goes to the reflection ray. Surfaces are two-sided: the shading
+// normal is turned to face the incoming ray. Outside SPD mode a secondary ray
+// is skipped when its weight along the path falls below min_contribution.
+#pragma once
+
+#include <functional>
+#include <optional>
+#include <vector>
+
+#include "tracer/camera.hpp"
+#include "tracer/database.hpp"
+#include "tracer/stats.hpp"
+
+namespace tracer {
+
+struct TraceOptions {
+  int max_depth = 5;                     // the eye ray is depth 1
+  float min_contribution = 1.0f / 256;   // adaptive depth cut-off (not in SPD mode)
+  bool spd_procedure = false;            // SPD testing procedure (see NFF.md)
+};
+
+// The closest hit of a ray: distance, barycentrics and the primitive record.
+struct Hit {
+  float t = 0;
+  float u = 0, v = 0;
+  std::uint32_t prim_index = 0;
+  PrimRecord prim{};
+};
+
+class Tracer {
+ public:
+  // header and pages must outlive the Tracer.
+  Tracer(const DatabaseHeader& header, PageSource& pages, TraceOptions options = {});
+
+  // Colour of pixel (x, y), one eye ray through its centre.
+  Color trace_pixel(int x, int y, RayStats& stats);
+  // SPD corner sample (sx, sy), 0 <= sx <= width, 0 <= sy <= height: pixel
+  // (x, y) is average_corners of samples (x, y), (x+1, y), (x, y+1), (x+1, y+1).
+  Color trace_sample(int sx, int sy, RayStats& stats);
+  static Color average_corners(const Color& c00, const Color& c10, const Color& c01,
+                               const Color& c11);
+
+  // Ray queries, public for tests and benchmarks.
+  std::optional<Hit> closest_hit(const Ray& ray, float t_min, float t_max, RayStats& stats);
+  bool occluded(const Ray& ray, float t_min, float t_max, RayStats& stats);
+
+ private:
+  template <class T> T read(Section section, std::uint64_t index, RayStats& stats);
+  const std::byte* fetch(PageId id, RayStats& stats);
+  void begin_sample();
+  void end_sample(RayStats& stats);
+  Color trace_eye(const Ray& ray, RayStats& stats);
+
+  // Traversal; Any = stop at the first hit (shadow rays).
+  template <bool Any> bool traverse_bvh(const Ray& ray, float t_min, float& t_max, Hit* hit, RayStats& stats);
+  template <bool Any> bool traverse_grid(const Ray& ray, float t_min, float& t_max, Hit* hit, RayStats& stats);
+  template <bool Any> bool test_prim(std::uint32_t index, const Ray& ray, float t_min, float& t_max, Hit* hit, RayStats& stats);
+
+  // Shading (shading.cpp).
+  Color shade(const Ray& ray, int depth, float weight, RayStats& stats);
+  Color shade_hit(const Ray& ray, const Hit& hit, int depth, float weight, RayStats& stats);
+  Color direct_light(const Vec3f& p, const Vec3f& n_geo, const Vec3f& n, const Vec3f& view,
+                     const MaterialRecord& m, RayStats& stats);
+
+  const DatabaseHeader& header_;
+  PageSource& pages_;
+  TraceOptions options_;
+  CameraModel camera_;
+  PageId last_page_ = 0;
+  const std::byte* last_ptr_ = nullptr;  // page last_page_, or null
+  std::vector<std::uint32_t> page_stamp_;  // sample generation that last touched each page
+  std::uint32_t generation_ = 0;
+  std::uint64_t sample_pages_ = 0;
+  struct StackEntry {
+    std::uint32_t child, count;
+    float t;
+  };
+  std::vector<StackEntry> stack_;
+};
+
+// Renders a whole frame sequentially into row-major pixels (y = 0 at the top);
+// in SPD mode from (W+1) x (H+1) corner samples. `progress(rows_done)` is
+// called after each row when given.
+std::vector<Color> render_frame(const DatabaseHeader& header, PageSource& pages,
+                                const TraceOptions& options, RayStats& stats,
+                                const std::function<void(int)>& progress = {});
+
+}  // namespace tracer
