@@ -1,0 +1,29 @@
+// Tessellation of analytic primitives into smooth triangles ("pp" patches
+// with unit vertex normals), exactly as SPD's "-t RES" option does, so a
+// tessellated built-in scene matches the SPD reference files:
+//  - a sphere at resolution r: the six faces of a cube, each an r x r grid
+//    at equal angles (-45..45 degrees) projected onto the sphere, each grid
+//    cell two triangles: 12 r^2 triangles, counter-clockwise seen from the
+//    visible side (inside, for a negative radius);
+//  - a cone or cylinder at resolution r: 4 r slices around the axis, each
+//    two triangles, no caps: 8 r triangles (fewer for a true cone, whose
+//    zero-area triangles at the apex are dropped).
+// Each object keeps its material and its place in the object order.
+#pragma once
+
+#include <vector>
+
+#include "tracer/scene.hpp"
+
+namespace tracer {
+
+inline constexpr int kMaxTessellation = 64;
+
+std::vector<Patch> tessellate_sphere(const Sphere& sphere, int resolution);
+std::vector<Patch> tessellate_cone(const Cone& cone, int resolution);
+
+// Replaces every sphere and cone of the scene by its triangles. Throws
+// std::invalid_argument unless 1 <= resolution <= kMaxTessellation.
+void tessellate(Scene& scene, int resolution);
+
+}  // namespace tracer
