@@ -116,7 +116,9 @@ void draw_panel(SvgDocument& doc, const LinePlot& plot, Rect panel) {
   const std::string clip_id = clip_id_for(a);
   doc.open("g", {{"class", "plot"}});
   doc.open("clipPath", {{"id", clip_id}});
-  doc.leaf("rect", {{"x", num(a.left)}, {"y", num(a.top)}, {"width", num(a.width)}, {"height", num(a.height)}});
+  // A little wider than the area so that markers on the border show whole.
+  doc.leaf("rect", {{"x", num(a.left - 4)}, {"y", num(a.top - 4)}, {"width", num(a.width + 8)},
+                    {"height", num(a.height + 8)}});
   doc.close();
   draw_grid_and_ticks(doc, g);
   draw_data(doc, plot, g, clip_id);

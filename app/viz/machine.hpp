@@ -1,0 +1,52 @@
+// A picture of the machine after a render, as SVG: every processor as a node
+// filled by the pixels it computed, ringed by the page requests it served, and
+// every directed link coloured and sized by the traffic it carried.
+// Layouts: hypercube bits alternate between x (even bits) and y (odd bits)
+// with gaps growing per level, so sub-cubes stand apart; mesh and torus on a
+// grid with node id = y * W + x (wrap links as arcs leaving the border); ring
+// and complete graph on a circle, node 0 at the top, ids clockwise.
+// Invariants: one element of class "node" per node, one of class "link" per
+// directed link that carried packets (the two directions of a link are drawn
+// side by side, each offset to the right of its direction of travel), one of
+// class "idle-link" per listed link that carried none.
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+namespace viz {
+
+enum class MachineKind { hypercube, mesh, torus, ring, complete };
+
+struct NodeWork {
+  std::uint64_t pixels = 0;                // pixels computed by this node
+  std::uint64_t page_requests_served = 0;  // by its page server
+  std::string label{};                     // drawn in the node; empty: its id
+};
+
+struct LinkTraffic {
+  int from = 0;  // the link carries packets from `from` to `to` (neighbours)
+  int to = 0;
+  std::uint64_t packets = 0;
+  std::uint64_t bytes = 0;
+};
+
+struct MachineDrawing {
+  MachineKind kind = MachineKind::ring;
+  int dim_a = 1;  // hypercube: dimension d; mesh/torus: width W; ring/complete: N
+  int dim_b = 1;  // mesh/torus: height H; unused otherwise
+  std::string title{};
+  std::vector<NodeWork> nodes{};     // index = node id
+  std::vector<LinkTraffic> links{};  // directed; colour and width by bytes (packets if no bytes given)
+};
+
+// Number of nodes the kind and dimensions describe; throws
+// std::invalid_argument naming the problem for impossible dimensions.
+int machine_node_count(const MachineDrawing& m);
+
+// Throws std::invalid_argument if nodes.size() does not match the topology or
+// a link names a node out of range.
+std::string machine_svg(const MachineDrawing& m);
+
+}  // namespace viz
