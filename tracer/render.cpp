@@ -38,6 +38,10 @@ T Tracer::read(Section section, std::uint64_t index, RayStats& stats) {
   return out;
 }
 
+// Shading (shading.cpp) reads these records too.
+template NormalRecord Tracer::read<NormalRecord>(Section, std::uint64_t, RayStats&);
+template MaterialRecord Tracer::read<MaterialRecord>(Section, std::uint64_t, RayStats&);
+
 void Tracer::begin_sample() {
   if (++generation_ == 0) {  // wrapped: forget stale stamps
     std::fill(page_stamp_.begin(), page_stamp_.end(), 0);

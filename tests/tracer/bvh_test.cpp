@@ -1,0 +1,85 @@
+// The BVH and the grid find the same closest hits as testing every primitive.
+#include <gtest/gtest.h>
+
+#include <cstring>
+#include <random>
+
+#include "test_scenes.hpp"
+#include "tracer/database.hpp"
+#include "tracer/render.hpp"
+
+namespace tracer {
+namespace {
+
+// Brute force over the packed primitive section, in the same float arithmetic.
+std::optional<std::pair<float, std::uint32_t>> brute_force(const Database& db, const Ray& ray) {
+  const SectionLayout& s = db.header.section(Section::prims);
+  std::optional<std::pair<float, std::uint32_t>> best;
+  float t_max = 1e30f;
+  for (std::uint32_t i = 0; i < s.record_count; ++i) {
+    const std::size_t byte = std::size_t{i} * sizeof(PrimRecord);
+    PrimRecord p;
+    std::memcpy(&p, db.pages[s.first_page + byte / db.header.page_size].data() +
+                        byte % db.header.page_size, sizeof p);
+    std::optional<float> t;
+    if (p.kind == PrimKind::sphere) t = intersect_sphere(ray, p.p0, p.p1.x, 0.0f, t_max);
+    else if (auto h = intersect_triangle(ray, p.p0, p.p1, p.p2, 0.0f, t_max)) t = h->t;
+    if (t) {
+      t_max = *t;
+      best = {{*t, p.object}};
+    }
+  }
+  return best;
+}
+
+void expect_same_hits_as_brute_force(Accel accel) {
+  const Scene scene = testing::random_scene(7, 400, 60);
+  const Database db = build_database(scene, {.accel = accel, .page_size = 512});
+  InMemoryPageSource pages(db);
+  Tracer tracer(db.header, pages);
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<float> u(-1.5f, 1.5f);
+  int hits = 0;
+  for (int i = 0; i < 3000; ++i) {
+    const Ray ray{{u(rng), u(rng), u(rng)}, {u(rng), u(rng), u(rng)}};
+    RayStats stats;
+    const auto expected = brute_force(db, ray);
+    const auto got = tracer.closest_hit(ray, 0.0f, 1e30f, stats);
+    ASSERT_EQ(expected.has_value(), got.has_value()) << "ray " << i;
+    if (!got) continue;
+    ++hits;
+    EXPECT_EQ(expected->first, got->t) << "ray " << i;
+    EXPECT_EQ(expected->second, got->prim.object) << "ray " << i;
+    EXPECT_TRUE(tracer.occluded(ray, 0.0f, got->t * 1.01f, stats));
+    EXPECT_FALSE(tracer.occluded(ray, 0.0f, got->t * 0.99f, stats));
+  }
+  EXPECT_GT(hits, 300);  // the test means something only if many rays hit
+}
+
+TEST(Bvh, ClosestHitsMatchBruteForce) { expect_same_hits_as_brute_force(Accel::bvh); }
+TEST(Grid, ClosestHitsMatchBruteForce) { expect_same_hits_as_brute_force(Accel::grid); }
+
+TEST(Bvh, SinglePrimitiveSceneIsTraversable) {
+  Scene s;
+  s.materials.push_back({});
+  s.objects.push_back({Sphere{{0, 0, 0}, 1}, 0});
+  const Database db = build_database(s);
+  InMemoryPageSource pages(db);
+  Tracer tracer(db.header, pages);
+  RayStats stats;
+  const auto hit = tracer.closest_hit({{0, 0, -5}, {0, 0, 1}}, 0.0f, 1e30f, stats);
+  ASSERT_TRUE(hit);
+  EXPECT_NEAR(hit->t, 4.0f, 1e-5f);
+}
+
+TEST(Bvh, EmptySceneHasNoHits) {
+  Scene s;
+  const Database db = build_database(s);
+  InMemoryPageSource pages(db);
+  Tracer tracer(db.header, pages);
+  RayStats stats;
+  EXPECT_FALSE(tracer.closest_hit({{0, 0, -5}, {0, 0, 1}}, 0.0f, 1e30f, stats));
+}
+
+}  // namespace
+}  // namespace tracer

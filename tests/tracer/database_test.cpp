@@ -1,0 +1,105 @@
+// Packing invariants of the paged database and page-size validation.
+#include "tracer/database.hpp"
+
+#include <gtest/gtest.h>
+
+#include <cstring>
+
+#include "test_scenes.hpp"
+
+namespace tracer {
+namespace {
+
+template <class T>
+T record(const Database& db, Section s, std::uint64_t i) {
+  const SectionLayout& l = db.header.section(s);
+  const std::uint64_t byte = i * l.record_size;
+  const std::uint64_t offset = byte % db.header.page_size;
+  EXPECT_LE(offset + l.record_size, db.header.page_size) << "record straddles a page";
+  T out;
+  std::memcpy(&out, db.pages.at(l.first_page + byte / db.header.page_size).data() + offset,
+              sizeof out);
+  return out;
+}
+
+void expect_consistent(const Database& db) {
+  const DatabaseHeader& h = db.header;
+  ASSERT_EQ(db.pages.size(), h.page_count);
+  for (const auto& p : db.pages) ASSERT_EQ(p.size(), h.page_size);
+  const auto& prims = h.section(Section::prims);
+  const auto& mats = h.section(Section::materials);
+  const auto& normals = h.section(Section::normals);
+  for (std::uint32_t i = 0; i < prims.record_count; ++i) {
+    const auto p = record<PrimRecord>(db, Section::prims, i);
+    EXPECT_LT(p.material, mats.record_count);
+    if (p.kind == PrimKind::smooth_triangle) EXPECT_LT(p.aux, normals.record_count);
+  }
+  if (h.accel == Accel::bvh) {
+    const auto& nodes = h.section(Section::bvh_nodes);
+    for (std::uint32_t i = 0; i < nodes.record_count; ++i) {
+      const auto n = record<BvhNode>(db, Section::bvh_nodes, i);
+      for (int c = 0; c < 2; ++c) {
+        if (n.count[c] == 0) EXPECT_LT(n.child[c], nodes.record_count);
+        else EXPECT_LE(std::uint64_t{n.child[c]} + n.count[c], prims.record_count);
+      }
+    }
+  } else {
+    const auto& cells = h.section(Section::grid_cells);
+    const auto& lists = h.section(Section::grid_lists);
+    EXPECT_EQ(cells.record_count, std::uint32_t(h.grid_dims[0] * h.grid_dims[1] * h.grid_dims[2]));
+    for (std::uint32_t i = 0; i < cells.record_count; ++i) {
+      const auto c = record<GridCell>(db, Section::grid_cells, i);
+      EXPECT_LE(std::uint64_t{c.first} + c.count, lists.record_count);
+    }
+    for (std::uint32_t i = 0; i < lists.record_count; ++i)
+      EXPECT_LT(record<std::uint32_t>(db, Section::grid_lists, i), prims.record_count);
+  }
+}
+
+TEST(Database, PackingKeepsRecordsInPagesAndReferencesResolve) {
+  const Scene scene = testing::showcase_scene(8);
+  for (Accel accel : {Accel::bvh, Accel::grid})
+    for (std::uint32_t page_size : {256u, 1024u, 65536u}) {
+      SCOPED_TRACE(page_size);
+      expect_consistent(build_database(scene, {.accel = accel, .page_size = page_size}));
+    }
+  expect_consistent(build_database(testing::random_scene(3, 300, 20), {.accel = Accel::grid}));
+}
+
+TEST(Database, SectionsStartOnPageBoundariesInOrder) {
+  const Database db = build_database(testing::random_scene(5, 200, 10), {.page_size = 256});
+  std::uint32_t pages = 0;
+  for (const SectionLayout& s : db.header.sections)
+    pages += static_cast<std::uint32_t>((std::uint64_t{s.record_count} * s.record_size + 255) / 256);
+  EXPECT_EQ(pages, db.header.page_count);  // no page is shared by two sections
+}
+
+TEST(Database, PackingIsDeterministic) {
+  const Scene scene = testing::random_scene(9, 300, 30);
+  const Database a = build_database(scene), b = build_database(scene);
+  EXPECT_EQ(a.pages, b.pages);
+}
+
+TEST(Database, TriangulatesPolygonsAndCountsPolygons) {
+  const Database db = build_database(testing::showcase_scene(8));
+  // Quad (2) + hexagon (4) + patch (1) triangles, 3 spheres, 2 cones.
+  EXPECT_EQ(db.header.primitive_count, 12u);
+  EXPECT_EQ(db.header.polygon_count, 3u);
+  EXPECT_EQ(db.header.bytes(), std::uint64_t{db.header.page_count} * 1024);
+}
+
+TEST(Database, RejectsPageSizesThatAreNotPowersOfTwoInRange) {
+  for (std::uint64_t bad : {0ull, 128ull, 255ull, 1000ull, 131072ull}) {
+    try {
+      validate_page_size(bad);
+      ADD_FAILURE() << bad << " accepted";
+    } catch (const DatabaseError& e) {
+      EXPECT_NE(std::string(e.what()).find(std::to_string(bad)), std::string::npos);
+    }
+  }
+  for (std::uint64_t good : {256ull, 512ull, 4096ull, 65536ull}) EXPECT_NO_THROW(validate_page_size(good));
+  EXPECT_THROW(build_database(testing::showcase_scene(8), {.page_size = 3000}), DatabaseError);
+}
+
+}  // namespace
+}  // namespace tracer

@@ -1,0 +1,118 @@
+// Renders of a small scene: independent of page size, of the page cache, of
+// how pixels are split; BVH and grid agree; SPD mode counts rays as specified.
+#include "tracer/render.hpp"
+
+#include <gtest/gtest.h>
+
+#include <cstring>
+
+#include "test_scenes.hpp"
+
+namespace tracer {
+namespace {
+
+constexpr int kSize = 40;
+
+std::vector<Color> render(const Scene& scene, BuildOptions build, TraceOptions trace = {},
+                          RayStats* stats_out = nullptr) {
+  const Database db = build_database(scene, build);
+  InMemoryPageSource pages(db);
+  RayStats stats;
+  auto image = render_frame(db.header, pages, trace, stats);
+  if (stats_out) *stats_out = stats;
+  return image;
+}
+
+// Keeps only the page read last, in one buffer: the smallest cache a node may have.
+class OnePageCache final : public PageSource {
+ public:
+  explicit OnePageCache(const Database& db) : db_(db), buffer_(db.header.page_size) {}
+  const std::byte* page(PageId id) override {
+    std::memset(buffer_.data(), 0xff, buffer_.size());  // poison the previous page
+    std::memcpy(buffer_.data(), db_.pages[id].data(), buffer_.size());
+    return buffer_.data();
+  }
+
+ private:
+  const Database& db_;
+  std::vector<std::byte> buffer_;
+};
+
+TEST(Render, ImageIsBitIdenticalForEveryPageSize) {
+  const Scene scene = testing::showcase_scene(kSize);
+  const auto reference = render(scene, {.page_size = 65536});
+  EXPECT_EQ(render(scene, {.page_size = 256}), reference);
+  EXPECT_EQ(render(scene, {.page_size = 1024}), reference);
+}
+
+TEST(Render, OnePageCacheGivesTheSameImage) {
+  const Scene scene = testing::showcase_scene(kSize);
+  const Database db = build_database(scene, {.page_size = 256});
+  InMemoryPageSource all(db);
+  OnePageCache one(db);
+  RayStats a, b;
+  EXPECT_EQ(render_frame(db.header, one, {}, b), render_frame(db.header, all, {}, a));
+  EXPECT_EQ(a.page_calls, b.page_calls);
+}
+
+TEST(Render, PixelsDoNotDependOnTraceOrder) {
+  const Scene scene = testing::showcase_scene(kSize);
+  const Database db = build_database(scene);
+  InMemoryPageSource pages(db);
+  RayStats stats;
+  const auto frame = render_frame(db.header, pages, {}, stats);
+  Tracer tracer(db.header, pages);
+  for (int y = kSize - 1; y >= 0; y -= 3)
+    for (int x = kSize - 1; x >= 0; x -= 5)
+      EXPECT_EQ(tracer.trace_pixel(x, y, stats), frame[std::size_t(y) * kSize + x]);
+}
+
+TEST(Render, BvhAndGridGiveTheSameImage) {
+  const Scene scene = testing::showcase_scene(kSize);
+  EXPECT_EQ(render(scene, {.accel = Accel::grid}), render(scene, {.accel = Accel::bvh}));
+}
+
+TEST(Render, SceneShowsEveryMaterial) {
+  const Scene scene = testing::showcase_scene(kSize);
+  RayStats stats;
+  const auto image = render(scene, {}, {}, &stats);
+  EXPECT_EQ(stats.primary, std::uint64_t(kSize) * kSize);
+  EXPECT_GT(stats.primary_hits, stats.primary / 2);
+  EXPECT_GT(stats.shadow, 0u);
+  EXPECT_GT(stats.reflected, 0u);
+  EXPECT_GT(stats.refracted, 0u);
+  EXPECT_GT(stats.pages_per_sample(), 1.0);
+  int background = 0;
+  for (const Color& c : image) background += c == scene.background;
+  EXPECT_GT(background, 0);
+  EXPECT_LT(background, kSize * kSize / 2);
+}
+
+TEST(Render, SpdProcedureTracesCornersAndAveragesThem) {
+  Scene scene = testing::showcase_scene(8);
+  const Database db = build_database(scene);
+  InMemoryPageSource pages(db);
+  RayStats stats;
+  const auto image = render_frame(db.header, pages, {.spd_procedure = true}, stats);
+  EXPECT_EQ(stats.primary, 9u * 9u);
+  Tracer tracer(db.header, pages, {.spd_procedure = true});
+  const Color expected = Tracer::average_corners(
+      tracer.trace_sample(3, 4, stats), tracer.trace_sample(4, 4, stats),
+      tracer.trace_sample(3, 5, stats), tracer.trace_sample(4, 5, stats));
+  EXPECT_EQ(image[4 * 8 + 3], expected);
+}
+
+TEST(Render, MaxDepthOneTracesNoSecondaryRays) {
+  RayStats stats;
+  render(testing::showcase_scene(16), {}, {.max_depth = 1}, &stats);
+  EXPECT_EQ(stats.reflected + stats.refracted, 0u);
+}
+
+TEST(Render, BackgroundWhenNothingIsHit) {
+  Scene scene = testing::showcase_scene(4);
+  scene.camera.at = scene.camera.from * 2.0;  // look away from everything
+  for (const Color& c : render(scene, {})) EXPECT_EQ(c, scene.background);
+}
+
+}  // namespace
+}  // namespace tracer
