@@ -1,0 +1,136 @@
+// Alt: selection over guards (see alt.hpp for the protocol).
+#include "csp/alt.hpp"
+
+#include <algorithm>
+#include <functional>
+#include <stdexcept>
+#include <string>
+
+#include "csp/detail/process.hpp"
+
+namespace csp {
+
+using detail::Clock;
+using detail::WaitState;
+
+std::size_t Alt::add(Guard g) {
+  guards_.push_back(std::move(g));
+  return guards_.size() - 1;
+}
+
+void Alt::enable(std::size_t guard, bool on) {
+  if (guard >= guards_.size()) {
+    throw std::out_of_range("Alt::enable: no guard " + std::to_string(guard));
+  }
+  guards_[guard].enabled = on;
+}
+
+std::size_t Alt::select() {
+  const std::size_t chosen = select_from(favourite_);
+  favourite_ = (chosen + 1) % guards_.size();
+  return chosen;
+}
+
+std::size_t Alt::pri_select() { return select_from(0); }
+
+std::size_t Alt::select_from(std::size_t first) {
+  // Collect the enabled channels and the earliest enabled timeout.
+  const Clock::time_point start = Clock::now();
+  channels_.clear();
+  std::size_t timeout_guard = none;
+  bool any_ready_kind = false;
+  for (std::size_t i = 0; i < guards_.size(); ++i) {
+    const Guard& g = guards_[i];
+    if (!g.enabled) continue;
+    if (g.kind == Kind::input) channels_.push_back(g.channel.get());
+    if (g.kind == Kind::skip) any_ready_kind = true;
+    if (g.kind == Kind::timeout && (timeout_guard == none || g.after < guards_[timeout_guard].after)) {
+      timeout_guard = i;
+    }
+  }
+  if (channels_.empty() && timeout_guard == none && !any_ready_kind) {
+    throw std::logic_error("Alt::select: every guard is disabled (occam STOP)");
+  }
+  std::sort(channels_.begin(), channels_.end(), std::less<>());
+  channels_.erase(std::unique(channels_.begin(), channels_.end()), channels_.end());
+
+  lock_channels();
+  const std::size_t ready = poll_locked(first);
+  if (ready != none) {
+    unlock_channels();
+    return ready;
+  }
+  const Clock::time_point deadline =
+      timeout_guard == none ? Clock::time_point::max() : start + guards_[timeout_guard].after;
+  return wait_locked(timeout_guard, deadline);
+}
+
+std::size_t Alt::poll_locked(std::size_t first) const {
+  const std::size_t n = guards_.size();
+  for (std::size_t k = 0; k < n; ++k) {
+    const std::size_t i = (first + k) % n;
+    const Guard& g = guards_[i];
+    if (!g.enabled) continue;
+    const bool ready = g.kind == Kind::skip ||
+                       (g.kind == Kind::input && g.channel->ready_locked()) ||
+                       (g.kind == Kind::timeout && g.after <= Clock::duration::zero());
+    if (ready) return i;
+  }
+  return none;
+}
+
+// Channels locked; nothing ready. Links a record per enabled input guard,
+// parks once, then unlinks whatever the winner left behind.
+std::size_t Alt::wait_locked(std::size_t timeout_guard, Clock::time_point deadline) {
+  detail::Waiter w;
+  w.op = "in ALT over";
+  w.channels = &channels_;
+  records_.clear();
+  records_.reserve(guards_.size());
+  for (std::size_t i = 0; i < guards_.size(); ++i) {
+    if (guards_[i].enabled && guards_[i].kind == Kind::input) {
+      records_.emplace_back();
+      records_.back().waiter = &w;
+      records_.back().guard = i;
+    }
+  }
+  auto record = records_.begin();
+  for (std::size_t i = 0; i < guards_.size(); ++i) {
+    if (guards_[i].enabled && guards_[i].kind == Kind::input) guards_[i].channel->readers_.push_back(*record++);
+  }
+
+  // Park holding only the last lock; the others may go first, because a
+  // waker on another thread can only queue this fiber for this thread's
+  // dispatcher, which runs after the fiber has suspended.
+  detail::Spinlock no_channel;
+  detail::Spinlock& last = channels_.empty() ? no_channel : channels_.back()->lock_;
+  if (channels_.empty()) no_channel.lock();
+  for (std::size_t c = 0; c + 1 < channels_.size(); ++c) channels_[c]->lock_.unlock();
+  detail::SpinlockLock lk(last, std::adopt_lock);
+  WaitState s = WaitState::waiting;
+  if (timeout_guard == none) {
+    s = detail::park(w, lk);
+  } else {
+    detail::park_until(w, lk, deadline);
+  }
+
+  lock_channels();
+  if (timeout_guard != none) s = detail::resolve_timeout(w);
+  record = records_.begin();
+  for (const Guard& g : guards_) {
+    if (g.enabled && g.kind == Kind::input) g.channel->readers_.erase(*record++);
+  }
+  unlock_channels();
+  if (s == WaitState::aborted) detail::unwind_deadlock();
+  return s == WaitState::timed_out ? timeout_guard : w.fired;
+}
+
+void Alt::lock_channels() {
+  for (detail::ChannelBase* c : channels_) c->lock_.lock();
+}
+
+void Alt::unlock_channels() {
+  for (detail::ChannelBase* c : channels_) c->lock_.unlock();
+}
+
+}  // namespace csp

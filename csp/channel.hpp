@@ -1,0 +1,235 @@
+// Occam channels: Channel<T> owns the shared state and hands out its ends,
+// In<T> (reading) and Out<T> (writing); ends are cheap copyable handles.
+//
+// Protocol and invariants (all under the channel's spinlock):
+// - capacity 0: rendezvous. A reader that finds a writer parked takes its
+//   value and wakes it; otherwise it parks with an empty slot that the next
+//   writer fills directly (so the writer returns without parking: the reader
+//   has taken the value). A writer that finds only an ALT reader fires the
+//   ALT, then parks until the ALT's read takes the value.
+// - capacity k: a bounded buffer of exactly k values. Readers park only when
+//   it is empty, writers only when it is full; a reader that frees a slot
+//   moves the first parked writer's value in and wakes that writer.
+// - At most one of (parked readers, parked writers with data) is non-empty.
+// - Poison is permanent and wakes every waiter; every later operation on
+//   either end throws Poisoned, even with values still buffered.
+// Who wakes whom: writers wake readers (and fire ALTs), readers wake writers,
+// poison wakes both; see detail/wait.hpp for the claiming rules.
+#pragma once
+
+#include <cstddef>
+#include <memory>
+#include <optional>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "csp/detail/wait.hpp"
+#include "csp/errors.hpp"
+
+namespace csp {
+
+class Alt;
+template <class T> class In;
+template <class T> class Out;
+
+namespace detail {
+
+template <class T>
+class ChannelState final : public ChannelBase {
+ public:
+  ChannelState(std::string name, std::size_t capacity)
+      : ChannelBase(std::move(name), capacity), ring_(capacity) {}
+
+  bool ready_locked() const override {
+    return poisoned() || count_ > 0 || !writers_.empty();
+  }
+
+  T read() {
+    SpinlockLock lk(lock_);
+    check_poison();
+    if (std::optional<T> v = take_locked()) return std::move(*v);
+    std::optional<T> slot;
+    Waiter w;
+    w.op = "reading";
+    w.channel = this;
+    Record rec;
+    rec.waiter = &w;
+    rec.slot = &slot;
+    readers_.push_back(rec);
+    finish_wait(park(w, lk), rec, readers_);
+    return std::move(*slot);
+  }
+
+  std::optional<T> try_read() {
+    SpinlockLock lk(lock_);
+    check_poison();
+    return take_locked();
+  }
+
+  std::optional<T> read_until(Clock::time_point deadline) {
+    SpinlockLock lk(lock_);
+    check_poison();
+    if (std::optional<T> v = take_locked()) return v;
+    std::optional<T> slot;
+    Waiter w;
+    Record rec;
+    rec.waiter = &w;
+    rec.slot = &slot;
+    readers_.push_back(rec);
+    park_until(w, lk, deadline);
+    lk.lock();
+    const WaitState s = resolve_timeout(w);
+    readers_.erase(rec);
+    lk.unlock();
+    if (s == WaitState::timed_out) return std::nullopt;
+    if (s == WaitState::poisoned) throw Poisoned(name_);
+    return slot;
+  }
+
+  void write(T value) {
+    SpinlockLock lk(lock_);
+    check_poison();
+    if (give_locked(value, false)) return;
+    Waiter w;
+    w.op = "writing";
+    w.channel = this;
+    Record rec;
+    rec.waiter = &w;
+    rec.slot = &value;
+    writers_.push_back(rec);
+    finish_wait(park(w, lk), rec, writers_);
+  }
+
+  bool try_write(T& value) {
+    SpinlockLock lk(lock_);
+    check_poison();
+    return give_locked(value, true);
+  }
+
+ private:
+  void check_poison() const {
+    if (poisoned()) throw Poisoned(name_);
+  }
+
+  // Lock held: a value without waiting (buffer first, then a parked writer).
+  std::optional<T> take_locked() {
+    if (count_ > 0) {
+      std::optional<T> v(std::in_place, std::move(*ring_[head_]));
+      ring_[head_].reset();
+      head_ = (head_ + 1) % capacity_;
+      --count_;
+      if (Record* r = claim_front_locked(writers_)) {
+        push_locked(std::move(*static_cast<T*>(r->slot)));
+        complete(*r->waiter, WaitState::data, r->guard);
+      }
+      return v;
+    }
+    if (Record* r = claim_front_locked(writers_)) {
+      std::optional<T> v(std::move(*static_cast<T*>(r->slot)));
+      complete(*r->waiter, WaitState::data, r->guard);
+      return v;
+    }
+    return std::nullopt;
+  }
+
+  // Lock held: hands value to a parked reader or the buffer. Fires a parked
+  // ALT reader. Returns false if the writer must park (value untouched).
+  bool give_locked(T& value, bool only_if_taken) {
+    if (only_if_taken && capacity_ == 0) {
+      while (Record* r = readers_.front()) {
+        if (!r->slot) return false;  // an ALT would have to run before taking it
+        readers_.erase(*r);
+        if (try_claim(*r->waiter)) return deliver(*r, value);
+      }
+      return false;
+    }
+    if (Record* r = claim_front_locked(readers_)) {
+      if (r->slot) return deliver(*r, value);
+      complete(*r->waiter, WaitState::data, r->guard);
+    }
+    if (count_ == capacity_) return false;
+    push_locked(std::move(value));
+    return true;
+  }
+
+  bool deliver(Record& r, T& value) {
+    static_cast<std::optional<T>*>(r.slot)->emplace(std::move(value));
+    complete(*r.waiter, WaitState::data, r.guard);
+    return true;
+  }
+
+  void push_locked(T&& value) {
+    ring_[(head_ + count_) % capacity_].emplace(std::move(value));
+    ++count_;
+  }
+
+  // After park(): throws for poison and deadlock; data needs nothing more.
+  void finish_wait(WaitState s, Record& rec, RecordQueue& q) {
+    if (s == WaitState::data) return;
+    if (s == WaitState::poisoned) throw Poisoned(name_);
+    SpinlockLock lk(lock_);
+    q.erase(rec);
+    lk.unlock();
+    unwind_deadlock();
+  }
+
+  std::vector<std::optional<T>> ring_;  // capacity_ slots, values at head_ .. head_+count_
+  std::size_t head_ = 0;
+  std::size_t count_ = 0;
+};
+
+}  // namespace detail
+
+template <class T>
+class Channel {
+ public:
+  explicit Channel(std::string name = {}, std::size_t capacity = 0)
+      : state_(std::make_shared<detail::ChannelState<T>>(std::move(name), capacity)) {}
+
+  In<T> reader() const { return In<T>(state_); }
+  Out<T> writer() const { return Out<T>(state_); }
+  void poison() { state_->poison(); }
+  const std::string& name() const { return state_->name(); }
+
+ private:
+  std::shared_ptr<detail::ChannelState<T>> state_;
+};
+
+template <class T>
+class In {
+ public:
+  In() = default;
+  T read() { return state_->read(); }
+  std::optional<T> try_read() { return state_->try_read(); }
+  std::optional<T> read_for(std::chrono::steady_clock::duration d) {
+    return state_->read_until(std::chrono::steady_clock::now() + d);
+  }
+  bool poisoned() const { return state_->poisoned(); }
+  void poison() { state_->poison(); }
+  const std::string& name() const { return state_->name(); }
+
+ private:
+  friend class Channel<T>;
+  friend class Alt;
+  explicit In(std::shared_ptr<detail::ChannelState<T>> s) : state_(std::move(s)) {}
+  std::shared_ptr<detail::ChannelState<T>> state_;
+};
+
+template <class T>
+class Out {
+ public:
+  Out() = default;
+  void write(T value) { state_->write(std::move(value)); }
+  bool try_write(T& value) { return state_->try_write(value); }
+  bool poisoned() const { return state_->poisoned(); }
+  void poison() { state_->poison(); }
+  const std::string& name() const { return state_->name(); }
+
+ private:
+  friend class Channel<T>;
+  explicit Out(std::shared_ptr<detail::ChannelState<T>> s) : state_(std::move(s)) {}
+  std::shared_ptr<detail::ChannelState<T>> state_;
+};
+
+}  // namespace csp

@@ -1,0 +1,116 @@
+// Waiter claiming, parking and the channel queues (see wait.hpp).
+#include "csp/detail/wait.hpp"
+
+#include <cstdint>
+
+#include "csp/detail/process.hpp"
+
+namespace csp::detail {
+
+namespace {
+
+// The value a timed waiter stores in its context's twstatus: Boost's timer
+// exchanges it for -2 on timeout, a waker CASes it to -1, so exactly one of
+// the two reschedules the fiber (the same protocol as Boost's own channels).
+std::intptr_t timed_token(const Waiter& w) { return reinterpret_cast<std::intptr_t>(&w); }
+
+}  // namespace
+
+void RecordQueue::push_back(Record& r) {
+  r.prev = tail_;
+  r.next = nullptr;
+  (tail_ ? tail_->next : head_) = &r;
+  tail_ = &r;
+  r.linked = true;
+}
+
+Record* RecordQueue::pop_front() {
+  Record* r = head_;
+  if (r) erase(*r);
+  return r;
+}
+
+void RecordQueue::erase(Record& r) {
+  if (!r.linked) return;
+  (r.prev ? r.prev->next : head_) = r.next;
+  (r.next ? r.next->prev : tail_) = r.prev;
+  r.prev = r.next = nullptr;
+  r.linked = false;
+}
+
+void ChannelBase::poison() {
+  SpinlockLock lk(lock_);
+  if (poisoned_.load(std::memory_order_relaxed)) return;
+  poisoned_.store(true, std::memory_order_release);
+  wake_all_locked(readers_, WaitState::poisoned);
+  wake_all_locked(writers_, WaitState::poisoned);
+}
+
+Record* ChannelBase::claim_front_locked(RecordQueue& q) {
+  // Records of waiters already won elsewhere (another ALT guard, a timeout,
+  // the deadlock detector) are dropped on the way.
+  while (Record* r = q.pop_front()) {
+    if (try_claim(*r->waiter)) return r;
+  }
+  return nullptr;
+}
+
+void ChannelBase::wake_all_locked(RecordQueue& q, WaitState outcome) {
+  while (Record* r = claim_front_locked(q)) complete(*r->waiter, outcome, r->guard);
+}
+
+bool try_claim(Waiter& w) {
+  WaitState expected = WaitState::waiting;
+  return w.state.compare_exchange_strong(expected, WaitState::claiming, std::memory_order_acq_rel);
+}
+
+void complete(Waiter& w, WaitState outcome, std::size_t fired) {
+  boost::fibers::context* ctx = w.ctx;
+  const std::intptr_t token = timed_token(w);
+  if (w.process) w.process->tracker->unblock(*w.process);
+  w.fired = fired;
+  w.state.store(outcome, std::memory_order_release);
+  std::intptr_t expected = token;
+  if (ctx->twstatus.compare_exchange_strong(expected, -1, std::memory_order_acq_rel) || expected == 0) {
+    boost::fibers::context::active()->schedule(ctx);
+  }
+}
+
+WaitState park(Waiter& w, SpinlockLock& lk) {
+  boost::fibers::context* ctx = boost::fibers::context::active();
+  w.ctx = ctx;
+  Process* p = current_process();
+  if (p) {
+    const bool runnable = !p->tracker->aborting() && p->tracker->block(*p, w);
+    if (!runnable && w.abortable) {
+      // Nobody can wake us (or the run is unwinding): do not park.
+      w.state.store(WaitState::aborted, std::memory_order_relaxed);
+      p->waiting.store(nullptr, std::memory_order_relaxed);
+      lk.unlock();
+      return WaitState::aborted;
+    }
+  }
+  ctx->twstatus.store(0, std::memory_order_release);
+  ctx->suspend(lk);
+  if (p) p->waiting.store(nullptr, std::memory_order_relaxed);
+  return w.state.load(std::memory_order_acquire);
+}
+
+void park_until(Waiter& w, SpinlockLock& lk, Clock::time_point deadline) {
+  boost::fibers::context* ctx = boost::fibers::context::active();
+  w.ctx = ctx;
+  ctx->twstatus.store(timed_token(w), std::memory_order_release);
+  ctx->wait_until(deadline, lk);
+}
+
+WaitState resolve_timeout(Waiter& w) {
+  WaitState s = WaitState::waiting;
+  if (w.state.compare_exchange_strong(s, WaitState::timed_out, std::memory_order_acq_rel)) {
+    return WaitState::timed_out;
+  }
+  return s;
+}
+
+void unwind_deadlock() { throw DeadlockUnwind{}; }
+
+}  // namespace csp::detail

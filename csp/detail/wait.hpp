@@ -1,0 +1,130 @@
+// Waiting machinery shared by channels, ALT and PAR.
+//
+// A fiber that must block builds one Waiter on its stack and links one Record
+// per channel it waits on into that channel's reader or writer queue (a plain
+// read or write: one record; an ALT: one record per enabled input guard).
+// Whoever makes the wait succeed — a writer, a reader, poison, the deadlock
+// detector — must *claim* the Waiter first: a CAS from `waiting`, so exactly
+// one party wins even when several channels fire at once. The winner fills
+// the payload, then complete() publishes the outcome and reschedules the
+// waiter's context (locally, or through Boost's remote-ready queue when the
+// waiter lives on another thread).
+//
+// Locking contract: records are linked, unlinked and claimed only under the
+// lock of the channel whose queue holds them, so a woken waiter that relocks
+// its channels knows every claimer has finished with it. The deadlock
+// detector claims without a channel lock but only untimed waiters, which
+// cannot run before they are rescheduled.
+//
+// Deadlock accounting: an untimed park of a process counts it as blocked; the
+// claimer uncounts it before rescheduling (see Tracker in runtime.cpp).
+#pragma once
+
+#include <atomic>
+#include <chrono>
+#include <cstddef>
+#include <string>
+#include <vector>
+
+#include <boost/fiber/context.hpp>
+#include <boost/fiber/detail/spinlock.hpp>
+
+namespace csp::detail {
+
+using Spinlock = boost::fibers::detail::spinlock;
+using SpinlockLock = boost::fibers::detail::spinlock_lock;
+using Clock = std::chrono::steady_clock;
+
+struct Process;
+class ChannelBase;
+
+// How a wait ended. `claiming` is transient: held by a claimer between its CAS
+// and complete(), always under a channel lock.
+enum class WaitState : int { waiting, claiming, data, poisoned, timed_out, aborted };
+
+struct Waiter {
+  boost::fibers::context* ctx = nullptr;          // the parked fiber
+  std::atomic<WaitState> state{WaitState::waiting};
+  std::size_t fired = 0;                          // guard index of the record that won (ALT)
+  Process* process = nullptr;                     // set when the park is counted as blocked
+  const char* op = "";                            // what it waits for, for the deadlock dump
+  const ChannelBase* channel = nullptr;           // single channel waited on, or null
+  const std::vector<ChannelBase*>* channels = nullptr;  // ALT: all channels waited on
+  bool abortable = true;                          // false for PAR joins: children end first
+};
+
+// One entry in a channel queue. slot points at the payload: for a writer the
+// value to take, for a blocking reader an std::optional<T> to fill; null for
+// an ALT reader, which only learns that the channel became ready.
+struct Record {
+  Record* prev = nullptr;
+  Record* next = nullptr;
+  Waiter* waiter = nullptr;
+  void* slot = nullptr;
+  std::size_t guard = 0;
+  bool linked = false;
+};
+
+// Intrusive FIFO of records; the owning channel's lock protects it.
+class RecordQueue {
+ public:
+  bool empty() const { return head_ == nullptr; }
+  Record* front() const { return head_; }
+  void push_back(Record& r);
+  Record* pop_front();
+  void erase(Record& r);  // no-op if r was already popped
+
+ private:
+  Record* head_ = nullptr;
+  Record* tail_ = nullptr;
+};
+
+// The type-independent half of a channel: lock, poison flag, wait queues.
+class ChannelBase {
+ public:
+  ChannelBase(std::string name, std::size_t capacity) : name_(std::move(name)), capacity_(capacity) {}
+  virtual ~ChannelBase() = default;
+  ChannelBase(const ChannelBase&) = delete;
+  ChannelBase& operator=(const ChannelBase&) = delete;
+
+  const std::string& name() const { return name_; }
+  bool poisoned() const { return poisoned_.load(std::memory_order_acquire); }
+  void poison();
+
+  // Lock must be held. True if a read would not block (data, or poison).
+  virtual bool ready_locked() const = 0;
+
+  Spinlock lock_;
+  RecordQueue readers_;  // guarded by lock_
+  RecordQueue writers_;  // guarded by lock_
+
+ protected:
+  // Lock must be held. Claims and completes the first live record of q with
+  // the given outcome; returns it (slot still valid) or null if none is live.
+  Record* claim_front_locked(RecordQueue& q);
+  void wake_all_locked(RecordQueue& q, WaitState outcome);
+
+  std::string name_;
+  std::size_t capacity_;
+  std::atomic<bool> poisoned_{false};
+};
+
+// Claiming: try_claim() wins the waiter or reports a lost race; complete()
+// (winner only, under the channel lock) publishes the outcome and wakes it.
+bool try_claim(Waiter& w);
+void complete(Waiter& w, WaitState outcome, std::size_t fired);
+
+// Parks the calling fiber on w until claimed. lk (locked) guards the records
+// of w and is released once the fiber is suspended; other locks must already
+// be released. Returns the outcome; `aborted` means the run is deadlocked and
+// the caller must unlink its records, then call unwind_deadlock().
+WaitState park(Waiter& w, SpinlockLock& lk);
+// Timed park: returns with lk *unlocked*; the caller relocks and resolves a
+// `waiting` state (a timeout nobody claimed) with resolve_timeout().
+void park_until(Waiter& w, SpinlockLock& lk, Clock::time_point deadline);
+WaitState resolve_timeout(Waiter& w);  // caller holds every lock w's records live under
+
+// Throws the internal unwinding signal that ends a process of a deadlocked run.
+[[noreturn]] void unwind_deadlock();
+
+}  // namespace csp::detail

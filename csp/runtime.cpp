@@ -1,0 +1,301 @@
+// Runtime, par, sleep_for: threads, placement, process lifetime, failures.
+#include "csp/runtime.hpp"
+
+#include <boost/fiber/fiber.hpp>
+#include <boost/fiber/fixedsize_stack.hpp>
+#include <boost/fiber/operations.hpp>
+#include <exception>
+#include <mutex>
+#include <stdexcept>
+#include <thread>
+#include <utility>
+
+#include "csp/detail/process.hpp"
+#include "csp/errors.hpp"
+
+namespace csp {
+
+namespace detail {
+
+namespace {
+
+thread_local bool on_runtime_thread = false;  // the thread runs a csp::Scheduler
+
+struct Failure {
+  std::string process;
+  std::exception_ptr error;
+};
+
+std::string message_of(const std::exception_ptr& e) {
+  try {
+    std::rethrow_exception(e);
+  } catch (const std::exception& x) {
+    return x.what();
+  } catch (...) {
+    return "unknown exception";
+  }
+}
+
+// One failure: rethrown as is; several: ProcessesFailed naming them all.
+[[noreturn]] void rethrow_failures(const std::vector<Failure>& failures) {
+  if (failures.size() == 1) std::rethrow_exception(failures.front().error);
+  std::string text = "process '" + failures.front().process + "' failed: " + message_of(failures.front().error) +
+                     "; and " + std::to_string(failures.size() - 1) + " more:";
+  for (std::size_t i = 1; i < failures.size(); ++i) {
+    text += " process '" + failures[i].process + "': " + message_of(failures[i].error) + ";";
+  }
+  text.pop_back();
+  throw ProcessesFailed(text);
+}
+
+enum class Ending { normal, poisoned, deadlock, failed };
+
+Ending run_body(const std::function<void()>& body, std::exception_ptr& error) {
+  try {
+    body();
+    return Ending::normal;
+  } catch (const Poisoned&) {
+    error = std::current_exception();
+    return Ending::poisoned;
+  } catch (const DeadlockUnwind&) {
+    return Ending::deadlock;
+  } catch (...) {
+    error = std::current_exception();
+    return Ending::failed;
+  }
+}
+
+// Binds the calling fiber to its process record (or unbinds it with null).
+void bind_fiber(Process* p) {
+  if (!on_runtime_thread) return;
+  if (auto* props = boost::fibers::context::active()->get_properties()) {
+    static_cast<ProcessProps*>(props)->process = p;
+  }
+}
+
+boost::fibers::fiber start_fiber(std::size_t stack_size, std::function<void()> fn) {
+  return boost::fibers::fiber(std::allocator_arg, boost::fibers::fixedsize_stack(stack_size), std::move(fn));
+}
+
+}  // namespace
+
+Process* current_process() {
+  if (!on_runtime_thread) return nullptr;
+  auto* props = boost::fibers::context::active()->get_properties();
+  return props ? static_cast<ProcessProps*>(props)->process : nullptr;
+}
+
+// A process placed on a thread but not started yet.
+struct Spawn {
+  std::shared_ptr<Process> process;
+  std::function<void()> body;
+};
+
+// One runtime thread. Its main fiber waits on the inbox for new processes
+// and for the stop signal sent when the last process of the run has ended.
+struct Worker {
+  Spinlock lock;
+  std::vector<Spawn> inbox;  // guarded by lock
+  Waiter* idle = nullptr;    // guarded by lock: the main fiber, parked
+  bool stop = false;         // guarded by lock
+
+  // Lock held: wakes the parked main fiber, if any.
+  void wake_locked() {
+    if (idle && try_claim(*idle)) complete(*idle, WaitState::data, 0);
+    idle = nullptr;
+  }
+};
+
+}  // namespace detail
+
+using detail::Failure;
+using detail::Process;
+using detail::Spawn;
+using detail::SpinlockLock;
+using detail::Worker;
+
+struct Runtime::Impl {
+  explicit Impl(RuntimeOptions o) : options(std::move(o)), tracker([this] { stop_all(); }) {
+    if (options.threads == 0) options.threads = std::max(1u, std::thread::hardware_concurrency());
+    for (unsigned i = 0; i < options.threads; ++i) workers.push_back(std::make_unique<Worker>());
+  }
+
+  void post(unsigned thread, Spawn s) {
+    Worker& w = *workers[thread];
+    SpinlockLock lk(w.lock);
+    w.inbox.push_back(std::move(s));
+    w.wake_locked();
+  }
+
+  void stop_all() {
+    for (auto& w : workers) {
+      SpinlockLock lk(w->lock);
+      w->stop = true;
+      w->wake_locked();
+    }
+  }
+
+  void worker_main(unsigned index);
+  boost::fibers::fiber launch(Spawn s);
+  void run_process(Process& p, const std::function<void()>& body);
+
+  RuntimeOptions options;
+  std::vector<std::unique_ptr<Worker>> workers;
+  detail::Tracker tracker;
+  std::mutex failures_mutex;
+  std::vector<Failure> failures;  // guarded by failures_mutex
+  bool started = false;
+};
+
+void Runtime::Impl::worker_main(unsigned index) {
+  detail::on_runtime_thread = true;
+  Scheduler* algo = options.scheduler ? options.scheduler(index) : new FifoScheduler;
+  boost::fibers::context::active()->get_scheduler()->set_algo(boost::fibers::algo::algorithm::ptr_t(algo));
+  std::vector<boost::fibers::fiber> fibers;
+  Worker& w = *workers[index];
+  for (bool stop = false; !stop;) {
+    SpinlockLock lk(w.lock);
+    while (w.inbox.empty() && !w.stop) {
+      detail::Waiter idle;
+      w.idle = &idle;
+      detail::park(idle, lk);  // the main fiber is no process: never counted
+      lk.lock();
+    }
+    std::vector<Spawn> batch = std::move(w.inbox);
+    w.inbox.clear();
+    stop = w.stop;
+    lk.unlock();
+    for (Spawn& s : batch) fibers.push_back(launch(std::move(s)));
+  }
+  for (boost::fibers::fiber& f : fibers) f.join();
+  detail::on_runtime_thread = false;
+}
+
+boost::fibers::fiber Runtime::Impl::launch(Spawn s) {
+  const std::size_t stack_size = s.process->stack_size;
+  return detail::start_fiber(stack_size, [this, s = std::move(s)] { run_process(*s.process, s.body); });
+}
+
+void Runtime::Impl::run_process(Process& p, const std::function<void()>& body) {
+  detail::bind_fiber(&p);
+  std::exception_ptr error;
+  if (detail::run_body(body, error) == detail::Ending::failed) {
+    std::lock_guard<std::mutex> lk(failures_mutex);
+    failures.push_back({p.name, error});
+  }
+  detail::bind_fiber(nullptr);
+  tracker.remove(p);
+}
+
+Runtime::Runtime(unsigned threads) : Runtime(RuntimeOptions{threads, RuntimeOptions{}.stack_size, {}}) {}
+Runtime::Runtime(RuntimeOptions options) : impl_(std::make_unique<Impl>(std::move(options))) {}
+Runtime::~Runtime() = default;
+
+unsigned Runtime::threads() const { return impl_->options.threads; }
+
+void Runtime::spawn(std::string name, unsigned thread, std::function<void()> body) {
+  auto p = std::make_shared<Process>();
+  p->name = std::move(name);
+  p->thread = thread % threads();
+  p->stack_size = impl_->options.stack_size;
+  impl_->tracker.add(*p);
+  impl_->post(p->thread, Spawn{p, std::move(body)});
+}
+
+void Runtime::run() {
+  if (impl_->started) throw std::logic_error("Runtime::run: a Runtime runs once");
+  impl_->started = true;
+  if (impl_->tracker.alive() == 0) return;
+  std::vector<std::thread> threads;
+  for (unsigned i = 0; i < impl_->options.threads; ++i) {
+    threads.emplace_back([this, i] { impl_->worker_main(i); });
+  }
+  for (std::thread& t : threads) t.join();
+
+  std::string dump = impl_->tracker.deadlock_dump();
+  if (!dump.empty()) {
+    for (const Failure& f : impl_->failures) {
+      dump += "\n  (before that, process '" + f.process + "' failed: " + detail::message_of(f.error) + ")";
+    }
+    throw Deadlock(dump);
+  }
+  if (!impl_->failures.empty()) detail::rethrow_failures(impl_->failures);
+}
+
+// The state a PAR shares with its children, guarded by lock.
+struct ParGroup {
+  detail::Spinlock lock;
+  std::size_t remaining = 0;
+  detail::Waiter* parent = nullptr;  // the parent, parked until remaining == 0
+  std::vector<Failure> failures;     // in the order the children ended
+  std::vector<Failure> poisons;
+  bool deadlock = false;
+};
+
+namespace {
+
+void run_child(ParGroup& g, Process* child, const std::string& name, const std::function<void()>& body) {
+  detail::bind_fiber(child);
+  std::exception_ptr error;
+  const detail::Ending e = detail::run_body(body, error);
+  detail::bind_fiber(nullptr);
+  {
+    SpinlockLock lk(g.lock);
+    if (e == detail::Ending::failed) g.failures.push_back({name, error});
+    if (e == detail::Ending::poisoned) g.poisons.push_back({name, error});
+    g.deadlock |= e == detail::Ending::deadlock;
+    // Wake the parent before ending, so it is never counted blocked alone.
+    if (--g.remaining == 0 && g.parent && detail::try_claim(*g.parent)) {
+      detail::complete(*g.parent, detail::WaitState::data, 0);
+    }
+  }
+  if (child) child->tracker->remove(*child);
+}
+
+}  // namespace
+
+void par(std::vector<std::function<void()>> processes) {
+  Process* parent = detail::current_process();
+  ParGroup g;
+  g.remaining = processes.size();
+  std::vector<boost::fibers::fiber> fibers;
+  for (std::size_t i = 0; i < processes.size(); ++i) {
+    std::shared_ptr<Process> child;
+    std::string name = (parent ? parent->name : std::string("par")) + "." + std::to_string(i);
+    if (parent) {
+      child = std::make_shared<Process>();
+      child->name = name;
+      child->thread = parent->thread;
+      child->stack_size = parent->stack_size;
+      parent->tracker->add(*child);
+    }
+    fibers.push_back(detail::start_fiber(
+        parent ? parent->stack_size : RuntimeOptions{}.stack_size,
+        [&g, child, name, body = std::move(processes[i])] { run_child(g, child.get(), name, body); }));
+  }
+  SpinlockLock lk(g.lock);
+  while (g.remaining > 0) {
+    detail::Waiter w;
+    w.op = "in PAR, waiting for its children";
+    w.abortable = false;  // the children unwind first and then wake it
+    g.parent = &w;
+    detail::park(w, lk);
+    lk.lock();
+    g.parent = nullptr;
+  }
+  lk.unlock();
+  for (boost::fibers::fiber& f : fibers) f.join();
+  if (g.deadlock) detail::unwind_deadlock();
+  if (!g.failures.empty()) detail::rethrow_failures(g.failures);
+  if (!g.poisons.empty()) std::rethrow_exception(g.poisons.front().error);
+}
+
+void sleep_for(std::chrono::steady_clock::duration d) { boost::this_fiber::sleep_for(d); }
+
+const std::string& current_process_name() {
+  static const std::string none;
+  const Process* p = detail::current_process();
+  return p ? p->name : none;
+}
+
+}  // namespace csp

@@ -1,0 +1,63 @@
+// Runtime: places processes (fibers) on OS threads and runs them to the end.
+//
+// Each of the T threads has its own Scheduler (made by the factory in
+// RuntimeOptions); a process stays on the thread it was placed on. A thread
+// with nothing ready sleeps in its scheduler until another thread wakes one
+// of its fibers or a timer is due. run() ends when the last process ends, or
+// reports a deadlock once every live process waits on a channel with no timer
+// pending — after unwinding them all. par() is occam PAR inside a process.
+//
+// Who wakes whom: spawn() wakes the target thread's main fiber (it waits on an
+// inbox of new processes); the last process to end wakes every thread's main
+// fiber, which then joins its fibers and returns.
+#pragma once
+
+#include <chrono>
+#include <cstddef>
+#include <functional>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "csp/scheduler.hpp"
+
+namespace csp {
+
+struct RuntimeOptions {
+  unsigned threads = 0;                   // 0: std::thread::hardware_concurrency()
+  std::size_t stack_size = 256 * 1024;    // bytes per process fiber
+  SchedulerFactory scheduler;             // empty: FifoScheduler on every thread
+};
+
+class Runtime {
+ public:
+  explicit Runtime(unsigned threads = 0);
+  explicit Runtime(RuntimeOptions options);
+  ~Runtime();
+  Runtime(const Runtime&) = delete;
+  Runtime& operator=(const Runtime&) = delete;
+
+  unsigned threads() const;
+  // Before run(), or from inside a running process. thread is taken modulo threads().
+  void spawn(std::string name, unsigned thread, std::function<void()> body);
+  // Runs every process to its end; once per Runtime. Rethrows a process's
+  // exception (ProcessesFailed if several failed); Poisoned ends a process
+  // normally. Throws Deadlock listing the blocked processes.
+  void run();
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+// PAR: runs every process as a fiber on the calling thread and waits for all.
+// Rethrows the first failure after all have ended (ProcessesFailed if several).
+void par(std::vector<std::function<void()>> processes);
+
+// Fiber-aware sleep; never counted as blocked by the deadlock detector.
+void sleep_for(std::chrono::steady_clock::duration d);
+
+// Name of the calling process ("" outside a Runtime).
+const std::string& current_process_name();
+
+}  // namespace csp

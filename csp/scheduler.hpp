@@ -1,0 +1,54 @@
+// Per-thread scheduling for Runtime: the replaceable piece.
+//
+// Each OS thread of a Runtime installs one Scheduler, made by the Runtime's
+// SchedulerFactory. A Scheduler is a Boost.Fiber algorithm whose per-fiber
+// properties are ProcessProps, so the runtime can find the process a fiber
+// belongs to (and a virtual-time scheduler can keep a clock per process).
+// FifoScheduler is the default: ready fibers run in FIFO order; when none is
+// ready the thread sleeps on a condition variable until notify() (a wake from
+// another thread) or the next timer deadline — it never spins.
+#pragma once
+
+#include <chrono>
+#include <condition_variable>
+#include <functional>
+#include <memory>
+#include <mutex>
+
+#include <boost/fiber/algo/algorithm.hpp>
+#include <boost/fiber/context.hpp>
+#include <boost/fiber/properties.hpp>
+#include <boost/fiber/scheduler.hpp>
+
+namespace csp {
+
+namespace detail {
+struct Process;
+}
+
+class ProcessProps : public boost::fibers::fiber_properties {
+ public:
+  explicit ProcessProps(boost::fibers::context* ctx) : fiber_properties(ctx) {}
+  detail::Process* process = nullptr;  // null for fibers that are not csp processes
+};
+
+using Scheduler = boost::fibers::algo::algorithm_with_properties<ProcessProps>;
+// Called once on each runtime thread, with that thread's index.
+using SchedulerFactory = std::function<Scheduler*(unsigned thread)>;
+
+class FifoScheduler final : public Scheduler {
+ public:
+  void awakened(boost::fibers::context* ctx, ProcessProps& props) noexcept override;
+  boost::fibers::context* pick_next() noexcept override;
+  bool has_ready_fibers() const noexcept override;
+  void suspend_until(std::chrono::steady_clock::time_point const& when) noexcept override;
+  void notify() noexcept override;
+
+ private:
+  boost::fibers::scheduler::ready_queue_type ready_;
+  std::mutex mutex_;                 // guards notified_ for the sleeping thread
+  std::condition_variable wakeup_;
+  bool notified_ = false;
+};
+
+}  // namespace csp

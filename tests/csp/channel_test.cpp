@@ -1,0 +1,156 @@
+// Channel semantics: rendezvous, ordering, buffering, poison, move-only values.
+#include <gtest/gtest.h>
+
+#include <memory>
+#include <vector>
+
+#include "csp/csp.hpp"
+
+namespace {
+
+using namespace std::chrono_literals;
+
+TEST(Channel, WriterBlocksUntilRead) {
+  csp::Channel<int> c("c");
+  bool written = false;
+  int got = 0;
+  csp::Runtime rt(1);
+  rt.spawn("writer", 0, [out = c.writer(), &written]() mutable {
+    out.write(7);
+    written = true;
+  });
+  rt.spawn("reader", 0, [in = c.reader(), &written, &got]() mutable {
+    csp::sleep_for(5ms);
+    EXPECT_FALSE(written);
+    got = in.read();
+  });
+  rt.run();
+  EXPECT_TRUE(written);
+  EXPECT_EQ(got, 7);
+}
+
+TEST(Channel, KeepsOrderPerChannel) {
+  for (std::size_t capacity : {0u, 1u, 3u}) {
+    csp::Channel<int> c("c", capacity);
+    std::vector<int> got;
+    csp::Runtime rt(1);
+    rt.spawn("writer", 0, [out = c.writer()]() mutable {
+      for (int i = 0; i < 1000; ++i) out.write(i);
+    });
+    rt.spawn("reader", 0, [in = c.reader(), &got]() mutable {
+      for (int i = 0; i < 1000; ++i) got.push_back(in.read());
+    });
+    rt.run();
+    ASSERT_EQ(got.size(), 1000u);
+    for (int i = 0; i < 1000; ++i) EXPECT_EQ(got[i], i) << "capacity " << capacity;
+  }
+}
+
+TEST(Channel, BufferHoldsExactlyCapacity) {
+  for (std::size_t k : {1u, 2u, 5u}) {
+    csp::Channel<int> c("c", k);
+    std::size_t done = 0;  // writes that returned before the reader started
+    csp::Runtime rt(1);
+    rt.spawn("writer", 0, [out = c.writer(), &done, k]() mutable {
+      for (std::size_t i = 0; i <= k; ++i) {
+        out.write(static_cast<int>(i));
+        ++done;
+      }
+    });
+    rt.spawn("reader", 0, [in = c.reader(), &done, k]() mutable {
+      csp::sleep_for(5ms);
+      EXPECT_EQ(done, k);  // the k+1-th write is still blocked
+      for (std::size_t i = 0; i <= k; ++i) EXPECT_EQ(in.read(), static_cast<int>(i));
+    });
+    rt.run();
+    EXPECT_EQ(done, k + 1);
+  }
+}
+
+TEST(Channel, TryOperationsNeverBlock) {
+  csp::Channel<int> c("c", 1);
+  auto in = c.reader();
+  auto out = c.writer();
+  EXPECT_FALSE(in.try_read().has_value());
+  int v = 4;
+  EXPECT_TRUE(out.try_write(v));
+  int w = 5;
+  EXPECT_FALSE(out.try_write(w));
+  EXPECT_EQ(w, 5);
+  EXPECT_EQ(in.try_read(), 4);
+  csp::Channel<int> rendezvous("r");
+  int x = 1;
+  EXPECT_FALSE(rendezvous.writer().try_write(x));
+}
+
+TEST(Channel, ReadForTimesOutWithoutWriter) {
+  csp::Channel<int> c("c");
+  std::optional<int> got = 1;
+  csp::Runtime rt(1);
+  rt.spawn("reader", 0, [in = c.reader(), &got]() mutable { got = in.read_for(2ms); });
+  rt.run();
+  EXPECT_FALSE(got.has_value());
+}
+
+TEST(Channel, ReadForReturnsValueWrittenInTime) {
+  csp::Channel<int> c("c");
+  std::optional<int> got;
+  csp::Runtime rt(2);
+  rt.spawn("reader", 0, [in = c.reader(), &got]() mutable { got = in.read_for(10s); });
+  rt.spawn("writer", 1, [out = c.writer()]() mutable {
+    csp::sleep_for(1ms);
+    out.write(9);
+  });
+  rt.run();
+  EXPECT_EQ(got, 9);
+}
+
+TEST(Channel, MovesMoveOnlyValues) {
+  for (std::size_t capacity : {0u, 2u}) {
+    csp::Channel<std::unique_ptr<int>> c("c", capacity);
+    int sum = 0;
+    csp::Runtime rt(1);
+    rt.spawn("writer", 0, [out = c.writer()]() mutable {
+      for (int i = 1; i <= 10; ++i) out.write(std::make_unique<int>(i));
+    });
+    rt.spawn("reader", 0, [in = c.reader(), &sum]() mutable {
+      for (int i = 1; i <= 10; ++i) sum += *in.read();
+    });
+    rt.run();
+    EXPECT_EQ(sum, 55);
+  }
+}
+
+TEST(Channel, PoisonWakesBlockedReader) {
+  csp::Channel<int> c("c");
+  bool poisoned = false;
+  csp::Runtime rt(1);
+  rt.spawn("reader", 0, [in = c.reader(), &poisoned]() mutable {
+    try {
+      in.read();
+    } catch (const csp::Poisoned&) {
+      poisoned = true;
+    }
+  });
+  rt.spawn("poisoner", 0, [out = c.writer()]() mutable {
+    csp::sleep_for(1ms);
+    out.poison();
+  });
+  rt.run();
+  EXPECT_TRUE(poisoned);
+}
+
+TEST(Channel, PoisonedBufferStillThrows) {
+  csp::Channel<int> c("c", 2);
+  auto out = c.writer();
+  out.write(1);
+  c.poison();
+  c.poison();
+  EXPECT_THROW(c.reader().read(), csp::Poisoned);
+  EXPECT_THROW(c.reader().try_read(), csp::Poisoned);
+  int v = 2;
+  EXPECT_THROW(out.try_write(v), csp::Poisoned);
+  EXPECT_TRUE(c.reader().poisoned());
+}
+
+}  // namespace

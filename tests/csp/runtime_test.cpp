@@ -1,0 +1,295 @@
+// Runtime and PAR: placement, failures, poison shutdown, deadlock diagnosis.
+#include <gtest/gtest.h>
+
+#include <atomic>
+#include <cstdint>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "csp/csp.hpp"
+
+namespace {
+
+using namespace std::chrono_literals;
+
+TEST(Runtime, CanBeCreatedAndDestroyedRepeatedly) {
+  for (int round = 0; round < 5; ++round) {
+    csp::Channel<int> c("c");
+    int got = 0;
+    csp::Runtime rt(2);
+    EXPECT_EQ(rt.threads(), 2u);
+    rt.spawn("writer", 0, [out = c.writer(), round]() mutable { out.write(round); });
+    rt.spawn("reader", 1, [in = c.reader(), &got]() mutable { got = in.read(); });
+    rt.run();
+    EXPECT_EQ(got, round);
+  }
+}
+
+TEST(Runtime, RunWithoutProcessesReturns) {
+  csp::Runtime rt(2);
+  rt.run();
+  EXPECT_THROW(rt.run(), std::logic_error);
+}
+
+TEST(Runtime, ProcessesKnowTheirNames) {
+  std::string seen;
+  std::string child;
+  csp::Runtime rt(1);
+  rt.spawn("worker", 0, [&] {
+    seen = csp::current_process_name();
+    csp::par({[&] { child = csp::current_process_name(); }});
+  });
+  rt.run();
+  EXPECT_EQ(seen, "worker");
+  EXPECT_EQ(child, "worker.0");
+  EXPECT_EQ(csp::current_process_name(), "");
+}
+
+TEST(Runtime, SpawnFromInsideARunningProcess) {
+  csp::Channel<int> c("c");
+  int got = 0;
+  csp::Runtime rt(2);
+  rt.spawn("parent", 0, [&rt, &c, &got] {
+    rt.spawn("child", 1, [out = c.writer()]() mutable { out.write(42); });
+    got = c.reader().read();
+  });
+  rt.run();
+  EXPECT_EQ(got, 42);
+}
+
+TEST(Runtime, RethrowsAProcessFailure) {
+  csp::Runtime rt(2);
+  rt.spawn("ok", 0, [] {});
+  rt.spawn("bad", 1, [] { throw std::runtime_error("boom"); });
+  EXPECT_THROW(
+      try { rt.run(); } catch (const std::runtime_error& e) {
+        EXPECT_STREQ(e.what(), "boom");
+        throw;
+      },
+      std::runtime_error);
+}
+
+TEST(Runtime, SummarisesSeveralFailures) {
+  csp::Runtime rt(1);
+  rt.spawn("a", 0, [] { throw std::runtime_error("first"); });
+  rt.spawn("b", 0, [] { throw std::runtime_error("second"); });
+  try {
+    rt.run();
+    FAIL() << "run() did not throw";
+  } catch (const csp::ProcessesFailed& e) {
+    const std::string what = e.what();
+    EXPECT_NE(what.find("'a' failed: first"), std::string::npos) << what;
+    EXPECT_NE(what.find("'b': second"), std::string::npos) << what;
+  }
+}
+
+TEST(Par, WaitsForAllAndRethrowsAfterwards) {
+  int finished = 0;
+  bool caught = false;
+  csp::Runtime rt(1);
+  rt.spawn("parent", 0, [&] {
+    try {
+      csp::par({[&] { throw std::runtime_error("child failed"); },
+                [&] {
+                  csp::sleep_for(2ms);
+                  ++finished;
+                },
+                [&] { ++finished; }});
+    } catch (const std::runtime_error& e) {
+      caught = std::string(e.what()) == "child failed";
+      EXPECT_EQ(finished, 2);
+    }
+  });
+  rt.run();
+  EXPECT_TRUE(caught);
+}
+
+TEST(Par, SummarisesSeveralChildFailures) {
+  csp::Runtime rt(1);
+  std::string what;
+  rt.spawn("parent", 0, [&] {
+    try {
+      csp::par({[] { throw std::runtime_error("x"); }, [] { throw std::runtime_error("y"); }});
+    } catch (const csp::ProcessesFailed& e) {
+      what = e.what();
+    }
+  });
+  rt.run();
+  EXPECT_NE(what.find("'parent.0' failed: x"), std::string::npos) << what;
+  EXPECT_NE(what.find("'parent.1': y"), std::string::npos) << what;
+}
+
+TEST(Par, WorksOutsideARuntime) {
+  csp::Channel<int> c("c");
+  int got = 0;
+  csp::par({[out = c.writer()]() mutable { out.write(3); }, [&, in = c.reader()]() mutable { got = in.read(); }});
+  EXPECT_EQ(got, 3);
+}
+
+// Each stage forwards values; on poison it poisons both its ends and ends.
+void stage(csp::In<int> in, csp::Out<int> out) {
+  try {
+    for (;;) out.write(in.read() + 1);
+  } catch (const csp::Poisoned&) {
+    in.poison();
+    out.poison();
+  }
+}
+
+TEST(Poison, ShutsDownAPipeline) {
+  constexpr int n = 6;
+  std::vector<csp::Channel<int>> c;
+  for (int i = 0; i <= n; ++i) c.emplace_back("c" + std::to_string(i));
+  std::vector<int> got;
+  csp::Runtime rt(2);
+  rt.spawn("source", 0, [out = c[0].writer()]() mutable {
+    for (int i = 0; i < 10; ++i) out.write(i);
+    out.poison();
+  });
+  for (int i = 0; i < n; ++i) {
+    rt.spawn("stage" + std::to_string(i), i, [in = c[i].reader(), out = c[i + 1].writer()] { stage(in, out); });
+  }
+  rt.spawn("sink", 1, [in = c[n].reader(), &got]() mutable {
+    for (;;) got.push_back(in.read());
+  });
+  rt.run();
+  ASSERT_EQ(got.size(), 10u);
+  for (int i = 0; i < 10; ++i) EXPECT_EQ(got[i], i + n);
+  for (auto& ch : c) EXPECT_TRUE(ch.reader().poisoned());
+}
+
+TEST(Poison, ShutsDownARing) {
+  constexpr int n = 8;
+  std::vector<csp::Channel<int>> c;
+  for (int i = 0; i < n; ++i) c.emplace_back("ring" + std::to_string(i));
+  int laps = 0;
+  csp::Runtime rt(2);
+  rt.spawn("head", 0, [in = c[n - 1].reader(), out = c[0].writer(), &laps]() mutable {
+    out.write(0);
+    while (in.read() < 100 * n) {
+      ++laps;
+      out.write(laps * n);
+    }
+    out.poison();  // the others pass it round and end
+  });
+  for (int i = 1; i < n; ++i) {
+    rt.spawn("node" + std::to_string(i), i, [in = c[i - 1].reader(), out = c[i].writer()]() mutable {
+      try {
+        for (;;) out.write(in.read() + 1);
+      } catch (const csp::Poisoned&) {
+        in.poison();
+        out.poison();
+      }
+    });
+  }
+  rt.run();
+  EXPECT_GT(laps, 0);
+  for (auto& ch : c) EXPECT_TRUE(ch.reader().poisoned());
+}
+
+TEST(Runtime, CrossThreadStressDeliversEverything) {
+  constexpr int producers = 16;
+  constexpr int per_producer = 5000;
+  csp::Channel<std::uint64_t> sink("sink");
+  std::vector<csp::Channel<std::uint64_t>> mid;
+  for (int i = 0; i < producers; ++i) mid.emplace_back("mid" + std::to_string(i), i % 3);
+  std::uint64_t sum = 0;
+  std::uint64_t count = 0;
+  csp::Runtime rt(2);
+  for (int i = 0; i < producers; ++i) {
+    rt.spawn("producer" + std::to_string(i), i, [out = mid[i].writer(), i]() mutable {
+      for (int k = 0; k < per_producer; ++k) out.write(static_cast<std::uint64_t>(i) * per_producer + k);
+    });
+    rt.spawn("relay" + std::to_string(i), i + 1, [in = mid[i].reader(), out = sink.writer()]() mutable {
+      for (int k = 0; k < per_producer; ++k) out.write(in.read());
+    });
+  }
+  rt.spawn("consumer", 0, [in = sink.reader(), &sum, &count]() mutable {
+    for (int k = 0; k < producers * per_producer; ++k) {
+      sum += in.read();
+      ++count;
+    }
+  });
+  rt.run();
+  const std::uint64_t n = std::uint64_t{producers} * per_producer;
+  EXPECT_EQ(count, n);
+  EXPECT_EQ(sum, n * (n - 1) / 2);
+}
+
+TEST(Deadlock, DetectedInARingNamingEveryProcess) {
+  constexpr int n = 4;
+  std::vector<csp::Channel<int>> c;
+  for (int i = 0; i < n; ++i) c.emplace_back("link" + std::to_string(i));
+  std::atomic<int> unwound{0};
+  struct Count {
+    std::atomic<int>& n;
+    ~Count() { ++n; }
+  };
+  csp::Runtime rt(2);
+  for (int i = 0; i < n; ++i) {
+    // Everyone reads first: nobody ever writes.
+    rt.spawn("node" + std::to_string(i), i, [in = c[i].reader(), out = c[(i + 1) % n].writer(), &unwound]() mutable {
+      Count guard{unwound};
+      out.write(in.read());
+    });
+  }
+  try {
+    rt.run();
+    FAIL() << "no deadlock reported";
+  } catch (const csp::Deadlock& e) {
+    const std::string what = e.what();
+    for (int i = 0; i < n; ++i) {
+      EXPECT_NE(what.find("'node" + std::to_string(i) + "'"), std::string::npos) << what;
+      EXPECT_NE(what.find("reading channel 'link" + std::to_string(i) + "'"), std::string::npos) << what;
+    }
+  }
+  EXPECT_EQ(unwound.load(), n);
+}
+
+TEST(Deadlock, DetectedThroughAltAndPar) {
+  csp::Channel<int> a("a");
+  csp::Channel<int> b("b");
+  csp::Runtime rt(1);
+  rt.spawn("parent", 0, [&] {
+    csp::par({[in = a.reader()]() mutable { in.read(); },
+              [&] {
+                csp::Alt alt;
+                alt.add_input(b.reader());
+                alt.add_input(a.reader());
+                alt.select();
+              }});
+  });
+  try {
+    rt.run();
+    FAIL() << "no deadlock reported";
+  } catch (const csp::Deadlock& e) {
+    const std::string what = e.what();
+    EXPECT_NE(what.find("'parent' (thread 0): in PAR"), std::string::npos) << what;
+    EXPECT_NE(what.find("'parent.0' (thread 0): reading channel 'a'"), std::string::npos) << what;
+    EXPECT_NE(what.find("'parent.1' (thread 0): in ALT over channels"), std::string::npos) << what;
+  }
+}
+
+TEST(Deadlock, TimersAreNotMistakenForDeadlock) {
+  csp::Channel<int> c("c");
+  csp::Channel<int> d("d");
+  int got = 0;
+  csp::Runtime rt(2);
+  rt.spawn("reader", 0, [in = c.reader(), &got]() mutable { got = in.read(); });
+  rt.spawn("sleeper", 1, [out = c.writer()]() mutable {
+    csp::sleep_for(5ms);
+    out.write(1);
+  });
+  rt.spawn("waiter", 1, [in = d.reader()]() mutable { EXPECT_FALSE(in.read_for(3ms)); });
+  rt.spawn("alt", 0, [in = d.reader()]() mutable {
+    csp::Alt alt;
+    alt.add_input(in);
+    alt.add_timeout(3ms);
+    EXPECT_EQ(alt.select(), 1u);
+  });
+  rt.run();
+  EXPECT_EQ(got, 1);
+}
+
+}  // namespace
