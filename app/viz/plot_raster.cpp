@@ -43,6 +43,11 @@ void draw_axes(Canvas& c, const PlotGeometry& g) {
     c.line({a.left, y}, {a.right(), y}, 1, grid_grey);
     c.text(a.left - 6, y - 3, g.y_ticks().labels[i], 1, ink, Align::right);
   }
+  // The frame goes under the data, so that points on the border stay visible.
+  c.line({a.left, a.top}, {a.right(), a.top}, 1, ink);
+  c.line({a.left, a.bottom()}, {a.right(), a.bottom()}, 1, ink);
+  c.line({a.left, a.top}, {a.left, a.bottom()}, 1, ink);
+  c.line({a.right(), a.top}, {a.right(), a.bottom()}, 1, ink);
 }
 
 void draw_data(Canvas& c, const LinePlot& plot, const PlotGeometry& g) {
@@ -65,13 +70,9 @@ void draw_data(Canvas& c, const LinePlot& plot, const PlotGeometry& g) {
   c.reset_clip();
 }
 
-void draw_frame_and_labels(Canvas& c, const LinePlot& plot, const PlotGeometry& g) {
+void draw_labels(Canvas& c, const LinePlot& plot, const PlotGeometry& g) {
   const Rect& a = g.area();
   const Rect& p = g.panel();
-  c.line({a.left, a.top}, {a.right(), a.top}, 1, ink);
-  c.line({a.left, a.bottom()}, {a.right(), a.bottom()}, 1, ink);
-  c.line({a.left, a.top}, {a.left, a.bottom()}, 1, ink);
-  c.line({a.right(), a.top}, {a.right(), a.bottom()}, 1, ink);
   const int title_scale = Canvas::text_width(plot.title, 2) <= p.width - 8 ? 2 : 1;
   c.text(a.left + a.width / 2, p.top + 8, plot.title, title_scale, {0, 0, 0}, Align::centre);
   c.text(a.left + a.width / 2, a.bottom() + 26, plot.x_label, 1, ink, Align::centre);
@@ -102,7 +103,7 @@ tracer::Image plot_image(const LinePlot& plot, int width, int height) {
   const PlotGeometry g(plot, {0, 0, static_cast<double>(width), static_cast<double>(height)}, 6.0);
   draw_axes(c, g);
   draw_data(c, plot, g);
-  draw_frame_and_labels(c, plot, g);
+  draw_labels(c, plot, g);
   draw_legend(c, plot, g);
   return c.image();
 }

@@ -24,6 +24,9 @@ void draw_grid_and_ticks(SvgDocument& doc, const PlotGeometry& g) {
   for (double v : g.y_ticks().values)
     doc.leaf("line", {{"x1", num(a.left)}, {"y1", num(g.y(v))}, {"x2", num(a.right())}, {"y2", num(g.y(v))}});
   doc.close();
+  // The frame goes under the data, so that points on the border stay visible.
+  doc.leaf("rect", {{"x", num(a.left)}, {"y", num(a.top)}, {"width", num(a.width)}, {"height", num(a.height)},
+                    {"fill", "none"}, {"stroke", "#444444"}});
   doc.open("g", {{"class", "tick-labels"}, {"font-size", "11"}, {"fill", "#333333"}});
   for (std::size_t i = 0; i < g.x_ticks().values.size(); ++i)
     doc.text(g.x_ticks().labels[i], {{"x", num(g.x(g.x_ticks().values[i]))}, {"y", num(a.bottom() + 15)},
@@ -37,8 +40,6 @@ void draw_grid_and_ticks(SvgDocument& doc, const PlotGeometry& g) {
 void draw_labels(SvgDocument& doc, const LinePlot& plot, const PlotGeometry& g) {
   const Rect& a = g.area();
   const Rect& p = g.panel();
-  doc.leaf("rect", {{"x", num(a.left)}, {"y", num(a.top)}, {"width", num(a.width)}, {"height", num(a.height)},
-                    {"fill", "none"}, {"stroke", "#444444"}});
   if (!plot.title.empty())
     doc.text(plot.title, {{"x", num(a.left + a.width / 2)}, {"y", num(p.top + 20)}, {"text-anchor", "middle"},
                           {"font-size", "14"}, {"font-weight", "bold"}});

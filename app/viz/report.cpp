@@ -1,0 +1,152 @@
+// HTML report writer; see report.hpp for what the page may reference.
+#include "app/viz/report.hpp"
+
+#include <cctype>
+#include <cstdio>
+#include <fstream>
+#include <stdexcept>
+
+#include "app/viz/svg.hpp"
+
+namespace viz {
+namespace {
+
+namespace fs = std::filesystem;
+
+constexpr const char* style = R"(body { font-family: sans-serif; margin: 2em auto; max-width: 1200px; color: #222; }
+h1 { border-bottom: 2px solid #444; }
+section { margin-bottom: 2em; }
+table { border-collapse: collapse; margin: 1em 0; }
+caption { font-weight: bold; text-align: left; padding-bottom: 0.3em; }
+th, td { border: 1px solid #ccc; padding: 0.2em 0.6em; }
+th { background: #f0f0f0; text-align: left; }
+td.num { text-align: right; font-variant-numeric: tabular-nums; }
+figure { margin: 1em 0; overflow-x: auto; }
+figcaption { color: #555; font-size: 0.9em; }
+img { image-rendering: pixelated; max-width: 100%; }
+)";
+
+// A file name as a relative URL: anything but unreserved characters is %-encoded.
+std::string url_of(const std::string& name) {
+  std::string out;
+  for (unsigned char c : name) {
+    if (std::isalnum(c) || c == '-' || c == '.' || c == '_' || c == '~') {
+      out += static_cast<char>(c);
+    } else {
+      char buf[4];
+      std::snprintf(buf, sizeof buf, "%%%02X", c);
+      out += buf;
+    }
+  }
+  return out;
+}
+
+bool looks_numeric(const std::string& s) {
+  if (s.empty()) return false;
+  for (char c : s)
+    if (!std::isdigit(static_cast<unsigned char>(c)) && c != '.' && c != '-' && c != '+' && c != 'e' &&
+        c != '%' && c != ',' && c != ' ')
+      return false;
+  return std::isdigit(static_cast<unsigned char>(s.front())) || s.front() == '-' || s.front() == '.';
+}
+
+void caption(std::string& out, const std::string& text) {
+  if (!text.empty()) out += "<caption>" + escape_xml(text) + "</caption>\n";
+}
+
+class PageWriter {
+ public:
+  PageWriter(const fs::path& html, std::vector<fs::path>& written) : html_(html), written_(written) {}
+
+  void operator()(const Paragraph& p) { out += "<p>" + escape_xml(p.text) + "</p>\n"; }
+
+  void operator()(const KeyValueTable& t) {
+    out += "<table class=\"stats\">\n";
+    caption(out, t.caption);
+    for (const auto& [k, v] : t.rows)
+      out += "<tr><th>" + escape_xml(k) + "</th>" + cell(v) + "</tr>\n";
+    out += "</table>\n";
+  }
+
+  void operator()(const Table& t) {
+    out += "<table>\n";
+    caption(out, t.caption);
+    if (!t.header.empty()) {
+      out += "<tr>";
+      for (const std::string& h : t.header) out += "<th>" + escape_xml(h) + "</th>";
+      out += "</tr>\n";
+    }
+    for (const auto& row : t.rows) {
+      out += "<tr>";
+      for (const std::string& c : row) out += cell(c);
+      out += "</tr>\n";
+    }
+    out += "</table>\n";
+  }
+
+  void operator()(const SvgFigure& f) {
+    if (f.svg.rfind("<svg", 0) != 0)
+      throw std::invalid_argument("report figure '" + f.caption + "' is not an SVG document");
+    out += "<figure>\n" + f.svg + figcaption(f.caption) + "</figure>\n";
+  }
+
+  void operator()(const ImageFigure& f) {
+    const std::string name = html_.stem().string() + "-" + std::to_string(++images_) + ".png";
+    const fs::path png = html_.parent_path() / name;
+    f.image.write_png(png.string());
+    written_.push_back(png);
+    out += "<figure>\n<img src=\"" + escape_xml(url_of(name)) + "\" width=\"" + std::to_string(f.image.width()) +
+           "\" height=\"" + std::to_string(f.image.height()) + "\" alt=\"" + escape_xml(f.caption) + "\"/>\n" +
+           figcaption(f.caption) + "</figure>\n";
+  }
+
+  std::string out;
+
+ private:
+  static std::string cell(const std::string& v) {
+    return (looks_numeric(v) ? "<td class=\"num\">" : "<td>") + escape_xml(v) + "</td>";
+  }
+  static std::string figcaption(const std::string& text) {
+    return text.empty() ? std::string{} : "<figcaption>" + escape_xml(text) + "</figcaption>\n";
+  }
+
+  const fs::path& html_;
+  std::vector<fs::path>& written_;
+  int images_ = 0;
+};
+
+void write_atomically(const fs::path& path, const std::string& text) {
+  const fs::path tmp = path.string() + ".tmp";
+  {
+    std::ofstream f(tmp, std::ios::binary);
+    f << text;
+    if (!f.flush()) throw std::runtime_error("cannot write " + tmp.string());
+  }
+  std::error_code ec;
+  fs::rename(tmp, path, ec);
+  if (ec) {
+    fs::remove(tmp, ec);
+    throw std::runtime_error("cannot write " + path.string());
+  }
+}
+
+}  // namespace
+
+std::vector<fs::path> write_html_report(const fs::path& html_path, const Report& report) {
+  std::vector<fs::path> written;
+  PageWriter page(html_path, written);
+  page.out = "<!DOCTYPE html>\n<html lang=\"en\">\n<head>\n<meta charset=\"utf-8\"/>\n<title>" +
+             escape_xml(report.title) + "</title>\n<style>\n" + style + "</style>\n</head>\n<body>\n<h1>" +
+             escape_xml(report.title) + "</h1>\n";
+  for (const Section& s : report.sections) {
+    page.out += "<section>\n<h2>" + escape_xml(s.heading) + "</h2>\n";
+    for (const Block& b : s.blocks) std::visit(page, b);
+    page.out += "</section>\n";
+  }
+  page.out += "</body>\n</html>\n";
+  write_atomically(html_path, page.out);
+  written.push_back(html_path);
+  return written;
+}
+
+}  // namespace viz

@@ -1,0 +1,63 @@
+// The HTML report of a render: one self-contained page (no network: no
+// external CSS, scripts or fonts) with statistics tables, inline SVG
+// pictures and the images.
+// Images are written as PNG files beside the HTML, named "<stem>-<n>.png"
+// (n = 1, 2, ... in document order) and linked by file name, so the page
+// references only files it wrote itself. All text is escaped; SVG figures
+// are inserted as they are and must come from this library's *_svg functions.
+#pragma once
+
+#include <filesystem>
+#include <string>
+#include <utility>
+#include <variant>
+#include <vector>
+
+#include "tracer/image.hpp"
+
+namespace viz {
+
+struct Paragraph {
+  std::string text{};
+};
+
+struct KeyValueTable {
+  std::string caption{};
+  std::vector<std::pair<std::string, std::string>> rows{};
+};
+
+struct Table {
+  std::string caption{};
+  std::vector<std::string> header{};
+  std::vector<std::vector<std::string>> rows{};  // cells that read as numbers are right-aligned
+};
+
+struct SvgFigure {
+  std::string caption{};
+  std::string svg{};  // a document from plot_svg, plots_svg or machine_svg
+};
+
+struct ImageFigure {
+  std::string caption{};
+  tracer::Image image{};
+};
+
+using Block = std::variant<Paragraph, KeyValueTable, Table, SvgFigure, ImageFigure>;
+
+struct Section {
+  std::string heading{};
+  std::vector<Block> blocks{};
+};
+
+struct Report {
+  std::string title{};
+  std::vector<Section> sections{};
+};
+
+// Writes the page to html_path (through a temporary file renamed into
+// place) and its PNGs beside it. Returns every file written, the HTML last.
+// Throws std::invalid_argument if an SvgFigure does not hold an <svg>
+// document, std::runtime_error naming the path on an I/O failure.
+std::vector<std::filesystem::path> write_html_report(const std::filesystem::path& html_path, const Report& report);
+
+}  // namespace viz

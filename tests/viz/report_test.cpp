@@ -1,0 +1,127 @@
+// HTML report: well-formed, escapes text, links only files it wrote (which
+// exist), needs no network.
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <stdexcept>
+
+#include "app/viz/machine.hpp"
+#include "app/viz/ownership.hpp"
+#include "app/viz/plot.hpp"
+#include "app/viz/report.hpp"
+#include "xml_check.hpp"
+
+namespace viz {
+namespace {
+
+namespace fs = std::filesystem;
+
+class ReportTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    dir_ = fs::temp_directory_path() /
+           ("viz-report-" + std::string(::testing::UnitTest::GetInstance()->current_test_info()->name()));
+    fs::remove_all(dir_);
+    fs::create_directories(dir_);
+  }
+  void TearDown() override { fs::remove_all(dir_); }
+
+  static std::string read(const fs::path& p) {
+    std::ifstream f(p);
+    std::stringstream s;
+    s << f.rdbuf();
+    return s.str();
+  }
+
+  fs::path dir_;
+};
+
+Report sample_report() {
+  tracer::Image render(4, 3);
+  render.at(1, 1) = {1, 0.5f, 0};
+  LinePlot plot;
+  plot.title = "efficiency";
+  plot.series.push_back({"teapot", {{1, 0.9}, {2, 0.8}}});
+  MachineDrawing m{MachineKind::ring, 3, 1, "ring", std::vector<NodeWork>(3), {{0, 1, 2, 64}}};
+  Report r;
+  r.title = "Render <teapot> & \"friends\"";
+  r.sections.push_back({"Image", {ImageFigure{"rendered", render},
+                                  ImageFigure{"owners", ownership_image(4, 3, std::vector<std::uint16_t>(12, 1))}}});
+  r.sections.push_back({"Statistics", {KeyValueTable{"rays", {{"primary", "262144"}, {"<odd> key", "a&b"}}},
+                                       Table{"per node", {"node", "pixels"}, {{"0", "100"}, {"1", "97"}}},
+                                       Paragraph{"1 < 2 && 3 > 2"}}});
+  r.sections.push_back({"Pictures", {SvgFigure{"plot", plot_svg(plot)}, SvgFigure{"machine", machine_svg(m)}}});
+  return r;
+}
+
+TEST_F(ReportTest, IsWellFormedAndEscapesText) {
+  const fs::path html = dir_ / "report.html";
+  write_html_report(html, sample_report());
+  const std::string text = read(html);
+  const test::XmlCheck doc = test::check_xml(text);
+  ASSERT_TRUE(doc.ok) << doc.error;
+  EXPECT_NE(text.find("<title>Render &lt;teapot&gt; &amp; &quot;friends&quot;</title>"), std::string::npos);
+  EXPECT_NE(text.find("<h1>Render &lt;teapot&gt; &amp; &quot;friends&quot;</h1>"), std::string::npos);
+  EXPECT_NE(text.find("&lt;odd&gt; key"), std::string::npos);
+  EXPECT_NE(text.find("1 &lt; 2 &amp;&amp; 3 &gt; 2"), std::string::npos);
+}
+
+TEST_F(ReportTest, LinksOnlyFilesItWrote) {
+  const fs::path html = dir_ / "run 1#a.html";  // a name that needs URL encoding
+  const std::vector<fs::path> written = write_html_report(html, sample_report());
+  ASSERT_EQ(written.size(), 3u);
+  EXPECT_EQ(written.back(), html);
+  const test::XmlCheck doc = test::check_xml(read(html));
+  ASSERT_TRUE(doc.ok) << doc.error;
+  std::size_t references = 0;
+  for (const auto& e : doc.elements)
+    for (const char* attr : {"src", "href", "xlink:href"}) {
+      if (!e.attrs.count(attr)) continue;
+      ++references;
+      const std::string url = e.attrs.at(attr);
+      EXPECT_EQ(url.find(':'), std::string::npos) << "not a relative file: " << url;
+      EXPECT_EQ(url.find('/'), std::string::npos) << url;
+      // Undo the %-encoding of the file name.
+      std::string name;
+      for (std::size_t i = 0; i < url.size(); ++i) {
+        if (url[i] == '%') {
+          name += static_cast<char>(std::stoi(url.substr(i + 1, 2), nullptr, 16));
+          i += 2;
+        } else {
+          name += url[i];
+        }
+      }
+      const fs::path target = dir_ / name;
+      EXPECT_TRUE(fs::exists(target)) << target;
+      EXPECT_NE(std::find(written.begin(), written.end(), target), written.end()) << target;
+    }
+  EXPECT_EQ(references, 2u);
+  const tracer::Rgb8Image png = tracer::read_png(written[0].string());
+  EXPECT_EQ(png.width, 4);
+  EXPECT_EQ(png.rgb[(1 * 4 + 1) * 3], 255);
+}
+
+TEST_F(ReportTest, NeedsNoNetwork) {
+  const fs::path html = dir_ / "r.html";
+  write_html_report(html, sample_report());
+  const std::string text = read(html);
+  EXPECT_EQ(text.find("<script"), std::string::npos);
+  EXPECT_EQ(text.find("<link"), std::string::npos);
+  EXPECT_EQ(text.find("@import"), std::string::npos);
+  EXPECT_EQ(text.find("url(http"), std::string::npos);
+}
+
+TEST_F(ReportTest, RejectsFigureThatIsNotSvg) {
+  Report r;
+  r.sections.push_back({"bad", {SvgFigure{"x", "<script>alert(1)</script>"}}});
+  EXPECT_THROW(write_html_report(dir_ / "r.html", r), std::invalid_argument);
+}
+
+TEST_F(ReportTest, UnwritableDirectoryIsAnError) {
+  EXPECT_THROW(write_html_report(dir_ / "missing" / "r.html", sample_report()), std::runtime_error);
+}
+
+}  // namespace
+}  // namespace viz
