@@ -1,0 +1,62 @@
+// vmpray: render an NFF or built-in scene in this process and report rays,
+// intersection tests and database pages. Exit 0 on success, 2 for a bad
+// command line, 1 for a runtime error; errors are one line on stderr, and a
+// failed run leaves no output file.
+#include <cctype>
+#include <chrono>
+#include <iostream>
+
+#include "app/options.hpp"
+#include "app/report.hpp"
+#include "app/scene_input.hpp"
+#include "app/single.hpp"
+
+namespace {
+
+int run(const app::Options& o) {
+  const auto t0 = std::chrono::steady_clock::now();
+  const tracer::Scene scene = app::load_scene(o);
+  const double load_seconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  app::RenderResult result = app::render_single(o, scene);
+  result.report.load_seconds = load_seconds;
+  result.image.write_image(o.output);
+  if (!o.stats_path.empty()) app::write_stats_json(o.stats_path, result.report);
+  if (!o.quiet) app::print_report(std::cout, result.report);
+  return 0;
+}
+
+bool has_image_extension(const std::string& path) {
+  auto lower = path.substr(path.size() >= 4 ? path.size() - 4 : 0);
+  for (char& c : lower) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  return lower == ".png" || lower == ".ppm";
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  app::Options options;
+  try {
+    options = app::parse_options(argc, argv);
+    if (!has_image_extension(options.output))
+      throw app::UsageError("--output: expected a .png or .ppm file name, got '" +
+                            options.output + "'");
+  } catch (const app::UsageError& e) {
+    std::cerr << "vmpray: " << e.what() << " (see vmpray --help)\n";
+    return 2;
+  }
+  if (options.action == app::Options::Action::help) {
+    std::cout << app::usage_text();
+    return 0;
+  }
+  if (options.action == app::Options::Action::version) {
+    std::cout << "vmpray " << VMPRAY_VERSION << "\n";
+    return 0;
+  }
+  try {
+    return run(options);
+  } catch (const std::exception& e) {
+    std::cerr << "vmpray: " << e.what() << "\n";
+    return 1;
+  }
+}

@@ -1,0 +1,44 @@
+// Command-line options of `vmpray`: one struct and its parser. The parser only
+// checks values; it opens no files (scene and output are checked by the caller).
+#pragma once
+
+#include <cstdint>
+#include <stdexcept>
+#include <string>
+
+#include "tracer/database.hpp"
+
+namespace app {
+
+// A bad command line; the message is one line naming the option.
+class UsageError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+struct Options {
+  enum class Action { render, help, version };
+  Action action = Action::render;
+  std::string scene = "teapot";   // NFF path, "-" for stdin, or a built-in spec
+  std::string output;             // .png or .ppm; derived from the scene when empty
+  std::string stats_path;         // JSON report, none when empty
+  bool spd_procedure = false;
+  tracer::Accel accel = tracer::Accel::bvh;
+  std::uint32_t page_size = 1024;
+  int max_depth = 5;
+  int width = 0;       // 0: the scene's resolution
+  int height = 0;
+  int tessellate = 0;  // 0: keep spheres and cones as they are
+  bool quiet = false;
+};
+
+// Throws UsageError. argv[0] is the program name.
+Options parse_options(int argc, const char* const argv[]);
+
+// The --help text (options and built-in scenes).
+std::string usage_text();
+
+// "teapot" -> "teapot.png", "tetra:9" -> "tetra-9.png", "dir/x.nff.gz" -> "x.png".
+std::string default_output(const std::string& scene);
+
+}  // namespace app

@@ -1,0 +1,81 @@
+// Human-readable and JSON forms of RunReport.
+#include "app/report.hpp"
+
+#include <cstdio>
+#include <fstream>
+#include <iomanip>
+#include <stdexcept>
+
+namespace app {
+namespace {
+
+const char* accel_name(tracer::Accel a) { return a == tracer::Accel::bvh ? "bvh" : "grid"; }
+
+std::string json_string(const std::string& s) {
+  std::string out = "\"";
+  for (char c : s) {
+    if (c == '"' || c == '\\') out += '\\', out += c;
+    else if (static_cast<unsigned char>(c) < 0x20) {
+      char buf[8];
+      std::snprintf(buf, sizeof buf, "\\u%04x", c);
+      out += buf;
+    } else out += c;
+  }
+  return out + "\"";
+}
+
+}  // namespace
+
+void print_report(std::ostream& out, const RunReport& r) {
+  const auto& s = r.rays;
+  out << std::fixed << std::setprecision(2);
+  out << "scene          " << r.scene << ": " << r.polygons << " polygons, " << r.objects
+      << " objects, " << r.primitives << " primitives\n"
+      << "image          " << r.output << " (" << r.width << "x" << r.height
+      << (r.spd_procedure ? ", SPD procedure" : "") << ")\n"
+      << "database       " << r.pages << " pages of " << r.page_size << " bytes = "
+      << r.database_bytes / 1024.0 << " KB (" << accel_name(r.accel) << ", built in "
+      << r.build.accel_seconds << " s)\n"
+      << "rays           " << s.rays() << ": primary " << s.primary << " (hit " << s.primary_hits
+      << "), shadow " << s.shadow << ", reflected " << s.reflected << ", refracted "
+      << s.refracted << "\n"
+      << "tests          " << s.box_tests << (r.accel == tracer::Accel::bvh ? " box" : " cell")
+      << ", " << s.prim_tests << " primitive\n"
+      << "page accesses  " << s.record_reads << " record reads, " << s.page_calls
+      << " page calls, " << s.pages_per_sample() << " distinct pages per "
+      << (r.spd_procedure ? "sample" : "pixel") << "\n"
+      << "time           load " << r.load_seconds << " s, build "
+      << r.build.triangulate_seconds + r.build.accel_seconds + r.build.pack_seconds
+      << " s, render " << r.render_seconds << " s, " << r.mrays_per_second() << " Mrays/s\n";
+}
+
+void write_stats_json(const std::string& path, const RunReport& r) {
+  std::ofstream f(path);
+  if (!f) throw std::runtime_error(path + ": cannot open for writing");
+  const auto& s = r.rays;
+  f << std::setprecision(9) << "{\n"
+    << "  \"scene\": " << json_string(r.scene) << ",\n"
+    << "  \"output\": " << json_string(r.output) << ",\n"
+    << "  \"width\": " << r.width << ", \"height\": " << r.height << ",\n"
+    << "  \"spd_procedure\": " << (r.spd_procedure ? "true" : "false") << ",\n"
+    << "  \"polygons\": " << r.polygons << ", \"objects\": " << r.objects
+    << ", \"primitives\": " << r.primitives << ",\n"
+    << "  \"database\": {\"accel\": \"" << accel_name(r.accel) << "\", \"page_size\": "
+    << r.page_size << ", \"pages\": " << r.pages << ", \"bytes\": " << r.database_bytes
+    << ", \"payload_bytes\": " << r.build.payload_bytes << ", \"bvh_nodes\": "
+    << r.build.bvh_nodes << ", \"grid_cells\": " << r.build.grid_cells << "},\n"
+    << "  \"rays\": {\"total\": " << s.rays() << ", \"primary\": " << s.primary
+    << ", \"primary_hits\": " << s.primary_hits << ", \"shadow\": " << s.shadow
+    << ", \"reflected\": " << s.reflected << ", \"refracted\": " << s.refracted << "},\n"
+    << "  \"tests\": {\"box\": " << s.box_tests << ", \"primitive\": " << s.prim_tests << "},\n"
+    << "  \"pages\": {\"record_reads\": " << s.record_reads << ", \"page_calls\": "
+    << s.page_calls << ", \"samples\": " << s.samples << ", \"distinct_pages\": "
+    << s.distinct_pages << ", \"per_sample\": " << s.pages_per_sample() << "},\n"
+    << "  \"seconds\": {\"load\": " << r.load_seconds << ", \"triangulate\": "
+    << r.build.triangulate_seconds << ", \"accel_build\": " << r.build.accel_seconds
+    << ", \"pack\": " << r.build.pack_seconds << ", \"render\": " << r.render_seconds << "},\n"
+    << "  \"mrays_per_second\": " << r.mrays_per_second() << "\n}\n";
+  if (!f) throw std::runtime_error(path + ": write failed");
+}
+
+}  // namespace app

@@ -1,0 +1,40 @@
+// The run report: what was rendered, the database, rays and timing; printed
+// for people and written as JSON (same fields) for scripts.
+#pragma once
+
+#include <cstdint>
+#include <ostream>
+#include <string>
+
+#include "tracer/database.hpp"
+#include "tracer/stats.hpp"
+
+namespace app {
+
+struct RunReport {
+  std::string scene;
+  std::string output;
+  int width = 0, height = 0;
+  bool spd_procedure = false;
+  std::uint64_t polygons = 0;    // "p" + "pp" entities
+  std::uint64_t objects = 0;
+  std::uint64_t primitives = 0;  // after triangulation
+  tracer::Accel accel = tracer::Accel::bvh;
+  std::uint32_t page_size = 0;
+  std::uint32_t pages = 0;
+  std::uint64_t database_bytes = 0;  // pages * page_size
+  tracer::BuildStats build;
+  double load_seconds = 0;
+  double render_seconds = 0;
+  tracer::RayStats rays;
+
+  double mrays_per_second() const {
+    return render_seconds > 0 ? double(rays.rays()) / render_seconds * 1e-6 : 0.0;
+  }
+};
+
+void print_report(std::ostream& out, const RunReport& r);
+// Throws std::runtime_error naming the path if the file cannot be written.
+void write_stats_json(const std::string& path, const RunReport& r);
+
+}  // namespace app
