@@ -193,7 +193,10 @@ class Parser {
 
   void keyword(std::string_view expected) {
     std::string_view token = lex_.next();
-    if (token != expected) fail("'" + std::string(expected) + "'", token);
+    if (token == expected) return;
+    std::string quoted(1, '\'');  // built by append: GCC 12 -O3 warns falsely on "'" + string
+    quoted.append(expected).push_back('\'');
+    fail(quoted, token);
   }
 
   void view();
