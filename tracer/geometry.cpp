@@ -6,37 +6,6 @@
 
 namespace tracer {
 
-std::optional<float> intersect_box(const Ray& r, const RayInverse& inv, const Box3f& b,
-                                   float t_min, float t_max) {
-  for (int axis = 0; axis < 3; ++axis) {
-    float t0 = (b.lo[axis] - r.origin[axis]) * inv.inv_dir[axis];
-    float t1 = (b.hi[axis] - r.origin[axis]) * inv.inv_dir[axis];
-    if (t0 > t1) std::swap(t0, t1);
-    // max/min written so that a NaN (0 * inf on a slab face) keeps the old bound.
-    t_min = t0 > t_min ? t0 : t_min;
-    t_max = t1 < t_max ? t1 : t_max;
-    if (t_min > t_max) return std::nullopt;
-  }
-  return t_min;
-}
-
-std::optional<TriangleHit> intersect_triangle(const Ray& r, const Vec3f& v0, const Vec3f& e1,
-                                              const Vec3f& e2, float t_min, float t_max) {
-  const Vec3f p = cross(r.dir, e2);
-  const float det = dot(e1, p);
-  if (det == 0.0f) return std::nullopt;  // ray parallel to the plane
-  const float inv_det = 1.0f / det;
-  const Vec3f s = r.origin - v0;
-  const float u = dot(s, p) * inv_det;
-  if (u < 0.0f || u > 1.0f) return std::nullopt;
-  const Vec3f q = cross(s, e1);
-  const float v = dot(r.dir, q) * inv_det;
-  if (v < 0.0f || u + v > 1.0f) return std::nullopt;
-  const float t = dot(e2, q) * inv_det;
-  if (!(t > t_min && t < t_max)) return std::nullopt;
-  return TriangleHit{t, u, v};
-}
-
 // Keeps the nearer root in (t_min, t_max) whose outward normal passes `visible`.
 template <class Visible>
 static std::optional<float> pick_root(float t0, float t1, float t_min, float t_max,

@@ -43,16 +43,43 @@ struct RayInverse {
 };
 
 // Slab test: entry distance if the ray meets the box within [t_min, t_max].
-std::optional<float> intersect_box(const Ray& r, const RayInverse& inv, const Box3f& b,
-                                   float t_min, float t_max);
+// Inline: it is the innermost operation of traversal. The operand order of
+// min/max drops a NaN (0 * inf on a slab face) in favour of the running bound.
+inline std::optional<float> intersect_box(const Ray& r, const RayInverse& inv, const Box3f& b,
+                                          float t_min, float t_max) {
+  auto lo = [](float a, float b) { return b < a ? b : a; };
+  auto hi = [](float a, float b) { return a < b ? b : a; };
+  const float x0 = (b.lo.x - r.origin.x) * inv.inv_dir.x, x1 = (b.hi.x - r.origin.x) * inv.inv_dir.x;
+  const float y0 = (b.lo.y - r.origin.y) * inv.inv_dir.y, y1 = (b.hi.y - r.origin.y) * inv.inv_dir.y;
+  const float z0 = (b.lo.z - r.origin.z) * inv.inv_dir.z, z1 = (b.hi.z - r.origin.z) * inv.inv_dir.z;
+  t_min = hi(hi(hi(t_min, lo(x0, x1)), lo(y0, y1)), lo(z0, z1));
+  t_max = lo(lo(lo(t_max, hi(x0, x1)), hi(y0, y1)), hi(z0, z1));
+  if (t_min > t_max) return std::nullopt;
+  return t_min;
+}
 
 struct TriangleHit {
   float t, u, v;  // barycentric (u, v) of vertex 1 and 2
 };
 
 // Two-sided Moeller-Trumbore on a triangle stored as v0, e1 = v1 - v0, e2 = v2 - v0.
-std::optional<TriangleHit> intersect_triangle(const Ray& r, const Vec3f& v0, const Vec3f& e1,
-                                              const Vec3f& e2, float t_min, float t_max);
+inline std::optional<TriangleHit> intersect_triangle(const Ray& r, const Vec3f& v0,
+                                                     const Vec3f& e1, const Vec3f& e2,
+                                                     float t_min, float t_max) {
+  const Vec3f p = cross(r.dir, e2);
+  const float det = dot(e1, p);
+  if (det == 0.0f) return std::nullopt;  // ray parallel to the plane
+  const float inv_det = 1.0f / det;
+  const Vec3f s = r.origin - v0;
+  const float u = dot(s, p) * inv_det;
+  if (u < 0.0f || u > 1.0f) return std::nullopt;
+  const Vec3f q = cross(s, e1);
+  const float v = dot(r.dir, q) * inv_det;
+  if (v < 0.0f || u + v > 1.0f) return std::nullopt;
+  const float t = dot(e2, q) * inv_det;
+  if (!(t > t_min && t < t_max)) return std::nullopt;
+  return TriangleHit{t, u, v};
+}
 
 // Sphere; a negative radius means only the inside is visible: hits where the
 // inward normal faces away from the ray are skipped.

@@ -1,0 +1,164 @@
+// tracer_bench: single-thread throughput of the paged tracer on the paper's
+// scenes at 512x512, measured side by side in one run:
+//  - "embree workload": one eye ray per pixel centre plus one shadow ray per
+//    light from each hit (the workload of the Embree reference figures), for
+//    vmpray and, when built with Embree, for Embree's rtcIntersect1/rtcOccluded1;
+//  - the full Whitted render (primary + shadow + reflected + refracted);
+//  - the same render at page sizes 256 and 65536 (paging granularity cost).
+// Times are thread CPU seconds, so other processes on the machine skew them less.
+#include <time.h>
+
+#include <cstdio>
+#include <cstring>
+#include <string>
+#include <vector>
+
+#include "tracer/database.hpp"
+#include "tracer/generators.hpp"
+#include "tracer/render.hpp"
+
+#ifdef VMPRAY_HAVE_EMBREE
+#include <embree3/rtcore.h>
+#endif
+
+namespace {
+
+double cpu_seconds() {
+  timespec ts;
+  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
+  return double(ts.tv_sec) + 1e-9 * double(ts.tv_nsec);
+}
+
+struct Workload {
+  std::uint64_t rays = 0;
+  double seconds = 0;
+  double mrays() const { return seconds > 0 ? double(rays) / seconds * 1e-6 : 0.0; }
+};
+
+// Eye ray per pixel centre, then a shadow ray to every light from each hit.
+Workload vmpray_primary_shadow(const tracer::Database& db) {
+  tracer::InMemoryPageSource pages(db);
+  tracer::Tracer tracer(db.header, pages);
+  const tracer::CameraModel camera(db.header.camera);
+  tracer::RayStats stats;
+  Workload w;
+  const double t0 = cpu_seconds();
+  for (int y = 0; y < db.header.camera.height; ++y)
+    for (int x = 0; x < db.header.camera.width; ++x) {
+      const tracer::Ray ray = camera.ray_through(x, y);
+      ++w.rays;
+      const auto hit = tracer.closest_hit(ray, camera.hither(), 1e30f, stats);
+      if (!hit) continue;
+      const tracer::Vec3f p = ray.origin + ray.dir * hit->t;
+      for (const auto& light : db.header.lights) {
+        const tracer::Vec3f d = light.position - p;
+        ++w.rays;
+        tracer.occluded({p, d}, db.header.epsilon, 1.0f, stats);
+      }
+    }
+  w.seconds = cpu_seconds() - t0;
+  return w;
+}
+
+Workload vmpray_whitted(const tracer::Database& db) {
+  tracer::InMemoryPageSource pages(db);
+  tracer::RayStats stats;
+  const double t0 = cpu_seconds();
+  tracer::render_frame(db.header, pages, {}, stats);
+  return {stats.rays(), cpu_seconds() - t0};
+}
+
+#ifdef VMPRAY_HAVE_EMBREE
+// The database's triangles (read back from the packed pages) in an Embree scene.
+Workload embree_primary_shadow(const tracer::Database& db) {
+  const auto& sec = db.header.section(tracer::Section::prims);
+  std::vector<float> verts;
+  std::vector<unsigned> index;
+  for (std::uint32_t i = 0; i < sec.record_count; ++i) {
+    const std::size_t byte = std::size_t{i} * sizeof(tracer::PrimRecord);
+    tracer::PrimRecord p;
+    std::memcpy(&p, db.pages[sec.first_page + byte / db.header.page_size].data() +
+                        byte % db.header.page_size, sizeof p);
+    if (p.kind != tracer::PrimKind::flat_triangle && p.kind != tracer::PrimKind::smooth_triangle)
+      continue;
+    for (const tracer::Vec3f& v : {p.p0, p.p0 + p.p1, p.p0 + p.p2}) {
+      index.push_back(static_cast<unsigned>(verts.size() / 3));
+      verts.insert(verts.end(), {v.x, v.y, v.z});
+    }
+  }
+  RTCDevice device = rtcNewDevice("threads=1");
+  RTCScene scene = rtcNewScene(device);
+  RTCGeometry geom = rtcNewGeometry(device, RTC_GEOMETRY_TYPE_TRIANGLE);
+  auto* vb = static_cast<float*>(rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_VERTEX, 0,
+                                                         RTC_FORMAT_FLOAT3, 12, verts.size() / 3));
+  std::copy(verts.begin(), verts.end(), vb);
+  auto* ib = static_cast<unsigned*>(rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_INDEX, 0,
+                                                            RTC_FORMAT_UINT3, 12, index.size() / 3));
+  std::copy(index.begin(), index.end(), ib);
+  rtcCommitGeometry(geom);
+  rtcAttachGeometry(scene, geom);
+  rtcReleaseGeometry(geom);
+  rtcCommitScene(scene);
+  const tracer::CameraModel camera(db.header.camera);
+  RTCIntersectContext ctx;
+  rtcInitIntersectContext(&ctx);
+  Workload w;
+  const double t0 = cpu_seconds();
+  for (int y = 0; y < db.header.camera.height; ++y)
+    for (int x = 0; x < db.header.camera.width; ++x) {
+      const tracer::Ray ray = camera.ray_through(x, y);
+      RTCRayHit rh{};
+      rh.ray = {ray.origin.x, ray.origin.y, ray.origin.z, camera.hither(),
+                ray.dir.x, ray.dir.y, ray.dir.z, 0.0f, 1e30f, 0xffffffffu, 0, 0};
+      rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
+      ++w.rays;
+      rtcIntersect1(scene, &ctx, &rh);
+      if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) continue;
+      const tracer::Vec3f p = ray.origin + ray.dir * rh.ray.tfar;
+      for (const auto& light : db.header.lights) {
+        const tracer::Vec3f d = light.position - p;
+        RTCRay s{p.x, p.y, p.z, db.header.epsilon, d.x, d.y, d.z, 0.0f, 1.0f, 0xffffffffu, 0, 0};
+        ++w.rays;
+        rtcOccluded1(scene, &ctx, &s);
+      }
+    }
+  w.seconds = cpu_seconds() - t0;
+  rtcReleaseScene(scene);
+  rtcReleaseDevice(device);
+  return w;
+}
+#endif
+
+void bench_scene(const std::string& spec) {
+  tracer::Scene scene = tracer::generate_scene(spec);
+  scene.camera.width = scene.camera.height = 512;
+  const tracer::Database db = build_database(scene, {.page_size = 1024});
+  std::printf("%-9s %8llu prims  BVH build %.3f s  %6u pages (%.0f KB)\n", spec.c_str(),
+              static_cast<unsigned long long>(db.header.primitive_count), db.stats.accel_seconds,
+              db.header.page_count, db.header.bytes() / 1024.0);
+  const Workload ours = vmpray_primary_shadow(db);
+  std::printf("  primary+shadow  vmpray %6.2f Mrays/s (%llu rays)", ours.mrays(),
+              static_cast<unsigned long long>(ours.rays));
+#ifdef VMPRAY_HAVE_EMBREE
+  const Workload ref = embree_primary_shadow(db);
+  std::printf("  embree %6.2f Mrays/s  ratio vmpray/embree %.2f", ref.mrays(), ours.mrays() / ref.mrays());
+#endif
+  std::printf("\n");
+  const Workload whitted = vmpray_whitted(db);
+  std::printf("  whitted         vmpray %6.2f Mrays/s (%llu rays, %.2f s)\n", whitted.mrays(),
+              static_cast<unsigned long long>(whitted.rays), whitted.seconds);
+  for (std::uint32_t ps : {256u, 65536u}) {
+    const tracer::Database other = build_database(scene, {.page_size = ps});
+    const Workload w = vmpray_whitted(other);
+    std::printf("  whitted @%5u  vmpray %6.2f Mrays/s  time ratio vs 1024: %.3f\n", ps, w.mrays(),
+                w.seconds / whitted.seconds);
+  }
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  std::vector<std::string> scenes = {"teapot", "mountain", "rings4", "tetra9"};
+  if (argc > 1) scenes.assign(argv + 1, argv + argc);
+  for (const auto& s : scenes) bench_scene(s);
+}
