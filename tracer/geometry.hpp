@@ -42,20 +42,25 @@ struct RayInverse {
       : inv_dir{1.0f / r.dir.x, 1.0f / r.dir.y, 1.0f / r.dir.z} {}
 };
 
-// Slab test: entry distance if the ray meets the box within [t_min, t_max].
-// Inline: it is the innermost operation of traversal. The operand order of
-// min/max drops a NaN (0 * inf on a slab face) in favour of the running bound.
-inline std::optional<float> intersect_box(const Ray& r, const RayInverse& inv, const Box3f& b,
-                                          float t_min, float t_max) {
+// Slab test: does the ray meet the box within [t_min, t_max]? If so t_entry
+// is where. Inline: it is the innermost operation of traversal. The operand
+// order of min/max drops a NaN (0 * inf on a slab face) for the running bound.
+inline bool slab_test(const Ray& r, const RayInverse& inv, const Box3f& b, float t_min,
+                      float t_max, float& t_entry) {
   auto lo = [](float a, float b) { return b < a ? b : a; };
   auto hi = [](float a, float b) { return a < b ? b : a; };
   const float x0 = (b.lo.x - r.origin.x) * inv.inv_dir.x, x1 = (b.hi.x - r.origin.x) * inv.inv_dir.x;
   const float y0 = (b.lo.y - r.origin.y) * inv.inv_dir.y, y1 = (b.hi.y - r.origin.y) * inv.inv_dir.y;
   const float z0 = (b.lo.z - r.origin.z) * inv.inv_dir.z, z1 = (b.hi.z - r.origin.z) * inv.inv_dir.z;
-  t_min = hi(hi(hi(t_min, lo(x0, x1)), lo(y0, y1)), lo(z0, z1));
+  t_entry = hi(hi(hi(t_min, lo(x0, x1)), lo(y0, y1)), lo(z0, z1));
   t_max = lo(lo(lo(t_max, hi(x0, x1)), hi(y0, y1)), hi(z0, z1));
-  if (t_min > t_max) return std::nullopt;
-  return t_min;
+  return t_entry <= t_max;
+}
+
+inline std::optional<float> intersect_box(const Ray& r, const RayInverse& inv, const Box3f& b,
+                                          float t_min, float t_max) {
+  float t;
+  return slab_test(r, inv, b, t_min, t_max, t) ? std::optional<float>(t) : std::nullopt;
 }
 
 struct TriangleHit {

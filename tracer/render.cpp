@@ -90,37 +90,58 @@ bool Tracer::test_prim(std::uint32_t index, const Ray& ray, float t_min, float& 
   return true;
 }
 
+// Marks "no child chosen" in traversal (a real leaf has at most a few primitives).
+constexpr std::uint32_t kNoChild = 0xffffffffu;
+
 template <bool Any>
 bool Tracer::traverse_bvh(const Ray& ray, float t_min, float& t_max, Hit* hit, RayStats& stats) {
   const RayInverse inv(ray);
   bool found = false;
   std::size_t sp = 0;
+  std::uint64_t box_tests = 0;
   BvhNode node = header_.bvh_root;
   for (;;) {
-    // Push the children the ray meets, the nearer one last so it is popped first.
-    stats.box_tests += 2;
-    const auto t0 = intersect_box(ray, inv, node.box[0], t_min, t_max);
-    const auto t1 = intersect_box(ray, inv, node.box[1], t_min, t_max);
-    const bool near_first = !t1 || (t0 && *t0 <= *t1);
-    const int far = near_first ? 1 : 0, near = 1 - far;
-    const std::optional<float> tc[2] = {t0, t1};
-    if (tc[far]) stack_[sp++] = {node.child[far], node.count[far], *tc[far]};
-    if (tc[near]) stack_[sp++] = {node.child[near], node.count[near], *tc[near]};
-    // Pop leaves until the next inner node.
+    // Go on with the nearer child the ray meets; stack the farther one.
+    box_tests += 2;
+    float t0, t1;
+    const bool hit0 = slab_test(ray, inv, node.box[0], t_min, t_max, t0);
+    const bool hit1 = slab_test(ray, inv, node.box[1], t_min, t_max, t1);
+    std::uint32_t child, count;
+    if (hit0 && hit1) {
+      const int near = t1 < t0 ? 1 : 0;
+      stack_[sp++] = {node.child[1 - near], node.count[1 - near], near ? t0 : t1};
+      child = node.child[near], count = node.count[near];
+    } else if (hit0 || hit1) {
+      child = node.child[hit1], count = node.count[hit1];
+    } else {
+      child = 0, count = kNoChild;  // neither: pop
+    }
+    // Run leaves and pop until the next inner node.
     for (;;) {
-      if (sp == 0) return found;
-      const StackEntry e = stack_[--sp];
-      if (e.t > t_max) continue;  // beyond the closest hit so far
-      if (e.count == 0) {
-        node = read<BvhNode>(Section::bvh_nodes, e.child, stats);
+      if (count == 0) {
+        node = read<BvhNode>(Section::bvh_nodes, child, stats);
         break;
       }
-      for (std::uint32_t k = 0; k < e.count; ++k) {
-        if (test_prim<Any>(e.child + k, ray, t_min, t_max, hit, stats)) {
-          if (Any) return true;
-          found = true;
+      if (count != kNoChild) {
+        for (std::uint32_t k = 0; k < count; ++k) {
+          if (test_prim<Any>(child + k, ray, t_min, t_max, hit, stats)) {
+            if (Any) {
+              stats.box_tests += box_tests;
+              return true;
+            }
+            found = true;
+          }
         }
       }
+      StackEntry e;
+      do {
+        if (sp == 0) {
+          stats.box_tests += box_tests;
+          return found;
+        }
+        e = stack_[--sp];
+      } while (e.t > t_max);  // beyond the closest hit so far
+      child = e.child, count = e.count;
     }
   }
 }
