@@ -26,6 +26,8 @@ const std::vector<Entry>& table() {
       {"mount", generate_mount, 6, 0, "SPD mount, size n: fractal mountain of 2*4^n triangles, 4 glass spheres (default 6, max 7)"},
       {"rings", generate_rings, 7, 0, "SPD rings, size n: pyramid of dodecahedral rings, 5n(n+1)(2n+1) spheres and cylinders (default 7)"},
       {"balls", generate_balls, 4, 0, "SPD balls (sphereflake), size n: sum of 9^k spheres for k=0..n (default 4)"},
+      {"gears", generate_gears, 4, 0, "SPD gears, size n: n^3 gears of two concave 144-gons and 144 rectangles each (default 4)"},
+      {"tree", generate_tree, 11, 0, "SPD tree, size n: 2^(n+1)-1 cones and spheres branching on a field (default 11)"},
       {"mountain", generate_mount, -6, 6, "the paper's Mountain: mount:6:t6, 9920 polygons"},
       {"rings4", generate_rings, -4, 1, "the paper's Rings4: rings:4:t1, 18001 polygons (18002 with the backdrop as 2 triangles)"},
       {"tetra9", generate_tetra, -9, 0, "the paper's Tetra9: tetra:9, 262144 triangles"},

@@ -4,7 +4,7 @@
 // (counts and bounding box) as the SPD program's NFF output.
 //
 // Spec grammar:  NAME[:SIZE][:tRES]
-//   NAME  teapot tetra mount rings balls             (SPD generators)
+//   NAME  teapot tetra mount rings balls gears tree   (SPD generators)
 //         mountain rings4 tetra9 tetra10             (the paper's scenes; no size)
 //   SIZE  the SPD size factor (default: the SPD program's default, teapot 8)
 //   tRES  tessellate spheres and cones into triangles at resolution RES, as
@@ -40,5 +40,7 @@ Scene generate_tetra(int size);
 Scene generate_mount(int size);
 Scene generate_rings(int size);
 Scene generate_balls(int size);
+Scene generate_gears(int size);
+Scene generate_tree(int size);
 
 }  // namespace tracer
