@@ -1,0 +1,175 @@
+// Network construction (channels, processes, placement), shutdown, and the
+// aggregation and formatting of the per-process counters.
+#include "nodes/network.hpp"
+
+#include <algorithm>
+#include <iomanip>
+#include <sstream>
+#include <stdexcept>
+#include <utility>
+
+namespace nodes {
+namespace {
+
+std::string link_name(NodeId from, NodeId to, unsigned cls) {
+  return "link " + std::to_string(from) + "->" + std::to_string(to) + " class " +
+         std::to_string(cls);
+}
+
+}  // namespace
+
+unsigned Network::block_placement(NodeId node, std::size_t nodes, unsigned threads) {
+  return static_cast<unsigned>(std::uint64_t{node} * threads / std::max<std::size_t>(nodes, 1));
+}
+
+Network::Network(csp::Runtime& runtime, topology::Topology topology, NetworkOptions options)
+    : topology_(std::move(topology)),
+      options_(std::move(options)),
+      classes_(topology_.buffer_classes()),
+      threads_(runtime.threads()) {
+  if (options_.buffer_capacity == 0) throw std::invalid_argument("network: buffer capacity must be at least 1");
+  if (options_.ports_per_node == 0) throw std::invalid_argument("network: each node needs at least one local port");
+  const std::size_t n = topology_.size();
+  link_in_.resize(n);
+  injections_.resize(n);
+  ports_.resize(n);
+  link_counters_.resize(n);
+  for (NodeId node = 0; node < n; ++node) {
+    for (NodeId from : topology_.neighbours(node))
+      for (unsigned c = 0; c < classes_; ++c) link_in_[node].emplace_back(link_name(from, node, c));
+    for (unsigned j = 0; j < options_.ports_per_node; ++j) {
+      const std::string where = std::to_string(node) + "." + std::to_string(j);
+      injections_[node].emplace_back("inject " + where);
+      ports_[node].emplace_back("port " + where);
+    }
+    router_counters_.push_back(std::make_unique<RouterCounters>());
+  }
+  for (NodeId node = 0; node < n; ++node) wire_node(runtime, node);
+}
+
+unsigned Network::thread_of(NodeId node) const {
+  return options_.placement ? options_.placement(node)
+                            : block_placement(node, topology_.size(), threads_);
+}
+
+// Link inputs of `node` are numbered by the port on `node` the link comes in
+// by: the link process of (m, port_to(m, node), c) writes input
+// port_to(node, m) * classes + c of node.
+void Network::wire_node(csp::Runtime& runtime, NodeId node) {
+  RouterEnds ends;
+  for (const auto& ch : link_in_[node]) ends.inputs.push_back(ch.reader());
+  for (const auto& ch : injections_[node]) ends.injections.push_back(ch.reader());
+  const auto neighbours = topology_.neighbours(node);
+  for (topology::Port p = 0; p < neighbours.size(); ++p) {
+    const NodeId m = neighbours[p];
+    const std::size_t back = topology_.port_to(m, node);
+    for (unsigned c = 0; c < classes_; ++c)
+      spawn_link(runtime, node, ends, link_in_[m][back * classes_ + c].writer(),
+                 link_name(node, m, c));
+  }
+  for (unsigned j = 0; j < options_.ports_per_node; ++j)
+    spawn_link(runtime, node, ends, ports_[node][j].writer(),
+               "deliver " + std::to_string(node) + "." + std::to_string(j));
+  RouterConfig config{options_.buffer_capacity, options_.trace_routes};
+  auto router = std::make_shared<Router>(topology_, node, std::move(ends), config,
+                                         *router_counters_[node]);
+  runtime.spawn("router " + std::to_string(node), thread_of(node), [router] { router->run(); });
+}
+
+void Network::spawn_link(csp::Runtime& runtime, NodeId node, RouterEnds& ends,
+                         csp::Out<Packet> next, const std::string& name) {
+  csp::Channel<Ready> request(name + " request");
+  csp::Channel<Packet> reply(name + " reply");
+  ends.requests.push_back(request.reader());
+  ends.replies.push_back(reply.writer());
+  link_counters_[node].push_back(std::make_unique<LinkCounters>());
+  auto link = std::make_shared<Link>(request.writer(), reply.reader(), std::move(next),
+                                     options_.link, *link_counters_[node].back());
+  requests_.push_back(std::move(request));
+  replies_.push_back(std::move(reply));
+  runtime.spawn(name, thread_of(node), [link] { link->run(); });
+}
+
+csp::Out<Packet> Network::injector(NodeId node, unsigned port) const {
+  return injections_.at(node).at(port).writer();
+}
+
+csp::In<Packet> Network::port(NodeId node, unsigned port) const {
+  return ports_.at(node).at(port).reader();
+}
+
+void Network::shutdown() {
+  for (auto& node : injections_)
+    for (auto& ch : node) ch.poison();
+  for (auto& ch : requests_) ch.poison();
+  for (auto& ch : replies_) ch.poison();
+  for (auto& node : link_in_)
+    for (auto& ch : node) ch.poison();
+  for (auto& node : ports_)
+    for (auto& ch : node) ch.poison();
+}
+
+NetworkStats Network::stats() const {
+  NetworkStats s;
+  for (NodeId node = 0; node < topology_.size(); ++node) {
+    const RouterCounters& r = *router_counters_[node];
+    s.routers.push_back(r);
+    s.hops.merge(r.hops);
+    for (const auto& [kind, h] : r.hops_by_kind) s.hops_by_kind[kind].merge(h);
+    s.routes.insert(s.routes.end(), r.routes.begin(), r.routes.end());
+    // Link queues come first, classes_ per port, in port order.
+    const auto neighbours = topology_.neighbours(node);
+    for (topology::Port p = 0; p < neighbours.size(); ++p) {
+      LinkStats link{node, neighbours[p], 0, 0};
+      for (unsigned c = 0; c < classes_; ++c) {
+        const LinkCounters& lc = *link_counters_[node][p * classes_ + c];
+        link.packets += lc.packets;
+        link.bytes += lc.bytes;
+      }
+      s.links.push_back(link);
+    }
+  }
+  std::sort(s.routes.begin(), s.routes.end(),
+            [](const RouteRecord& a, const RouteRecord& b) { return a.id < b.id; });
+  return s;
+}
+
+std::string format_route(const RouteRecord& record, const KindNamer& kind_name) {
+  std::string s = kind_name(record.kind) + " " + std::to_string(record.id) + ":";
+  for (std::size_t i = 0; i < record.route.size(); ++i)
+    s += (i ? " \u2192 " : " ") + std::to_string(record.route[i]);
+  const std::size_t hops = record.route.empty() ? 0 : record.route.size() - 1;
+  s += " (" + std::to_string(hops) + (hops == 1 ? " hop)" : " hops)");
+  return s;
+}
+
+std::string format_summary(const NetworkStats& stats, const topology::Topology& topology,
+                           const KindNamer& kind_name) {
+  std::ostringstream out;
+  out << std::fixed << std::setprecision(3);
+  out << "network " << topology.spec() << ": " << stats.hops.packets << " packets delivered, "
+      << "mean hops " << stats.hops.mean() << " (max " << stats.hops.max_hops
+      << "), analytic average distance " << topology.average_distance() << "\n";
+  out << "  " << std::left << std::setw(16) << "kind" << std::right << std::setw(12) << "packets"
+      << std::setw(12) << "mean hops" << std::setw(10) << "max" << "\n";
+  for (const auto& [kind, h] : stats.hops_by_kind)
+    out << "  " << std::left << std::setw(16) << kind_name(kind) << std::right << std::setw(12)
+        << h.packets << std::setw(12) << h.mean() << std::setw(10) << h.max_hops << "\n";
+  const auto busiest = std::max_element(
+      stats.links.begin(), stats.links.end(),
+      [](const LinkStats& a, const LinkStats& b) { return a.packets < b.packets; });
+  if (busiest != stats.links.end())
+    out << "  busiest link " << busiest->from << " -> " << busiest->to << ": " << busiest->packets
+        << " packets, " << busiest->bytes << " bytes\n";
+  std::uint32_t peak = 0;
+  std::uint64_t forwarded = 0;
+  for (const auto& r : stats.routers) {
+    peak = std::max(peak, r.peak_queued);
+    forwarded += r.forwarded;
+  }
+  out << "  packets forwarded by routers " << forwarded << ", peak packets held by one router "
+      << peak << "\n";
+  return out.str();
+}
+
+}  // namespace nodes

@@ -1,0 +1,109 @@
+// nodes::Network: the store-and-forward interconnect of the simulated machine,
+// built on a csp::Runtime along a topology::Topology.
+//
+// Per node n (all placed on thread placement(n), block placement by default,
+// so most links join processes of the same thread):
+//   - one Router process (router.hpp),
+//   - one Link process per outgoing link and buffer class, carrying packets
+//     to the neighbour's router over a rendezvous channel,
+//   - one delivery Link process per local port, writing to that port's
+//     channel, which the application reads through port(n, p).
+// Every buffer is bounded (buffer_capacity packets per queue); deadlock
+// freedom rests on the acyclic channel dependencies of topology::next_hop
+// and on the consumption assumption documented in router.hpp.
+//
+// Use: create the Network before Runtime::run(); local processes write to
+// injector(n, p) (one injection channel per local port: give each channel one
+// writing process) and read port(n, p). Once the application knows nothing
+// is in flight, one of its processes calls shutdown(), which poisons every
+// network channel: routers, link processes and any reader of a port end with
+// csp::Poisoned, so run() returns with no fiber left blocked. Packets still
+// in the network at shutdown are dropped. stats() is valid after run().
+#pragma once
+
+#include <functional>
+#include <map>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "csp/csp.hpp"
+#include "nodes/link.hpp"
+#include "nodes/packet.hpp"
+#include "nodes/router.hpp"
+#include "topology/topology.hpp"
+
+namespace nodes {
+
+struct NetworkOptions {
+  std::size_t buffer_capacity = 4;  // packets per output queue, at least 1
+  unsigned ports_per_node = 1;      // local ports (and injection channels) per node
+  std::uint64_t trace_routes = 0;   // record routes of packets whose id is below this
+  LinkModel link;                   // optional per-hop latency and bandwidth
+  std::function<unsigned(NodeId)> placement;  // thread of node n; default block
+};
+
+struct LinkStats {
+  NodeId from = 0;
+  NodeId to = 0;
+  std::uint64_t packets = 0;
+  std::uint64_t bytes = 0;
+};
+
+struct NetworkStats {
+  std::vector<RouterCounters> routers;  // index = node
+  std::vector<LinkStats> links;         // one per directed link, classes summed
+  HopSummary hops;                      // of all delivered packets
+  std::map<std::uint8_t, HopSummary> hops_by_kind;
+  std::vector<RouteRecord> routes;  // traced packets, by id
+};
+
+using KindNamer = std::function<std::string(std::uint8_t kind)>;
+
+class Network {
+ public:
+  Network(csp::Runtime& runtime, topology::Topology topology, NetworkOptions options = {});
+  Network(const Network&) = delete;
+  Network& operator=(const Network&) = delete;
+
+  const topology::Topology& topology() const { return topology_; }
+  const NetworkOptions& options() const { return options_; }
+
+  csp::Out<Packet> injector(NodeId node, unsigned port = 0) const;
+  csp::In<Packet> port(NodeId node, unsigned port = 0) const;
+  unsigned thread_of(NodeId node) const;
+
+  void shutdown();
+  NetworkStats stats() const;  // after Runtime::run() has returned
+
+  // Contiguous ranges of nodes per thread: node * threads / nodes.
+  static unsigned block_placement(NodeId node, std::size_t nodes, unsigned threads);
+
+ private:
+  void wire_node(csp::Runtime& runtime, NodeId node);
+  void spawn_link(csp::Runtime& runtime, NodeId node, RouterEnds& ends, csp::Out<Packet> next,
+                  const std::string& name);
+
+  topology::Topology topology_;
+  NetworkOptions options_;
+  unsigned classes_;
+  unsigned threads_;
+  // Per node, per (port, class): the channel into that node's router.
+  std::vector<std::vector<csp::Channel<Packet>>> link_in_;
+  std::vector<std::vector<csp::Channel<Packet>>> injections_;
+  std::vector<std::vector<csp::Channel<Packet>>> ports_;
+  std::vector<csp::Channel<Ready>> requests_;
+  std::vector<csp::Channel<Packet>> replies_;
+  // Counters live here so they outlive the processes; each is written by
+  // exactly one process and read only after run().
+  std::vector<std::unique_ptr<RouterCounters>> router_counters_;
+  std::vector<std::vector<std::unique_ptr<LinkCounters>>> link_counters_;  // [node][queue]
+};
+
+// "page 17: 5 → 4 → 6 → 7 (3 hops)"
+std::string format_route(const RouteRecord& record, const KindNamer& kind_name);
+// Table: packets, mean/max hops overall and per kind, busiest link, peak buffers.
+std::string format_summary(const NetworkStats& stats, const topology::Topology& topology,
+                           const KindNamer& kind_name);
+
+}  // namespace nodes

@@ -1,0 +1,38 @@
+// nodes::Packet: the one message type of the machine network, moved by value
+// through csp channels from router to router (processors share nothing).
+//
+// Invariants: hops counts links crossed so far (0 at injection); route is
+// non-empty only for traced packets and then lists every node visited, the
+// source first; a delivered traced packet has route.size() == hops + 1.
+// kind is the application's own tag (the network only counts by it); port
+// names the local process on the destination that receives the packet.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <vector>
+
+#include "topology/topology.hpp"
+
+namespace nodes {
+
+using topology::NodeId;
+
+struct Packet {
+  NodeId source = 0;       // set by the network at injection
+  NodeId destination = 0;
+  std::uint8_t kind = 0;   // application-defined tag
+  std::uint16_t port = 0;  // local port on the destination
+  std::uint16_t hops = 0;  // links crossed, counted by the routers
+  bool traced = false;     // record the route (or the network decides: trace_routes)
+  std::uint64_t id = 0;    // application-defined sequence number
+  std::vector<std::byte> payload;
+  std::vector<NodeId> route;  // visited nodes, for traced packets only
+};
+
+// Kinds used by the network's own tests and the traffic example; the
+// machine's messages (messages.hpp) use small values, these stay clear.
+inline constexpr std::uint8_t kind_traffic = 0xf0;
+inline constexpr std::uint8_t kind_probe = 0xf1;
+
+}  // namespace nodes

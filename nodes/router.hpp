@@ -1,0 +1,121 @@
+// The router of one processor: store-and-forward switching by the topology's
+// deadlock-free routing function.
+//
+// Ends (all read by the router alone):
+//   inputs[q]    packets arriving over link port p in buffer class c,
+//                q = p * classes + c (written by the neighbour's link process)
+//   injections[j] packets sent by local process j of this node
+//   requests[o]  Ready from the link process of output queue o; outputs are
+//                the link queues (same numbering as inputs) then one
+//                delivery queue per local port
+//   replies[o]   the packet answering requests[o]
+//
+// Protocol: one ALT (fair select) over all of these. A request is enabled
+// only when its queue holds a packet, so the reply write meets a link process
+// that is already waiting: the router never blocks on output while a
+// neighbour blocks on it. A packet read from input i goes to its output queue
+// if that has room (capacity K); otherwise it waits in pending[i] and input i
+// is disabled until the queue drains. So each (link, class) owns at most
+// K queued + 1 carried + 1 pending packets, a packet in one channel's buffers
+// waits only for the next channel on its route, and the acyclic channel
+// dependency graph of topology::next_hop makes the whole network free of
+// deadlock with bounded buffers.
+//
+// Consumption assumption: a delivery queue is a sink; it drains as long as the
+// local process reading that port keeps reading, even while its own writes
+// to an injection channel are blocked. A local process that both receives and
+// sends must therefore read its port in a fiber of its own (or never block on
+// injection while packets for it may be waiting); otherwise it can close a
+// cycle through the network with its own injection.
+#pragma once
+
+#include <cstdint>
+#include <deque>
+#include <map>
+#include <optional>
+#include <vector>
+
+#include "csp/csp.hpp"
+#include "nodes/link.hpp"
+#include "nodes/packet.hpp"
+#include "topology/topology.hpp"
+
+namespace nodes {
+
+struct HopSummary {
+  std::uint64_t packets = 0;
+  std::uint64_t total_hops = 0;
+  std::uint32_t max_hops = 0;
+
+  void add(std::uint32_t hops);
+  void merge(const HopSummary& other);
+  double mean() const { return packets ? static_cast<double>(total_hops) / packets : 0.0; }
+};
+
+struct RouteRecord {
+  std::uint64_t id = 0;
+  std::uint8_t kind = 0;
+  std::vector<NodeId> route;
+};
+
+// Owned by one router process; read only after the runtime has stopped.
+struct RouterCounters {
+  std::uint64_t injected = 0;
+  std::uint64_t forwarded = 0;  // packets sent on into a link queue
+  std::uint64_t delivered = 0;
+  std::uint32_t peak_queued = 0;  // most packets held at once (queues + pending)
+  std::uint32_t peak_queue = 0;   // longest single output queue
+  HopSummary hops;                // of packets delivered here
+  std::map<std::uint8_t, HopSummary> hops_by_kind;
+  std::vector<RouteRecord> routes;  // traced packets delivered here
+};
+
+struct RouterEnds {
+  std::vector<csp::In<Packet>> inputs;
+  std::vector<csp::In<Packet>> injections;
+  std::vector<csp::In<Ready>> requests;
+  std::vector<csp::Out<Packet>> replies;
+};
+
+struct RouterConfig {
+  std::size_t buffer_capacity = 1;
+  std::uint64_t trace_routes = 0;  // trace packets whose id is below this
+};
+
+class Router {
+ public:
+  Router(topology::Topology topology, NodeId self, RouterEnds ends, RouterConfig config,
+         RouterCounters& counters);
+  void run();
+
+ private:
+  struct Pending {
+    Packet packet;
+    std::size_t queue;
+  };
+
+  void build_alt();
+  void update_guards();
+  void receive(std::size_t source, Packet packet);
+  void accept_injection(Packet& packet) const;
+  void send(std::size_t queue);
+  void admit_pending(std::size_t queue);
+  std::size_t output_queue(const Packet& packet) const;
+  void note_delivery(const Packet& packet);
+  void note_occupancy();
+
+  topology::Topology topology_;
+  NodeId self_;
+  RouterEnds ends_;
+  RouterConfig config_;
+  RouterCounters& counters_;
+  std::size_t link_queues_;  // degree * classes; delivery queues follow
+  std::vector<std::deque<Packet>> queues_;
+  std::vector<std::optional<Pending>> pending_;  // per input, then per injection
+  std::size_t pending_count_ = 0;
+  std::size_t next_admit_ = 0;  // rotates which pending packet is admitted first
+  csp::Alt alt_;
+  std::vector<std::size_t> request_guard_, source_guard_;
+};
+
+}  // namespace nodes
