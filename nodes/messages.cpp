@@ -46,6 +46,15 @@ tracer::Color ResultView::color(std::uint32_t i) const {
   return c;
 }
 
+Packet make_packet(NodeId destination, std::uint16_t port, MessageKind kind, std::vector<std::byte> payload) {
+  Packet p;
+  p.destination = destination;
+  p.port = port;
+  p.kind = static_cast<std::uint8_t>(kind);
+  p.payload = std::move(payload);
+  return p;
+}
+
 std::vector<std::byte> encode_port(std::uint16_t port) {
   std::vector<std::byte> out;
   put(out, port);

@@ -23,8 +23,11 @@
 #include <cstdint>
 #include <span>
 #include <string_view>
+#include <utility>
 #include <vector>
 
+#include "csp/csp.hpp"
+#include "nodes/packet.hpp"
 #include "tracer/vec.hpp"
 
 namespace nodes {
@@ -88,6 +91,29 @@ ResultView decode_result(std::span<const std::byte> payload);
 
 std::vector<std::byte> encode_page_request(PageRequest request);
 PageRequest decode_page_request(std::span<const std::byte> payload);
+
+// A packet to (destination, port); the network stamps the source.
+Packet make_packet(NodeId destination, std::uint16_t port, MessageKind kind, std::vector<std::byte> payload = {});
+
+// A process's injection end that numbers its packets: ids interleave over
+// all sending processes (first id = the process's index, step = their
+// count), so ids below K cover the first packets of every process, which is
+// what route tracing (NetworkOptions::trace_routes) selects.
+class Outbox {
+ public:
+  Outbox(csp::Out<Packet> out, std::uint64_t index, std::uint64_t processes)
+      : out_(std::move(out)), next_id_(index), step_(processes) {}
+  void send(Packet packet) {
+    packet.id = next_id_;
+    next_id_ += step_;
+    out_.write(std::move(packet));
+  }
+
+ private:
+  csp::Out<Packet> out_;
+  std::uint64_t next_id_;
+  std::uint64_t step_;
+};
 
 // The page id leads the bytes so a reply names what it carries.
 std::vector<std::byte> encode_page_reply(std::uint32_t page, std::span<const std::byte> bytes);

@@ -1,0 +1,23 @@
+// Frame collector process (see collector.hpp).
+#include "nodes/collector.hpp"
+
+#include <stdexcept>
+#include <string>
+
+namespace nodes {
+
+Collector::Collector(FrameAssembler& frame, csp::In<Packet> in, Outbox out, Progress progress)
+    : frame_(frame), in_(std::move(in)), out_(std::move(out)), progress_(std::move(progress)) {}
+
+void Collector::run() {
+  while (!frame_.complete()) {
+    const Packet packet = in_.read();
+    if (static_cast<MessageKind>(packet.kind) != MessageKind::result)
+      throw std::logic_error("collector got a " + std::string(message_kind_name(packet.kind)) + " message");
+    frame_.add(decode_result(packet.payload));
+    if (progress_) progress_(frame_.received(), frame_.items());
+  }
+  out_.send(make_packet(0, Ports::farmer, MessageKind::frame_done));
+}
+
+}  // namespace nodes

@@ -1,0 +1,119 @@
+// The VM_pRAY machine: N processors on a topology, the scene database spread
+// over them as object pages in a shared virtual memory, pixels farmed out on
+// demand, everything carried by the store-and-forward network.
+//
+// Processes of processor n, all on the OS thread of n's router:
+//   page server (+ its mailbox)      Ports::page_server
+//   pixel computers w = 0..k-1       Ports::first_worker + w
+// and on node 0 only:
+//   farmer (+ its mailbox)           Ports::farmer
+//   frame collector                  Ports::collector
+// The host's copy of the database is moved into the owners before the run:
+// page p lives only on its owner and in caches.
+//
+// Orderly end (no message lost, none left in flight, no fiber blocked):
+//  1. The farmer answers every work request with a tile until the plan is
+//     exhausted, then with stop.
+//  2. A worker sends its result before asking for more work, so when it
+//     reads stop all its results are sent and all its page requests have
+//     been answered; it sends worker_done and ends.
+//  3. After the last worker_done no page request exists anywhere, so the
+//     farmer sends server_stop to every page server; each answers
+//     server_done and ends.
+//  4. The collector sends frame_done once the last item arrived.
+//  5. With N*k worker_done, N server_done and frame_done received, every
+//     packet sent has been read: the farmer calls Network::shutdown(), which
+//     ends routers, links and the mailboxes, and Runtime::run() returns.
+// Buffer bounds: at most one packet per worker, one per page server and
+// the collector's one are outstanding for the farmer (N*k + N + 1), and at
+// most N*k page requests for a page server (one per worker, plus its
+// server_stop), which sizes their mailboxes.
+#pragma once
+
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "nodes/collector.hpp"
+#include "nodes/farmer.hpp"
+#include "nodes/network.hpp"
+#include "nodes/node_memory.hpp"
+#include "nodes/page_server.hpp"
+#include "nodes/pixel_computer.hpp"
+#include "nodes/svm.hpp"
+#include "nodes/work_plan.hpp"
+#include "tracer/database.hpp"
+#include "tracer/image.hpp"
+#include "tracer/render.hpp"
+
+namespace nodes {
+
+struct MachineOptions {
+  std::string topology = "hypercube";  // a kind, or a full spec such as "hypercube:4"
+  std::optional<std::size_t> nodes = 16;  // with a bare kind; must agree with a full spec
+  unsigned threads = 0;                // 0: hardware cores; never more than the nodes
+  std::optional<std::uint32_t> cache_pages;  // remote pages cached per node
+  std::optional<std::uint64_t> cache_kb;     // the same in KB; default (neither): 1/8 of the database
+  std::uint32_t grain = 4;             // items per tile
+  Schedule schedule = Schedule::dynamic;
+  int workers_per_node = 1;
+  Distribution distribution = Distribution::modulo;
+  std::uint64_t trace_routes = 0;      // record the routes of the first N packets
+  std::size_t buffer_capacity = 4;     // packets per network queue
+  tracer::TraceOptions trace;
+  Progress progress;                   // called by the collector (on its thread)
+};
+
+struct NodeReport {
+  SvmStats svm;
+  ServerCounters served;
+  WorkerCounters work;          // summed over the node's workers
+  std::size_t own_bytes = 0;    // scene bytes the node owns
+  std::size_t peak_resident_bytes = 0;  // own pages + cache slots ever used
+  std::uint32_t cache_capacity = 0;     // pages
+  std::uint64_t evictions = 0;          // cached pages dropped for others
+};
+
+struct MachineReport {
+  std::string topology;  // canonical spec
+  int nodes = 0;
+  unsigned threads = 0;
+  int workers_per_node = 0;
+  std::uint32_t cache_pages = 0;  // requested per node (before capping at remote pages)
+  std::uint32_t page_size = 0;
+  std::uint32_t page_count = 0;
+  std::uint64_t items = 0;  // pixels, or SPD corner samples
+  double wall_seconds = 0;
+  std::vector<NodeReport> per_node;
+  FarmerCounters farmer;
+  std::uint64_t collected = 0;
+  NetworkStats network;
+
+  SvmStats svm() const;
+  ServerCounters served() const;
+  tracer::RayStats rays() const;
+  std::uint64_t items_computed() const;
+  // max / mean over nodes of the items and of the rays each computed.
+  double item_imbalance() const;
+  double ray_imbalance() const;
+};
+
+struct MachineResult {
+  tracer::Image image;
+  MachineReport report;
+};
+
+// Cache size in pages from the options: std::invalid_argument naming the
+// option for 0 pages, less than a page of KB, or both options given.
+std::uint32_t cache_pages_for(const MachineOptions& options, const tracer::DatabaseHeader& header);
+
+// Renders db's frame on the machine; consumes db (its pages move to their
+// owners). Throws std::invalid_argument for bad options (one line, naming
+// the option) and whatever a process throws.
+MachineResult run_machine(tracer::Database db, const MachineOptions& options);
+
+// Route trace lines and the network summary, with the machine's kind names.
+std::string format_routes(const MachineReport& report);
+
+}  // namespace nodes

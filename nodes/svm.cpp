@@ -1,0 +1,100 @@
+// Page sources of the shared virtual memory (see svm.hpp).
+#include "nodes/svm.hpp"
+
+#include <string>
+
+#include "nodes/messages.hpp"
+
+namespace nodes {
+
+SvmStats& SvmStats::operator+=(const SvmStats& o) {
+  accesses += o.accesses;
+  own_hits += o.own_hits;
+  cache_hits += o.cache_hits;
+  misses += o.misses;
+  coalesced += o.coalesced;
+  return *this;
+}
+
+double SvmStats::miss_ratio() const {
+  return accesses == 0 ? 0.0 : static_cast<double>(misses + coalesced) / static_cast<double>(accesses);
+}
+
+SvmSource::SvmSource(NodeSvm& node, int worker, PageFetch fetch)
+    : node_(node),
+      memory_(node.memory_),
+      worker_(worker),
+      fetch_(std::move(fetch)),
+      wake_("svm wake " + std::to_string(worker), 1) {}
+
+const std::byte* SvmSource::page(tracer::PageId id) {
+  ++stats_.accesses;
+  const std::int32_t entry = memory_.entry(id);
+  if (entry >= 0) {
+    ++stats_.own_hits;
+    release();
+    return memory_.own_page(entry);
+  }
+  if (NodeMemory::is_slot(entry)) {
+    ++stats_.cache_hits;
+    return from_slot(NodeMemory::slot_of_entry(entry));
+  }
+  return miss(id);
+}
+
+void SvmSource::release() {
+  if (pinned_ >= 0) memory_.unpin(pinned_);
+  pinned_ = -1;
+}
+
+const std::byte* SvmSource::from_slot(int slot) {
+  if (slot != pinned_) {
+    release();
+    memory_.pin(slot);
+    pinned_ = slot;
+  }
+  memory_.touch(slot);
+  return memory_.slot_bytes(slot);
+}
+
+const std::byte* SvmSource::miss(tracer::PageId id) {
+  release();
+  // page() found no entry, so the first pass cannot hit the cache.
+  for (;;) {
+    const std::int32_t entry = memory_.entry(id);
+    if (NodeMemory::is_slot(entry)) {
+      ++stats_.coalesced;
+      return from_slot(NodeMemory::slot_of_entry(entry));
+    }
+    if (memory_.begin_fetch(id)) {
+      ++stats_.misses;
+      return fetch_and_install(id);
+    }
+    memory_.add_waiter(id, worker_);
+    wake_.reader().read();
+  }
+}
+
+const std::byte* SvmSource::fetch_and_install(tracer::PageId id) {
+  const auto reply = fetch_(id);
+  if (page_reply_id(reply) != id)
+    throw std::logic_error("asked for page " + std::to_string(id) + ", got page " +
+                           std::to_string(page_reply_id(reply)));
+  // Pin before waking anyone, so the page stays until this worker moves on.
+  const std::byte* bytes = from_slot(memory_.install(id, page_reply_bytes(reply)));
+  for (int waiter : memory_.end_fetch(id)) node_.worker(waiter).wake_.writer().write(1);
+  return bytes;
+}
+
+SvmSource& NodeSvm::add_worker(PageFetch fetch) {
+  workers_.push_back(std::make_unique<SvmSource>(*this, worker_count(), std::move(fetch)));
+  return *workers_.back();
+}
+
+SvmStats NodeSvm::stats() const {
+  SvmStats total;
+  for (const auto& w : workers_) total += w->stats();
+  return total;
+}
+
+}  // namespace nodes

@@ -1,0 +1,234 @@
+// End-to-end invariants of the VM_pRAY machine: the image is bit-identical
+// to the single-process render for every topology, size, cache, page size,
+// grain, schedule, worker count and thread count; every pixel is computed
+// once; memory per processor stays within its share plus its cache; misses
+// fall as the cache grows and equal the pages served; bad options fail with
+// one line. Small frames keep the suite quick.
+#include "nodes/machine.hpp"
+
+#include <gtest/gtest.h>
+
+#include <cstring>
+#include <map>
+#include <string>
+#include <tuple>
+
+#include "tracer/generators.hpp"
+
+namespace {
+
+using nodes::MachineOptions;
+using nodes::Schedule;
+
+tracer::Database make_db(const std::string& spec, std::uint32_t page_size, int size) {
+  tracer::Scene scene = tracer::generate_scene(spec);
+  scene.camera.width = size;
+  scene.camera.height = size;
+  tracer::BuildOptions build;
+  build.page_size = page_size;
+  return tracer::build_database(scene, build);
+}
+
+std::vector<tracer::Color> reference(const std::string& spec, int size, bool spd) {
+  const auto db = make_db(spec, 65536, size);
+  tracer::InMemoryPageSource pages(db);
+  tracer::RayStats stats;
+  tracer::TraceOptions trace;
+  trace.spd_procedure = spd;
+  return tracer::render_frame(db.header, pages, trace, stats);
+}
+
+// Reference renders are shared between tests: they do not depend on options.
+const std::vector<tracer::Color>& cached_reference(const std::string& spec, int size, bool spd = false) {
+  static std::map<std::tuple<std::string, int, bool>, std::vector<tracer::Color>> cache;
+  auto [it, fresh] = cache.try_emplace({spec, size, spd});
+  if (fresh) it->second = reference(spec, size, spd);
+  return it->second;
+}
+
+bool same_bits(const std::vector<tracer::Color>& a, const std::vector<tracer::Color>& b) {
+  return a.size() == b.size() && std::memcmp(a.data(), b.data(), a.size() * sizeof(tracer::Color)) == 0;
+}
+
+struct Case {
+  std::string topology;
+  std::size_t nodes;
+  std::uint32_t cache_pages;  // 0: the whole database
+  std::uint32_t page_size;
+  std::uint32_t grain;
+  Schedule schedule;
+  int workers;
+  unsigned threads;
+  std::string scene = "teapot:2";
+  int size = 24;
+};
+
+nodes::MachineResult run_case(const Case& c) {
+  MachineOptions options;
+  options.topology = c.topology;
+  options.nodes = c.nodes;
+  options.threads = c.threads;
+  auto db = make_db(c.scene, c.page_size, c.size);
+  options.cache_pages = c.cache_pages ? c.cache_pages : db.header.page_count;
+  options.grain = c.grain;
+  options.schedule = c.schedule;
+  options.workers_per_node = c.workers;
+  return nodes::run_machine(std::move(db), options);
+}
+
+std::string describe(const Case& c) {
+  return c.topology + " n=" + std::to_string(c.nodes) + " cache=" + std::to_string(c.cache_pages) +
+         " page=" + std::to_string(c.page_size) + " grain=" + std::to_string(c.grain) +
+         (c.schedule == Schedule::dynamic ? " dynamic" : " static") + " k=" + std::to_string(c.workers) +
+         " threads=" + std::to_string(c.threads) + " " + c.scene;
+}
+
+TEST(Machine, ImageIsBitIdenticalToSingleProcessRenderAcrossConfigurations) {
+  const std::vector<Case> cases{
+      {"hypercube", 1, 1, 1024, 4, Schedule::dynamic, 1, 1},
+      {"hypercube", 2, 1, 256, 1, Schedule::dynamic, 1, 2},
+      {"ring", 3, 2, 1024, 4, Schedule::dynamic, 2, 2},
+      {"complete", 3, 0, 65536, 7, Schedule::static_split, 1, 1},
+      {"mesh", 3, 8, 1024, 4, Schedule::dynamic, 3, 2},
+      {"torus", 4, 1, 256, 4, Schedule::dynamic, 3, 2},
+      {"hypercube", 8, 16, 1024, 1, Schedule::static_split, 2, 2},
+      {"mesh", 16, 4, 256, 4, Schedule::dynamic, 1, 2},
+      {"torus", 16, 0, 1024, 64, Schedule::dynamic, 2, 1},
+      {"hypercube", 16, 2, 1024, 576, Schedule::dynamic, 1, 2},
+      {"ring", 16, 3, 1024, 4, Schedule::static_split, 1, 2},
+      {"complete", 8, 1, 1024, 4, Schedule::dynamic, 3, 2},
+      {"hypercube", 64, 4, 256, 2, Schedule::dynamic, 1, 2},
+      {"torus", 64, 1, 1024, 4, Schedule::static_split, 2, 2},
+      {"hypercube", 16, 2, 1024, 4, Schedule::dynamic, 2, 2, "balls:1", 24},
+  };
+  for (const auto& c : cases) {
+    const auto result = run_case(c);
+    EXPECT_TRUE(same_bits(result.image.pixels(), cached_reference(c.scene, c.size))) << describe(c);
+  }
+}
+
+TEST(Machine, ImageIsBitIdenticalOn256Nodes) {
+  const Case c{"hypercube", 256, 2, 256, 1, Schedule::dynamic, 1, 2, "teapot:2", 16};
+  EXPECT_TRUE(same_bits(run_case(c).image.pixels(), cached_reference(c.scene, c.size)));
+}
+
+TEST(Machine, SpdProcedureMatchesSingleProcessSpdRender) {
+  MachineOptions options;
+  options.topology = "mesh";
+  options.nodes = 4;
+  options.threads = 2;
+  options.cache_pages = 3;
+  options.workers_per_node = 2;
+  options.trace.spd_procedure = true;
+  const auto result = nodes::run_machine(make_db("teapot:2", 1024, 20), options);
+  EXPECT_TRUE(same_bits(result.image.pixels(), cached_reference("teapot:2", 20, true)));
+  EXPECT_EQ(result.report.items, 21u * 21u);
+}
+
+TEST(Machine, EveryPixelIsComputedExactlyOnce) {
+  const Case c{"torus", 16, 4, 1024, 3, Schedule::dynamic, 2, 2};
+  const auto result = run_case(c);
+  const auto& r = result.report;
+  const std::uint64_t pixels = 24 * 24;
+  EXPECT_EQ(r.items, pixels);
+  EXPECT_EQ(r.farmer.items, pixels);
+  EXPECT_EQ(r.collected, pixels);
+  EXPECT_EQ(r.items_computed(), pixels);
+  EXPECT_EQ(r.farmer.stops, 16u * 2u);
+  EXPECT_EQ(r.rays().samples, pixels);
+}
+
+TEST(Machine, ResidentSceneBytesStayWithinOwnShareAndCache) {
+  for (const auto& c : {Case{"hypercube", 16, 3, 256, 4, Schedule::dynamic, 3, 2},
+                        Case{"ring", 8, 1, 1024, 1, Schedule::dynamic, 1, 2}}) {
+    const auto result = run_case(c);
+    for (const auto& node : result.report.per_node) {
+      EXPECT_LE(node.peak_resident_bytes, node.own_bytes + std::size_t{c.cache_pages} * c.page_size)
+          << describe(c);
+      EXPECT_LE(node.cache_capacity, c.cache_pages);
+    }
+  }
+}
+
+TEST(Machine, LargeSceneOn64NodesKeepsASmallFractionPerProcessor) {
+  MachineOptions options;
+  options.topology = "hypercube";
+  options.nodes = 64;
+  options.threads = 2;
+  options.cache_pages = 64;
+  auto db = make_db("tetra:5", 1024, 16);
+  const std::uint64_t database_bytes = db.header.bytes();
+  ASSERT_GT(db.header.page_count, 64u * 8u);
+  const auto result = nodes::run_machine(std::move(db), options);
+  for (const auto& node : result.report.per_node) {
+    EXPECT_LE(node.peak_resident_bytes, node.own_bytes + 64u * 1024u);
+    EXPECT_LT(static_cast<double>(node.peak_resident_bytes), 0.1 * static_cast<double>(database_bytes));
+  }
+  EXPECT_TRUE(same_bits(result.image.pixels(), cached_reference("tetra:5", 16)));
+}
+
+TEST(Machine, MissRatioFallsAsTheCacheGrowsAndVanishesWhenItHoldsEverything) {
+  // A static split gives every node the same access sequence in every run,
+  // so LRU's inclusion property makes misses non-increasing in cache size.
+  double previous = 1.0;
+  for (std::uint32_t cache : {1u, 2u, 4u, 16u, 64u, 0u}) {
+    const auto result = run_case({"hypercube", 4, cache, 256, 4, Schedule::static_split, 1, 2});
+    const auto svm = result.report.svm();
+    EXPECT_LE(svm.miss_ratio(), previous) << "cache " << cache;
+    previous = svm.miss_ratio();
+    EXPECT_EQ(result.report.served().pages_served, svm.misses);
+    EXPECT_EQ(svm.accesses, svm.own_hits + svm.cache_hits + svm.misses + svm.coalesced);
+    EXPECT_EQ(svm.accesses, result.report.rays().page_calls);
+    if (cache == 0) {
+      // Only cold misses remain: no page is ever evicted, so each node
+      // fetches each remote page it touches exactly once.
+      for (const auto& node : result.report.per_node) {
+        EXPECT_EQ(node.evictions, 0u);
+        EXPECT_LE(node.svm.misses, result.report.page_count - node.own_bytes / 256);
+      }
+    }
+  }
+}
+
+TEST(Machine, PageCommunicationsEqualMissesWithSharedCaches) {
+  const auto result = run_case({"mesh", 9, 2, 256, 2, Schedule::dynamic, 3, 2});
+  EXPECT_EQ(result.report.served().pages_served, result.report.svm().misses);
+  EXPECT_EQ(result.report.served().bytes_served, result.report.svm().misses * 256u);
+}
+
+void expect_error(const Case& c, MachineOptions options, const std::string& fragment) {
+  options.topology = c.topology;
+  options.nodes = c.nodes;
+  try {
+    nodes::run_machine(make_db(c.scene, c.page_size, 8), options);
+    ADD_FAILURE() << "no error for " << fragment;
+  } catch (const std::invalid_argument& e) {
+    const std::string what = e.what();
+    EXPECT_NE(what.find(fragment), std::string::npos) << what;
+    EXPECT_EQ(what.find('\n'), std::string::npos) << what;
+  }
+}
+
+TEST(Machine, BadOptionsFailWithOneLineNamingTheOption) {
+  const Case c{"hypercube", 4, 1, 1024, 4, Schedule::dynamic, 1, 1};
+  MachineOptions zero_cache;
+  zero_cache.cache_pages = 0;
+  expect_error(c, zero_cache, "--cache-pages");
+  MachineOptions tiny_kb;
+  tiny_kb.cache_kb = 0;
+  expect_error(c, tiny_kb, "--cache-kb");
+  MachineOptions workers;
+  workers.workers_per_node = 0;
+  expect_error(c, workers, "--workers-per-node");
+  MachineOptions grain;
+  grain.grain = 0;
+  expect_error(c, grain, "--grain");
+  expect_error({"hypercube", 48, 1, 1024, 4, Schedule::dynamic, 1, 1}, MachineOptions{}, "48");
+  expect_error({"mesh:8x8", 32, 1, 1024, 4, Schedule::dynamic, 1, 1}, MachineOptions{}, "32");
+}
+
+TEST(Machine, PageSizeErrorsComeFromTheDatabaseBuild) {
+  EXPECT_THROW(make_db("teapot:2", 1000, 8), tracer::DatabaseError);
+}
+
+}  // namespace
