@@ -10,11 +10,11 @@ namespace {
 constexpr int kBins = 16;
 constexpr float kTraversalCost = 1.0f;  // relative to one primitive test
 
-// A built subtree as its parent sees it: a box and a leaf or node reference.
-struct ChildRef {
+// A node of the binary tree before it is collapsed to four-wide nodes.
+struct BinNode {
   Box3f box;
-  std::uint32_t child = 0;
-  std::uint32_t count = 0;
+  std::uint32_t left = 0, right = 0;  // inner node: children in bin_
+  std::uint32_t first = 0, count = 0;  // leaf (count > 0): primitives in order
 };
 
 struct Split {
@@ -32,52 +32,76 @@ class Builder {
   }
 
   BvhBuild run() {
-    if (bounds_.empty()) {
-      out_.nodes.push_back(BvhNode{});  // never traversed: the tracer checks for no primitives
-      return std::move(out_);
-    }
-    const ChildRef top = build(0, static_cast<std::uint32_t>(bounds_.size()), 1);
-    if (top.count > 0) {
-      // A single leaf: the root's two children split it (or repeat a lone
-      // primitive), since traversal has no notion of an absent child.
-      const std::uint32_t half = std::max(1u, top.count / 2);
-      BvhNode root{};
-      root.box[0] = root.box[1] = top.box;
-      root.child[0] = top.child;
-      root.count[0] = half;
-      root.child[1] = top.count > 1 ? top.child + half : top.child;
-      root.count[1] = top.count > 1 ? top.count - half : top.count;
-      out_.nodes.push_back(root);
+    out_.nodes.emplace_back();
+    for (int lane = 0; lane < 4; ++lane) set_lane_box(out_.nodes[0], lane, Box3f{});
+    if (bounds_.empty()) return std::move(out_);
+    bin_.emplace_back();
+    build(0, 0, static_cast<std::uint32_t>(bounds_.size()));
+    if (bin_[0].count > 0) {  // one leaf: a root with a single used lane
+      set_lane_box(out_.nodes[0], 0, bin_[0].box);
+      out_.nodes[0].child[0] = bin_[0].first;
+      out_.nodes[0].count[0] = bin_[0].count;
+    } else {
+      out_.nodes.clear();
+      collapse(0, 1);
     }
     return std::move(out_);
   }
 
  private:
-  ChildRef build(std::uint32_t begin, std::uint32_t end, std::uint32_t depth) {
+  // Builds the binary subtree of primitives [begin, end) into bin_[index].
+  void build(std::uint32_t index, std::uint32_t begin, std::uint32_t end) {
     Box3f box, centroids;
     for (std::uint32_t k = begin; k < end; ++k) {
       box.extend(bounds_[out_.order[k]]);
       centroids.extend(bounds_[out_.order[k]].centre());
     }
+    bin_[index].box = box;
     const std::uint32_t n = end - begin;
     const Split split = find_split(begin, end, centroids, box);
-    const float leaf_cost = static_cast<float>(n);
-    if (n <= static_cast<std::uint32_t>(max_leaf_) && (split.axis < 0 || split.cost >= leaf_cost))
-      return {box, begin, n};
+    if (n <= static_cast<std::uint32_t>(max_leaf_) &&
+        (split.axis < 0 || split.cost >= static_cast<float>(n))) {
+      bin_[index].first = begin;
+      bin_[index].count = n;
+      return;
+    }
     const std::uint32_t mid = partition(begin, end, centroids, split);
-    const auto index = static_cast<std::uint32_t>(out_.nodes.size());
+    const auto left = static_cast<std::uint32_t>(bin_.size());
+    bin_.resize(bin_.size() + 2);
+    bin_[index].left = left;
+    bin_[index].right = left + 1;
+    build(left, begin, mid);
+    build(left + 1, mid, end);
+  }
+
+  // Emits the four-wide node for inner binary node `index`; returns its index.
+  std::uint32_t collapse(std::uint32_t index, std::uint32_t depth) {
+    std::vector<std::uint32_t> lanes = {bin_[index].left, bin_[index].right};
+    while (lanes.size() < 4) {
+      // Open the inner child with the largest area (the likeliest to be entered).
+      int pick = -1;
+      for (int i = 0; i < static_cast<int>(lanes.size()); ++i)
+        if (bin_[lanes[i]].count == 0 &&
+            (pick < 0 || bin_[lanes[i]].box.half_area() > bin_[lanes[pick]].box.half_area()))
+          pick = i;
+      if (pick < 0) break;
+      const BinNode opened = bin_[lanes[pick]];
+      lanes[pick] = opened.left;
+      lanes.insert(lanes.begin() + pick + 1, opened.right);
+    }
+    const auto node = static_cast<std::uint32_t>(out_.nodes.size());
     out_.nodes.emplace_back();
     out_.depth = std::max(out_.depth, depth);
-    const ChildRef left = build(begin, mid, depth + 1);
-    const ChildRef right = build(mid, end, depth + 1);
-    BvhNode& node = out_.nodes[index];
-    node.box[0] = left.box;
-    node.box[1] = right.box;
-    node.child[0] = left.child;
-    node.child[1] = right.child;
-    node.count[0] = left.count;
-    node.count[1] = right.count;
-    return {box, index, 0};
+    for (int lane = 0; lane < 4; ++lane) {
+      const bool used = lane < static_cast<int>(lanes.size());
+      set_lane_box(out_.nodes[node], lane, used ? bin_[lanes[lane]].box : Box3f{});
+      if (!used) continue;
+      const BinNode& b = bin_[lanes[lane]];
+      const std::uint32_t child = b.count > 0 ? b.first : collapse(lanes[lane], depth + 1);
+      out_.nodes[node].child[lane] = child;  // re-index: collapse may grow nodes
+      out_.nodes[node].count[lane] = b.count;
+    }
+    return node;
   }
 
   int bin_of(std::uint32_t prim, int axis, const Box3f& centroids) const {
@@ -144,10 +168,19 @@ class Builder {
 
   const std::vector<Box3f>& bounds_;
   int max_leaf_;
+  std::vector<BinNode> bin_;
   BvhBuild out_;
 };
 
 }  // namespace
+
+void set_lane_box(BvhNode& node, int lane, const Box3f& b) {
+  for (int a = 0; a < 3; ++a) {
+    node.lo[a][lane] = b.lo[a];
+    node.hi[a][lane] = b.hi[a];
+  }
+  if (b.empty()) node.child[lane] = node.count[lane] = 0;
+}
 
 BvhBuild build_bvh(const std::vector<Box3f>& prim_bounds, int max_leaf) {
   return Builder(prim_bounds, max_leaf).run();

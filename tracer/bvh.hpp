@@ -1,11 +1,12 @@
-// Bounding volume hierarchy built with the binned surface area heuristic.
-// The builder sees only primitive boxes, so the tree (and with it the order
-// in which a ray meets primitives) does not depend on how it is later packed.
-// Output invariants: nodes[0] is the root; each node's two children are either
-// nodes (count == 0, child = node index > parent's index) or leaves of
-// 1..max_leaf primitives, which are consecutive in `order` (order[k] is the
-// original index of the k-th primitive). With no primitives, nodes[0] is
-// all empty and must not be traversed.
+// Bounding volume hierarchy: a binary tree built with the binned surface area
+// heuristic, then collapsed to four-wide nodes (each node adopts grandchildren
+// of its largest inner children until it has four). The builder sees only
+// primitive boxes, so the tree, and with it the order in which a ray meets
+// primitives, does not depend on how it is later packed into pages.
+// Output invariants: nodes[0] is the root; an inner lane's node index is
+// greater than its parent's; leaves hold 1..max_leaf primitives, consecutive
+// in `order` (order[k] is the original index of the k-th primitive). With no
+// primitives, nodes[0] has four empty lanes.
 #pragma once
 
 #include <cstdint>
@@ -23,5 +24,8 @@ struct BvhBuild {
 };
 
 BvhBuild build_bvh(const std::vector<Box3f>& prim_bounds, int max_leaf);
+
+// Sets lane i of a node to box b (an empty Box3f makes the lane unused).
+void set_lane_box(BvhNode& node, int lane, const Box3f& b);
 
 }  // namespace tracer

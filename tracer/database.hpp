@@ -92,15 +92,18 @@ struct MaterialRecord {
 };
 static_assert(sizeof(MaterialRecord) == 32);
 
-// Two-wide BVH node holding both children's boxes, so one record read decides
-// which children a ray visits. child[i] is a node index when count[i] == 0,
-// else the first of count[i] consecutive primitives.
+// Four-wide BVH node: the boxes of up to four children in structure-of-arrays
+// form, so one record read decides which children a ray visits and the four
+// slab tests run side by side. Lane i: child[i] is a node index when
+// count[i] == 0, else the first of count[i] consecutive primitives. An unused
+// lane has an empty box (lo > hi), which no ray meets.
 struct BvhNode {
-  Box3f box[2];
-  std::uint32_t child[2];
-  std::uint32_t count[2];
+  float lo[3][4];  // [axis][lane]
+  float hi[3][4];
+  std::uint32_t child[4];
+  std::uint32_t count[4];
 };
-static_assert(sizeof(BvhNode) == 64);
+static_assert(sizeof(BvhNode) == 128);
 
 // A grid cell: `count` primitive ids starting at `first` in the cell-list section.
 struct GridCell {

@@ -3,6 +3,7 @@
 #include "tracer/render.hpp"
 
 #include <algorithm>
+#include <bit>
 #include <cmath>
 #include <cstring>
 #include <limits>
@@ -11,7 +12,7 @@ namespace tracer {
 
 Tracer::Tracer(const DatabaseHeader& header, PageSource& pages, TraceOptions options)
     : header_(header), pages_(pages), options_(options), camera_(header.camera),
-      page_stamp_(header.page_count, 0), stack_(2 * std::size_t{header.bvh_depth} + 4) {}
+      page_stamp_(header.page_count, 0), stack_(3 * std::size_t{header.bvh_depth} + 4) {}
 
 // ---- Paged reads ----
 
@@ -90,49 +91,54 @@ bool Tracer::test_prim(std::uint32_t index, const Ray& ray, float t_min, float& 
   return true;
 }
 
-// Marks "no child chosen" in traversal (a real leaf has at most a few primitives).
-constexpr std::uint32_t kNoChild = 0xffffffffu;
+namespace {
+// Slab tests of the ray against a node's four boxes, lane by lane (the loop
+// vectorises). near/far pick each axis's entry plane by the ray's direction
+// sign, so an empty box (lo > hi) is never entered. Returns a hit-lane mask.
+inline unsigned slab_test4(const BvhNode& node, const Ray& ray, const RayInverse& inv,
+                           const bool negative[3], float t_min, float t_max, float t_entry[4]) {
+  float tn[4] = {t_min, t_min, t_min, t_min}, tf[4] = {t_max, t_max, t_max, t_max};
+  for (int a = 0; a < 3; ++a) {
+    const float* near = negative[a] ? node.hi[a] : node.lo[a];
+    const float* far = negative[a] ? node.lo[a] : node.hi[a];
+    const float o = ray.origin[a], id = inv.inv_dir[a];
+    for (int i = 0; i < 4; ++i) {
+      const float n = (near[i] - o) * id, f = (far[i] - o) * id;
+      tn[i] = n > tn[i] ? n : tn[i];  // a NaN plane distance keeps the running bound
+      tf[i] = f < tf[i] ? f : tf[i];
+    }
+  }
+  unsigned mask = 0;
+  for (int i = 0; i < 4; ++i) {
+    t_entry[i] = tn[i];
+    mask |= unsigned(tn[i] <= tf[i]) << i;
+  }
+  return mask;
+}
+}  // namespace
 
 template <bool Any>
 bool Tracer::traverse_bvh(const Ray& ray, float t_min, float& t_max, Hit* hit, RayStats& stats) {
   const RayInverse inv(ray);
+  const bool negative[3] = {inv.inv_dir.x < 0, inv.inv_dir.y < 0, inv.inv_dir.z < 0};
   bool found = false;
   std::size_t sp = 0;
   std::uint64_t box_tests = 0;
   BvhNode node = header_.bvh_root;
   for (;;) {
-    // Go on with the nearer child the ray meets; stack the farther one.
-    box_tests += 2;
-    float t0, t1;
-    const bool hit0 = slab_test(ray, inv, node.box[0], t_min, t_max, t0);
-    const bool hit1 = slab_test(ray, inv, node.box[1], t_min, t_max, t1);
-    std::uint32_t child, count;
-    if (hit0 && hit1) {
-      const int near = t1 < t0 ? 1 : 0;
-      stack_[sp++] = {node.child[1 - near], node.count[1 - near], near ? t0 : t1};
-      child = node.child[near], count = node.count[near];
-    } else if (hit0 || hit1) {
-      child = node.child[hit1], count = node.count[hit1];
-    } else {
-      child = 0, count = kNoChild;  // neither: pop
+    box_tests += 4;
+    float t[4];
+    unsigned mask = slab_test4(node, ray, inv, negative, t_min, t_max, t);
+    // Stack the lanes met, farthest first; go on with the nearest.
+    const std::size_t base = sp;
+    for (; mask; mask &= mask - 1) {
+      const int lane = std::countr_zero(mask);
+      std::size_t k = sp++;
+      for (; k > base && stack_[k - 1].t < t[lane]; --k) stack_[k] = stack_[k - 1];
+      stack_[k] = {node.child[lane], node.count[lane], t[lane]};
     }
     // Run leaves and pop until the next inner node.
     for (;;) {
-      if (count == 0) {
-        node = read<BvhNode>(Section::bvh_nodes, child, stats);
-        break;
-      }
-      if (count != kNoChild) {
-        for (std::uint32_t k = 0; k < count; ++k) {
-          if (test_prim<Any>(child + k, ray, t_min, t_max, hit, stats)) {
-            if (Any) {
-              stats.box_tests += box_tests;
-              return true;
-            }
-            found = true;
-          }
-        }
-      }
       StackEntry e;
       do {
         if (sp == 0) {
@@ -141,7 +147,19 @@ bool Tracer::traverse_bvh(const Ray& ray, float t_min, float& t_max, Hit* hit, R
         }
         e = stack_[--sp];
       } while (e.t > t_max);  // beyond the closest hit so far
-      child = e.child, count = e.count;
+      if (e.count == 0) {
+        node = read<BvhNode>(Section::bvh_nodes, e.child, stats);
+        break;
+      }
+      for (std::uint32_t k = 0; k < e.count; ++k) {
+        if (test_prim<Any>(e.child + k, ray, t_min, t_max, hit, stats)) {
+          if (Any) {
+            stats.box_tests += box_tests;
+            return true;
+          }
+          found = true;
+        }
+      }
     }
   }
 }

@@ -32,15 +32,21 @@ void expect_consistent(const Database& db) {
   for (std::uint32_t i = 0; i < prims.record_count; ++i) {
     const auto p = record<PrimRecord>(db, Section::prims, i);
     EXPECT_LT(p.material, mats.record_count);
-    if (p.kind == PrimKind::smooth_triangle) EXPECT_LT(p.aux, normals.record_count);
+    if (p.kind == PrimKind::smooth_triangle) {
+      EXPECT_LT(p.aux, normals.record_count);
+    }
   }
   if (h.accel == Accel::bvh) {
     const auto& nodes = h.section(Section::bvh_nodes);
     for (std::uint32_t i = 0; i < nodes.record_count; ++i) {
       const auto n = record<BvhNode>(db, Section::bvh_nodes, i);
-      for (int c = 0; c < 2; ++c) {
-        if (n.count[c] == 0) EXPECT_LT(n.child[c], nodes.record_count);
-        else EXPECT_LE(std::uint64_t{n.child[c]} + n.count[c], prims.record_count);
+      for (int c = 0; c < 4; ++c) {
+        if (n.lo[0][c] > n.hi[0][c]) continue;  // unused lane
+        if (n.count[c] == 0) {
+          EXPECT_LT(n.child[c], nodes.record_count);
+        } else {
+          EXPECT_LE(std::uint64_t{n.child[c]} + n.count[c], prims.record_count);
+        }
       }
     }
   } else {
