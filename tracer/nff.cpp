@@ -317,7 +317,12 @@ Scene parse_nff(std::string_view text, const std::string& source_name) {
 }
 
 Scene parse_nff(std::istream& in, const std::string& source_name) {
-  std::string text{std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+  std::string text;
+  try {
+    text.assign(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+  } catch (const std::ios_base::failure&) {  // e.g. the path is a directory
+    throw SceneError(source_name + ": cannot read (is it a regular file?)");
+  }
   if (in.bad()) throw SceneError(source_name + ": read error");
   return parse_nff(std::string_view(text), source_name);
 }

@@ -163,6 +163,10 @@ TEST(NffError, MissingFileNamesIt) {
   EXPECT_THROW(load_nff_file("/nonexistent/scene.nff"), SceneError);
 }
 
+TEST(NffError, DirectoryIsASceneErrorNotACrash) {
+  EXPECT_THROW(load_nff_file(::testing::TempDir()), SceneError);
+}
+
 struct BadInput {
   const char* label;
   std::string text;
