@@ -131,6 +131,7 @@ void Alt::lock_channels() {
 
 void Alt::unlock_channels() {
   for (detail::ChannelBase* c : channels_) c->lock_.unlock();
+  detail::flush_wakes();
 }
 
 }  // namespace csp

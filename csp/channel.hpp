@@ -46,7 +46,7 @@ class ChannelState final : public ChannelBase {
   }
 
   T read() {
-    SpinlockLock lk(lock_);
+    ChannelLock lk(lock_);
     check_poison();
     if (std::optional<T> v = take_locked()) return std::move(*v);
     std::optional<T> slot;
@@ -57,18 +57,18 @@ class ChannelState final : public ChannelBase {
     rec.waiter = &w;
     rec.slot = &slot;
     readers_.push_back(rec);
-    finish_wait(park(w, lk), rec, readers_);
+    finish_wait(park(w, lk.get()), rec, readers_);
     return std::move(*slot);
   }
 
   std::optional<T> try_read() {
-    SpinlockLock lk(lock_);
+    ChannelLock lk(lock_);
     check_poison();
     return take_locked();
   }
 
   std::optional<T> read_until(Clock::time_point deadline) {
-    SpinlockLock lk(lock_);
+    ChannelLock lk(lock_);
     check_poison();
     if (std::optional<T> v = take_locked()) return v;
     std::optional<T> slot;
@@ -77,7 +77,7 @@ class ChannelState final : public ChannelBase {
     rec.waiter = &w;
     rec.slot = &slot;
     readers_.push_back(rec);
-    park_until(w, lk, deadline);
+    park_until(w, lk.get(), deadline);
     lk.lock();
     const WaitState s = resolve_timeout(w);
     readers_.erase(rec);
@@ -88,7 +88,7 @@ class ChannelState final : public ChannelBase {
   }
 
   void write(T value) {
-    SpinlockLock lk(lock_);
+    ChannelLock lk(lock_);
     check_poison();
     if (give_locked(value, false)) return;
     Waiter w;
@@ -98,11 +98,11 @@ class ChannelState final : public ChannelBase {
     rec.waiter = &w;
     rec.slot = &value;
     writers_.push_back(rec);
-    finish_wait(park(w, lk), rec, writers_);
+    finish_wait(park(w, lk.get()), rec, writers_);
   }
 
   bool try_write(T& value) {
-    SpinlockLock lk(lock_);
+    ChannelLock lk(lock_);
     check_poison();
     return give_locked(value, true);
   }
@@ -168,7 +168,7 @@ class ChannelState final : public ChannelBase {
   void finish_wait(WaitState s, Record& rec, RecordQueue& q) {
     if (s == WaitState::data) return;
     if (s == WaitState::poisoned) throw Poisoned(name_);
-    SpinlockLock lk(lock_);
+    ChannelLock lk(lock_);
     q.erase(rec);
     lk.unlock();
     unwind_deadlock();

@@ -122,14 +122,14 @@ struct Runtime::Impl {
 
   void post(unsigned thread, Spawn s) {
     Worker& w = *workers[thread];
-    SpinlockLock lk(w.lock);
+    detail::ChannelLock lk(w.lock);
     w.inbox.push_back(std::move(s));
     w.wake_locked();
   }
 
   void stop_all() {
     for (auto& w : workers) {
-      SpinlockLock lk(w->lock);
+      detail::ChannelLock lk(w->lock);
       w->stop = true;
       w->wake_locked();
     }
@@ -240,7 +240,7 @@ void run_child(ParGroup& g, Process* child, const std::string& name, const std::
   const detail::Ending e = detail::run_body(body, error);
   detail::bind_fiber(nullptr);
   {
-    SpinlockLock lk(g.lock);
+    detail::ChannelLock lk(g.lock);
     if (e == detail::Ending::failed) g.failures.push_back({name, error});
     if (e == detail::Ending::poisoned) g.poisons.push_back({name, error});
     g.deadlock |= e == detail::Ending::deadlock;

@@ -49,14 +49,17 @@ std::string Tracker::deadlock_dump() const {
 void Tracker::abort_run(const Process* self) {
   bool expected = false;
   if (!aborting_.compare_exchange_strong(expected, true, std::memory_order_acq_rel)) return;
-  std::lock_guard<std::mutex> lk(mutex_);
-  dump_ = describe_locked();
-  // Everyone is parked and nobody else can claim them: wake all to unwind.
-  for (Process* q : processes_) {
-    Waiter* w = q->waiting.load(std::memory_order_acquire);
-    if (q == self || !w || !w->abortable) continue;
-    if (try_claim(*w)) complete(*w, WaitState::aborted, 0);
+  {
+    std::lock_guard<std::mutex> lk(mutex_);
+    dump_ = describe_locked();
+    // Everyone is parked and nobody else can claim them: wake all to unwind.
+    for (Process* q : processes_) {
+      Waiter* w = q->waiting.load(std::memory_order_acquire);
+      if (q == self || !w || !w->abortable) continue;
+      if (try_claim(*w)) complete(*w, WaitState::aborted, 0);
+    }
   }
+  flush_wakes();
 }
 
 namespace {

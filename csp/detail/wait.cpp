@@ -14,6 +14,10 @@ namespace {
 // the two reschedules the fiber (the same protocol as Boost's own channels).
 std::intptr_t timed_token(const Waiter& w) { return reinterpret_cast<std::intptr_t>(&w); }
 
+// Contexts on other threads, claimed under a lock still held. Emptied before
+// the fiber suspends, so it never carries over to another fiber.
+thread_local std::vector<boost::fibers::context*> deferred_wakes;
+
 }  // namespace
 
 void RecordQueue::push_back(Record& r) {
@@ -39,7 +43,7 @@ void RecordQueue::erase(Record& r) {
 }
 
 void ChannelBase::poison() {
-  SpinlockLock lk(lock_);
+  ChannelLock lk(lock_);
   if (poisoned_.load(std::memory_order_relaxed)) return;
   poisoned_.store(true, std::memory_order_release);
   wake_all_locked(readers_, WaitState::poisoned);
@@ -72,8 +76,21 @@ void complete(Waiter& w, WaitState outcome, std::size_t fired) {
   w.state.store(outcome, std::memory_order_release);
   std::intptr_t expected = token;
   if (ctx->twstatus.compare_exchange_strong(expected, -1, std::memory_order_acq_rel) || expected == 0) {
-    boost::fibers::context::active()->schedule(ctx);
+    // Safe to defer: ctx stays parked until it is scheduled.
+    boost::fibers::context* self = boost::fibers::context::active();
+    if (self->get_scheduler() == ctx->get_scheduler()) {
+      self->schedule(ctx);
+    } else {
+      deferred_wakes.push_back(ctx);
+    }
   }
+}
+
+void flush_wakes() {
+  if (deferred_wakes.empty()) return;
+  boost::fibers::context* self = boost::fibers::context::active();
+  for (boost::fibers::context* ctx : deferred_wakes) self->schedule(ctx);
+  deferred_wakes.clear();
 }
 
 WaitState park(Waiter& w, SpinlockLock& lk) {
@@ -87,9 +104,11 @@ WaitState park(Waiter& w, SpinlockLock& lk) {
       w.state.store(WaitState::aborted, std::memory_order_relaxed);
       p->waiting.store(nullptr, std::memory_order_relaxed);
       lk.unlock();
+      flush_wakes();
       return WaitState::aborted;
     }
   }
+  flush_wakes();
   ctx->twstatus.store(0, std::memory_order_release);
   ctx->suspend(lk);
   if (p) p->waiting.store(nullptr, std::memory_order_relaxed);
@@ -99,6 +118,7 @@ WaitState park(Waiter& w, SpinlockLock& lk) {
 void park_until(Waiter& w, SpinlockLock& lk, Clock::time_point deadline) {
   boost::fibers::context* ctx = boost::fibers::context::active();
   w.ctx = ctx;
+  flush_wakes();
   ctx->twstatus.store(timed_token(w), std::memory_order_release);
   ctx->wait_until(deadline, lk);
 }

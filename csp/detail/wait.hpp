@@ -111,8 +111,35 @@ class ChannelBase {
 
 // Claiming: try_claim() wins the waiter or reports a lost race; complete()
 // (winner only, under the channel lock) publishes the outcome and wakes it.
+// A waiter on this thread is made ready at once; one on another thread is
+// woken by flush_wakes() once the lock is released — waking a sleeping thread
+// is a system call, and a lock held across it gets the waker preempted while
+// the woken thread spins on that very lock.
 bool try_claim(Waiter& w);
 void complete(Waiter& w, WaitState outcome, std::size_t fired);
+void flush_wakes();
+
+// A held channel lock that issues the deferred cross-thread wakes when it is
+// released (by the destructor, or by park() suspending the fiber).
+class ChannelLock {
+ public:
+  explicit ChannelLock(Spinlock& l) : lk_(l) {}
+  ~ChannelLock() {
+    if (lk_.owns_lock()) lk_.unlock();
+    flush_wakes();
+  }
+  ChannelLock(const ChannelLock&) = delete;
+  ChannelLock& operator=(const ChannelLock&) = delete;
+  SpinlockLock& get() { return lk_; }
+  void lock() { lk_.lock(); }
+  void unlock() {
+    lk_.unlock();
+    flush_wakes();
+  }
+
+ private:
+  SpinlockLock lk_;
+};
 
 // Parks the calling fiber on w until claimed. lk (locked) guards the records
 // of w and is released once the fiber is suspended; other locks must already

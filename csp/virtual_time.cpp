@@ -1,0 +1,120 @@
+// VirtualTimeScheduler and the this_process clock API (see virtual_time.hpp).
+#include "csp/virtual_time.hpp"
+
+#include "csp/runtime.hpp"
+
+#include <algorithm>
+#include <boost/fiber/operations.hpp>
+#include <stdexcept>
+
+namespace csp {
+
+namespace {
+
+VirtualProps* props_of(boost::fibers::context* ctx) {
+  if (!ctx) return nullptr;
+  return dynamic_cast<VirtualProps*>(ctx->get_properties());
+}
+
+}  // namespace
+
+VirtualTimeScheduler::VirtualTimeScheduler(std::shared_ptr<VirtualTimeRecord> record)
+    : record_(record ? std::move(record) : std::make_shared<VirtualTimeRecord>()) {}
+
+boost::fibers::fiber_properties* VirtualTimeScheduler::new_properties(boost::fibers::context* ctx) {
+  return new VirtualProps(ctx, *this);
+}
+
+void VirtualTimeScheduler::awakened(boost::fibers::context* ctx, ProcessProps& props) noexcept {
+  auto& self = static_cast<VirtualProps&>(props);
+  if (self.queued) {  // pass_to() has queued it already, at its own time
+    self.queued = false;
+    return;
+  }
+  // Woken by the running fiber (a channel, an ALT, a PAR's end): no earlier
+  // than the waker's now.
+  const VirtualProps* waker = props_of(boost::fibers::context::active());
+  const VirtualDuration key = std::max(self.clock, waker ? waker->clock : self.clock);
+  ready_.emplace(key.count(), arrivals_++, ctx);
+}
+
+void VirtualTimeScheduler::pass_to(boost::fibers::context* self, VirtualProps& props, VirtualDuration until) {
+  if (ready_.empty() || std::get<0>(*ready_.begin()) > until.count()) {
+    props.clock = until;
+    note_time(until.count());
+    return;
+  }
+  props.queued = true;
+  ready_.emplace(until.count(), arrivals_++, self);
+  boost::this_fiber::yield();
+}
+
+void VirtualTimeScheduler::note_time(std::int64_t t) {
+  if (t > record_->end_ps.load(std::memory_order_relaxed)) record_->end_ps.store(t, std::memory_order_relaxed);
+}
+
+boost::fibers::context* VirtualTimeScheduler::pick_next() noexcept {
+  if (ready_.empty()) return nullptr;
+  const auto [key, arrival, ctx] = *ready_.begin();
+  ready_.erase(ready_.begin());
+  if (VirtualProps* p = props_of(ctx)) p->clock = VirtualDuration(key);
+  note_time(key);
+  return ctx;
+}
+
+bool VirtualTimeScheduler::has_ready_fibers() const noexcept { return !ready_.empty(); }
+
+void VirtualTimeScheduler::suspend_until(std::chrono::steady_clock::time_point const& when) noexcept {
+  std::unique_lock<std::mutex> lk(mutex_);
+  const auto woken = [this] { return notified_; };
+  if (when == std::chrono::steady_clock::time_point::max()) {
+    wakeup_.wait(lk, woken);
+  } else {
+    wakeup_.wait_until(lk, when, woken);
+  }
+  notified_ = false;
+}
+
+void VirtualTimeScheduler::notify() noexcept {
+  {
+    std::lock_guard<std::mutex> lk(mutex_);
+    notified_ = true;
+  }
+  wakeup_.notify_one();
+}
+
+SchedulerFactory virtual_time_scheduler(std::shared_ptr<VirtualTimeRecord> record) {
+  return [record](unsigned) -> Scheduler* { return new VirtualTimeScheduler(record); };
+}
+
+namespace this_process {
+
+bool in_virtual_time() { return props_of(boost::fibers::context::active()) != nullptr; }
+
+VirtualDuration now() {
+  const VirtualProps* p = props_of(boost::fibers::context::active());
+  return p ? p->clock : VirtualDuration{0};
+}
+
+void advance(VirtualDuration d) {
+  if (d.count() < 0) throw std::invalid_argument("csp::this_process::advance: negative duration");
+  boost::fibers::context* self = boost::fibers::context::active();
+  if (VirtualProps* p = props_of(self)) p->scheduler.pass_to(self, *p, p->clock + d);
+}
+
+void sync() {
+  boost::fibers::context* self = boost::fibers::context::active();
+  if (VirtualProps* p = props_of(self)) p->scheduler.pass_to(self, *p, p->clock);
+}
+
+void delay(std::chrono::nanoseconds d) {
+  if (in_virtual_time()) {
+    advance(d);
+  } else {
+    sleep_for(d);
+  }
+}
+
+}  // namespace this_process
+
+}  // namespace csp

@@ -1,0 +1,117 @@
+// Virtual time: run a csp program as a discrete-event simulation whose
+// processes are the real fibers, so it reports what the run would take on a
+// machine with given costs, whatever the host's speed.
+//
+// Model. There is one global virtual clock, "now". A process spends virtual
+// time only by this_process::advance(d) (csp::sleep_for(d) does the same under
+// this scheduler); every channel operation takes zero virtual time, and a
+// process that blocks resumes at the virtual time of the process that woke it.
+//
+// VirtualTimeScheduler keeps every ready fiber under a key and always resumes
+// the one with the smallest key, ties in the order they became ready (FIFO):
+//   - advance(d): key = clock + d; it goes on at once if no other fiber is
+//     due before then, else it yields;
+//   - woken by another fiber (channel, ALT, PAR end): key = max(own clock,
+//     waker's clock);
+//   - on resumption the fiber's clock becomes its key.
+// Invariant: the running fiber's clock is the smallest key of all fibers that
+// can run, and it never decreases ("now" is monotone). Hence every message is
+// sent at "now", messages are sent in non-decreasing time order, and a
+// receiver reads each message at a time no earlier than it was sent (a receive
+// completes at the later of the receiver's clock and the send): no process
+// ever sees the future, and a process that merges several inputs (ALT) sees
+// only messages already sent by then. Contention falls out of the processes
+// themselves: a link process that carries one packet for latency + size/bw is
+// busy meanwhile, so the next packet waits in its queue.
+//
+// Determinism: the whole simulated program must run on ONE scheduler thread
+// (RuntimeOptions{.threads = 1}). The ready order is then a function of the
+// program alone — no OS scheduling, no cross-thread wake — so the same program
+// gives the same virtual times and statistics on every run. Wall time is not
+// the point of this mode. Real timers (read_until deadlines) still use the
+// wall clock and would break determinism: virtual-time programs must not use them.
+#pragma once
+
+#include <atomic>
+#include <chrono>
+#include <cstdint>
+#include <memory>
+#include <set>
+#include <tuple>
+
+#include "csp/scheduler.hpp"
+
+namespace csp {
+
+// Picoseconds: a 64-bit count covers 106 days at sub-nanosecond resolution.
+using VirtualDuration = std::chrono::duration<std::int64_t, std::pico>;
+
+class VirtualTimeScheduler;
+
+// Per-fiber state of the virtual-time scheduler.
+class VirtualProps final : public ProcessProps {
+ public:
+  VirtualProps(boost::fibers::context* ctx, VirtualTimeScheduler& scheduler)
+      : ProcessProps(ctx), scheduler(scheduler) {}
+  VirtualTimeScheduler& scheduler;  // of the fiber's thread
+  VirtualDuration clock{0};         // the fiber's virtual time: "now" while it runs
+  bool queued = false;              // put in the ready set by pass_to(): skip the next awakened()
+};
+
+// The largest virtual time a run reached; read after Runtime::run().
+struct VirtualTimeRecord {
+  std::atomic<std::int64_t> end_ps{0};
+  VirtualDuration end() const { return VirtualDuration(end_ps.load()); }
+};
+
+class VirtualTimeScheduler final : public Scheduler {
+ public:
+  explicit VirtualTimeScheduler(std::shared_ptr<VirtualTimeRecord> record = {});
+
+  boost::fibers::fiber_properties* new_properties(boost::fibers::context* ctx) override;
+  void awakened(boost::fibers::context* ctx, ProcessProps& props) noexcept override;
+  boost::fibers::context* pick_next() noexcept override;
+  bool has_ready_fibers() const noexcept override;
+  void suspend_until(std::chrono::steady_clock::time_point const& when) noexcept override;
+  void notify() noexcept override;
+
+  // The running fiber self moves its clock to `until`: it keeps running if no
+  // other fiber is due before (or, at equal time, was ready first); otherwise
+  // it joins the ready set at `until` and yields. (Boost.Fiber picks the next
+  // fiber before it re-queues a yielding one, so the yielder queues itself.)
+  void pass_to(boost::fibers::context* self, VirtualProps& props, VirtualDuration until);
+
+ private:
+  void note_time(std::int64_t t);
+
+  // (key, arrival, fiber): the smallest key first, FIFO among equal keys.
+  using Entry = std::tuple<std::int64_t, std::uint64_t, boost::fibers::context*>;
+  std::set<Entry> ready_;
+  std::uint64_t arrivals_ = 0;
+  std::shared_ptr<VirtualTimeRecord> record_;
+  std::mutex mutex_;  // guards notified_ for the sleeping thread
+  std::condition_variable wakeup_;
+  bool notified_ = false;
+};
+
+// A factory for RuntimeOptions::scheduler; record (optional) receives the end time.
+SchedulerFactory virtual_time_scheduler(std::shared_ptr<VirtualTimeRecord> record = {});
+
+namespace this_process {
+
+// True when the calling fiber runs under a VirtualTimeScheduler.
+bool in_virtual_time();
+// The calling fiber's virtual clock (zero outside virtual time).
+VirtualDuration now();
+// Spends d of virtual time: clock += d, then every fiber due earlier runs
+// first. Outside virtual time it does nothing. d must not be negative.
+void advance(VirtualDuration d);
+// Lets every ready fiber due no later than now run first (a yield in virtual
+// time; nothing outside it).
+void sync();
+// Spends d: virtual time under a VirtualTimeScheduler, a real sleep otherwise.
+void delay(std::chrono::nanoseconds d);
+
+}  // namespace this_process
+
+}  // namespace csp

@@ -1,0 +1,221 @@
+// commstime: cost of one channel communication and of one ALT.
+//
+// The network (Welch's occam benchmark):  Prefix -> Delta -> Succ -> Prefix,
+// Delta -> Consume. Each cycle is four communications; Consume times N cycles.
+// It runs on csp channels and, in the same run, on raw Boost.Fiber
+// unbuffered_channel, on one thread and across two, and prints ns per
+// communication and the ratio. Then it times ALT over 1, 4 and 16 channels,
+// with the input already waiting (ready) and with the ALT parking (idle).
+//
+// Each figure is the best of several runs, alternating csp and raw, so that
+// load from other programs on the machine hits both alike. Raw Boost across
+// two threads can hang (Boost.Fiber issue #256), so it runs in a child
+// process with a deadline and is reported as "hung" when it overruns.
+//
+// Usage: commstime [cycles] [runs]   (defaults 200000 and 5)
+#include <poll.h>
+#include <signal.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <boost/fiber/all.hpp>
+#include <chrono>
+#include <limits>
+#include <optional>
+#include <cstdio>
+#include <cstdlib>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "csp/csp.hpp"
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+double ns_per(Clock::duration d, long count) {
+  return std::chrono::duration<double, std::nano>(d).count() / static_cast<double>(count);
+}
+
+// --- commstime on csp ----------------------------------------------------
+
+double csp_commstime(unsigned threads, long cycles) {
+  csp::Channel<long> a("a"), b("b"), c("c"), d("d");
+  Clock::duration elapsed{};
+  csp::Runtime rt(threads);
+  const unsigned far = threads > 1 ? 1 : 0;  // Succ and Consume go across
+  rt.spawn("prefix", 0, [in = d.reader(), out = a.writer()]() mutable {
+    out.write(0);
+    for (;;) out.write(in.read());
+  });
+  rt.spawn("delta", 0, [in = a.reader(), to_succ = b.writer(), to_consume = c.writer()]() mutable {
+    for (;;) {
+      const long x = in.read();
+      to_consume.write(x);
+      to_succ.write(x);
+    }
+  });
+  rt.spawn("succ", far, [in = b.reader(), out = d.writer()]() mutable {
+    for (;;) out.write(in.read() + 1);
+  });
+  rt.spawn("consume", far, [in = c.reader(), &c, &elapsed, cycles]() mutable {
+    in.read();
+    const Clock::time_point start = Clock::now();
+    for (long i = 0; i < cycles; ++i) in.read();
+    elapsed = Clock::now() - start;
+    c.poison();  // shut the network down: poison spreads on first use
+  });
+  try {
+    rt.run();
+  } catch (const csp::Deadlock&) {
+    // The others wait on ends nobody uses any more: by design here.
+  }
+  return ns_per(elapsed, 4 * cycles);
+}
+
+// --- the same network on raw Boost.Fiber ---------------------------------
+
+using RawChannel = boost::fibers::unbuffered_channel<long>;
+
+void raw_thread(std::vector<std::function<void()>> bodies) {
+  std::vector<boost::fibers::fiber> fibers;
+  for (auto& body : bodies) fibers.emplace_back(std::move(body));
+  for (auto& f : fibers) f.join();
+}
+
+double raw_commstime(unsigned threads, long cycles) {
+  RawChannel a, b, c, d;
+  Clock::duration elapsed{};
+  auto prefix = [&] {
+    a.push(0);
+    long x;
+    while (d.pop(x) == boost::fibers::channel_op_status::success) a.push(x);
+  };
+  auto delta = [&] {
+    long x;
+    while (a.pop(x) == boost::fibers::channel_op_status::success) {
+      c.push(x);
+      b.push(x);
+    }
+  };
+  auto succ = [&] {
+    long x;
+    while (b.pop(x) == boost::fibers::channel_op_status::success) d.push(x + 1);
+  };
+  auto consume = [&] {
+    c.value_pop();
+    const Clock::time_point start = Clock::now();
+    for (long i = 0; i < cycles; ++i) c.value_pop();
+    elapsed = Clock::now() - start;
+    for (RawChannel* ch : {&a, &b, &c, &d}) ch->close();
+  };
+  if (threads == 1) {
+    raw_thread({prefix, delta, succ, consume});
+  } else {
+    std::thread far(raw_thread, std::vector<std::function<void()>>{succ, consume});
+    raw_thread({prefix, delta});
+    far.join();
+  }
+  return ns_per(elapsed, 4 * cycles);
+}
+
+// Runs raw_commstime in a child process; nullopt if it does not finish in time.
+std::optional<double> raw_commstime_guarded(unsigned threads, long cycles, std::chrono::seconds limit) {
+  int fds[2];
+  if (pipe(fds) != 0) return std::nullopt;
+  const pid_t child = fork();
+  if (child == 0) {
+    close(fds[0]);
+    const double ns = raw_commstime(threads, cycles);
+    const ssize_t written = write(fds[1], &ns, sizeof ns);
+    _exit(written == sizeof ns ? 0 : 1);
+  }
+  close(fds[1]);
+  pollfd pfd{fds[0], POLLIN, 0};
+  double ns = 0;
+  const bool done = child > 0 && poll(&pfd, 1, static_cast<int>(limit.count() * 1000)) == 1 &&
+                    read(fds[0], &ns, sizeof ns) == static_cast<ssize_t>(sizeof ns);
+  close(fds[0]);
+  if (child > 0) {
+    if (!done) kill(child, SIGKILL);
+    waitpid(child, nullptr, 0);
+  }
+  return done ? std::optional<double>(ns) : std::nullopt;
+}
+
+// --- ALT -----------------------------------------------------------------
+
+// One writer feeds channel k of n (k cycles through all); the ALT selects and
+// reads `count` times. Buffered channels keep input waiting (ready path);
+// unbuffered ones make the ALT park before each input (idle path).
+double alt_cost(std::size_t n, bool ready, long count) {
+  std::vector<csp::Channel<long>> chans;
+  for (std::size_t i = 0; i < n; ++i) chans.emplace_back(std::to_string(i), ready ? 64 : 0);
+  Clock::duration elapsed{};
+  csp::Runtime rt(1);
+  rt.spawn("writer", 0, [&chans, n, count] {
+    std::vector<csp::Out<long>> outs;
+    for (auto& c : chans) outs.push_back(c.writer());
+    for (long i = 0; i < count; ++i) outs[static_cast<std::size_t>(i) % n].write(i);
+  });
+  rt.spawn("alt", 0, [&chans, &elapsed, count] {
+    csp::Alt alt;
+    std::vector<csp::In<long>> ins;
+    for (auto& c : chans) ins.push_back(c.reader());
+    for (auto& in : ins) alt.add_input(in);
+    const Clock::time_point start = Clock::now();
+    for (long i = 0; i < count; ++i) ins[alt.select()].read();
+    elapsed = Clock::now() - start;
+  });
+  rt.run();
+  return ns_per(elapsed, count);
+}
+
+void print_commstime(unsigned threads, long cycles, int runs) {
+  double ours = std::numeric_limits<double>::max();
+  double raw = std::numeric_limits<double>::max();
+  bool raw_hung = false;
+  for (int r = 0; r < runs; ++r) {
+    ours = std::min(ours, csp_commstime(threads, cycles));
+    if (raw_hung) continue;
+    const std::optional<double> ns = raw_commstime_guarded(threads, cycles, std::chrono::seconds(20));
+    raw_hung = !ns;
+    if (ns) raw = std::min(raw, *ns);
+  }
+  if (raw_hung) {
+    std::printf("%-8u %10.1f %12s %8s\n", threads, ours, "hung", "-");
+  } else {
+    std::printf("%-8u %10.1f %12.1f %7.2fx\n", threads, ours, raw, raw / ours);
+  }
+}
+
+void print_alt(std::size_t n, long count, int runs) {
+  double ready = std::numeric_limits<double>::max();
+  double idle = std::numeric_limits<double>::max();
+  for (int r = 0; r < runs; ++r) {
+    ready = std::min(ready, alt_cost(n, true, count));
+    idle = std::min(idle, alt_cost(n, false, count));
+  }
+  std::printf("%-8zu %10.1f %10.1f\n", n, ready, idle);
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  std::setvbuf(stdout, nullptr, _IOLBF, 0);  // show each line as it is measured
+  const long cycles = argc > 1 ? std::atol(argv[1]) : 200000;
+  const int runs = argc > 2 ? std::atoi(argv[2]) : 5;
+  if (cycles <= 0 || runs <= 0) {
+    std::fprintf(stderr, "usage: commstime [cycles > 0] [runs > 0]\n");
+    return 2;
+  }
+  std::printf("commstime: %ld cycles of 4 communications, best of %d runs, ns per communication\n", cycles, runs);
+  std::printf("%-8s %10s %12s %8s\n", "threads", "csp", "raw boost", "raw/csp");
+  for (unsigned threads : {1u, 2u}) print_commstime(threads, cycles, runs);
+  std::printf("\nALT on one thread, ns per select + read, best of %d runs\n", runs);
+  std::printf("%-8s %10s %10s\n", "inputs", "ready", "idle");
+  for (std::size_t n : {1u, 4u, 16u}) print_alt(n, cycles, runs);
+  return 0;
+}
