@@ -42,8 +42,7 @@ class Builder {
       out_.nodes[0].child[0] = bin_[0].first;
       out_.nodes[0].count[0] = bin_[0].count;
     } else {
-      out_.nodes.clear();
-      collapse(0, 1);
+      collapse(0, 0, 1);
     }
     return std::move(out_);
   }
@@ -74,11 +73,11 @@ class Builder {
     build(left + 1, mid, end);
   }
 
-  // Emits the four-wide node for inner binary node `index`; returns its index.
-  std::uint32_t collapse(std::uint32_t index, std::uint32_t depth) {
+  // The binary nodes that become the lanes of the four-wide node for `index`:
+  // its children, with the largest inner ones opened until there are four.
+  std::vector<std::uint32_t> lanes_of(std::uint32_t index) const {
     std::vector<std::uint32_t> lanes = {bin_[index].left, bin_[index].right};
     while (lanes.size() < 4) {
-      // Open the inner child with the largest area (the likeliest to be entered).
       int pick = -1;
       for (int i = 0; i < static_cast<int>(lanes.size()); ++i)
         if (bin_[lanes[i]].count == 0 &&
@@ -89,19 +88,28 @@ class Builder {
       lanes[pick] = opened.left;
       lanes.insert(lanes.begin() + pick + 1, opened.right);
     }
-    const auto node = static_cast<std::uint32_t>(out_.nodes.size());
-    out_.nodes.emplace_back();
+    return lanes;
+  }
+
+  // Fills four-wide node `slot` from inner binary node `index`. The inner
+  // children of a node get consecutive slots, so siblings share cache lines
+  // and pages.
+  void collapse(std::uint32_t slot, std::uint32_t index, std::uint32_t depth) {
     out_.depth = std::max(out_.depth, depth);
+    const std::vector<std::uint32_t> lanes = lanes_of(index);
+    std::vector<std::pair<std::uint32_t, std::uint32_t>> inner;  // (slot, binary node)
+    auto next = static_cast<std::uint32_t>(out_.nodes.size());
     for (int lane = 0; lane < 4; ++lane) {
       const bool used = lane < static_cast<int>(lanes.size());
-      set_lane_box(out_.nodes[node], lane, used ? bin_[lanes[lane]].box : Box3f{});
+      set_lane_box(out_.nodes[slot], lane, used ? bin_[lanes[lane]].box : Box3f{});
       if (!used) continue;
       const BinNode& b = bin_[lanes[lane]];
-      const std::uint32_t child = b.count > 0 ? b.first : collapse(lanes[lane], depth + 1);
-      out_.nodes[node].child[lane] = child;  // re-index: collapse may grow nodes
-      out_.nodes[node].count[lane] = b.count;
+      out_.nodes[slot].count[lane] = b.count;
+      out_.nodes[slot].child[lane] = b.count > 0 ? b.first : next;
+      if (b.count == 0) inner.emplace_back(next++, lanes[lane]);
     }
-    return node;
+    out_.nodes.resize(next);
+    for (const auto& [child_slot, child] : inner) collapse(child_slot, child, depth + 1);
   }
 
   int bin_of(std::uint32_t prim, int axis, const Box3f& centroids) const {

@@ -4,7 +4,7 @@
 // primitive boxes, so the tree, and with it the order in which a ray meets
 // primitives, does not depend on how it is later packed into pages.
 // Output invariants: nodes[0] is the root; an inner lane's node index is
-// greater than its parent's; leaves hold 1..max_leaf primitives, consecutive
+// greater than its parent's, and a node's inner children are consecutive; leaves hold 1..max_leaf primitives, consecutive
 // in `order` (order[k] is the original index of the k-th primitive). With no
 // primitives, nodes[0] has four empty lanes.
 #pragma once

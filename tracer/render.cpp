@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <bit>
 #include <cmath>
+#include <cstddef>
 #include <cstring>
 #include <limits>
 
@@ -16,7 +17,7 @@ Tracer::Tracer(const DatabaseHeader& header, PageSource& pages, TraceOptions opt
 
 // ---- Paged reads ----
 
-const std::byte* Tracer::fetch(PageId id, RayStats& stats) {
+inline const std::byte* Tracer::fetch(PageId id, RayStats& stats) {
   if (last_ptr_ && id == last_page_) return last_ptr_;
   ++stats.page_calls;
   if (page_stamp_[id] != generation_) {
@@ -28,14 +29,19 @@ const std::byte* Tracer::fetch(PageId id, RayStats& stats) {
   return last_ptr_;
 }
 
+inline const std::byte* Tracer::locate(Section section, std::uint64_t index, std::size_t size,
+                                RayStats& stats) {
+  const SectionLayout& s = header_.sections[static_cast<int>(section)];
+  const std::uint64_t byte = index * size;
+  const std::byte* page = fetch(s.first_page + static_cast<PageId>(byte >> header_.page_shift), stats);
+  ++stats.record_reads;
+  return page + (byte & (header_.page_size - 1));
+}
+
 template <class T>
 T Tracer::read(Section section, std::uint64_t index, RayStats& stats) {
-  const SectionLayout& s = header_.sections[static_cast<int>(section)];
-  const std::uint64_t byte = index * sizeof(T);
-  const std::byte* page = fetch(s.first_page + static_cast<PageId>(byte >> header_.page_shift), stats);
   T out;
-  std::memcpy(&out, page + (byte & (header_.page_size - 1)), sizeof(T));
-  ++stats.record_reads;
+  std::memcpy(&out, locate(section, index, sizeof(T), stats), sizeof(T));
   return out;
 }
 
@@ -95,12 +101,17 @@ namespace {
 // Slab tests of the ray against a node's four boxes, lane by lane (the loop
 // vectorises). near/far pick each axis's entry plane by the ray's direction
 // sign, so an empty box (lo > hi) is never entered. Returns a hit-lane mask.
-inline unsigned slab_test4(const BvhNode& node, const Ray& ray, const RayInverse& inv,
+// `node` points at a BvhNode in a page (or the header); its planes are loaded
+// with memcpy, as the record may not be copied whole without cost.
+inline unsigned slab_test4(const std::byte* node, const Ray& ray, const RayInverse& inv,
                            const bool negative[3], float t_min, float t_max, float t_entry[4]) {
   float tn[4] = {t_min, t_min, t_min, t_min}, tf[4] = {t_max, t_max, t_max, t_max};
   for (int a = 0; a < 3; ++a) {
-    const float* near = negative[a] ? node.hi[a] : node.lo[a];
-    const float* far = negative[a] ? node.lo[a] : node.hi[a];
+    float near[4], far[4];
+    const std::size_t lo = offsetof(BvhNode, lo) + a * sizeof(near);
+    const std::size_t hi = offsetof(BvhNode, hi) + a * sizeof(near);
+    std::memcpy(near, node + (negative[a] ? hi : lo), sizeof near);
+    std::memcpy(far, node + (negative[a] ? lo : hi), sizeof far);
     const float o = ray.origin[a], id = inv.inv_dir[a];
     for (int i = 0; i < 4; ++i) {
       const float n = (near[i] - o) * id, f = (far[i] - o) * id;
@@ -115,6 +126,12 @@ inline unsigned slab_test4(const BvhNode& node, const Ray& ray, const RayInverse
   }
   return mask;
 }
+
+// Lane references of a node in a page: child index and primitive count.
+inline void lane_refs(const std::byte* node, std::uint32_t child[4], std::uint32_t count[4]) {
+  std::memcpy(child, node + offsetof(BvhNode, child), 4 * sizeof(std::uint32_t));
+  std::memcpy(count, node + offsetof(BvhNode, count), 4 * sizeof(std::uint32_t));
+}
 }  // namespace
 
 template <bool Any>
@@ -124,18 +141,21 @@ bool Tracer::traverse_bvh(const Ray& ray, float t_min, float& t_max, Hit* hit, R
   bool found = false;
   std::size_t sp = 0;
   std::uint64_t box_tests = 0;
-  BvhNode node = header_.bvh_root;
+  // The node being tested, in place: valid until the next page read.
+  const std::byte* node = reinterpret_cast<const std::byte*>(&header_.bvh_root);
   for (;;) {
     box_tests += 4;
     float t[4];
     unsigned mask = slab_test4(node, ray, inv, negative, t_min, t_max, t);
-    // Stack the lanes met, farthest first; go on with the nearest.
+    std::uint32_t child[4], count[4];
+    lane_refs(node, child, count);
+    // Stack the lanes met, farthest first, so the nearest is popped next.
     const std::size_t base = sp;
     for (; mask; mask &= mask - 1) {
       const int lane = std::countr_zero(mask);
       std::size_t k = sp++;
       for (; k > base && stack_[k - 1].t < t[lane]; --k) stack_[k] = stack_[k - 1];
-      stack_[k] = {node.child[lane], node.count[lane], t[lane]};
+      stack_[k] = {child[lane], count[lane], t[lane]};
     }
     // Run leaves and pop until the next inner node.
     for (;;) {
@@ -148,7 +168,7 @@ bool Tracer::traverse_bvh(const Ray& ray, float t_min, float& t_max, Hit* hit, R
         e = stack_[--sp];
       } while (e.t > t_max);  // beyond the closest hit so far
       if (e.count == 0) {
-        node = read<BvhNode>(Section::bvh_nodes, e.child, stats);
+        node = locate(Section::bvh_nodes, e.child, sizeof(BvhNode), stats);
         break;
       }
       for (std::uint32_t k = 0; k < e.count; ++k) {

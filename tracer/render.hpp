@@ -64,6 +64,8 @@ class Tracer {
   bool occluded(const Ray& ray, float t_min, float t_max, RayStats& stats);
 
  private:
+  // Where record `index` of a section lies; valid until the next page read.
+  const std::byte* locate(Section section, std::uint64_t index, std::size_t size, RayStats& stats);
   template <class T> T read(Section section, std::uint64_t index, RayStats& stats);
   const std::byte* fetch(PageId id, RayStats& stats);
   void begin_sample();
