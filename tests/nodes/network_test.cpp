@@ -111,7 +111,7 @@ TEST(Network, RandomStormWithBuffersOfOneDeliversEveryPacketOnce) {
   for (const auto& spec : specs) {
     SCOPED_TRACE(spec);
     const auto t = topology::parse_topology(spec);
-    const std::size_t per_node = std::max<std::size_t>(16, 2000 / t.size());
+    const std::size_t per_node = std::max<std::size_t>(8, 1000 / t.size());
     const Plan plan = random_plan(t.size(), per_node, 1234);
     NetworkOptions options;
     options.buffer_capacity = 1;
