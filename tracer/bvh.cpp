@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <array>
+#include <cmath>
 
 namespace tracer {
 namespace {
@@ -192,6 +193,82 @@ void set_lane_box(BvhNode& node, int lane, const Box3f& b) {
 
 BvhBuild build_bvh(const std::vector<Box3f>& prim_bounds, int max_leaf) {
   return Builder(prim_bounds, max_leaf).run();
+}
+
+namespace {
+
+using Piece = std::vector<Vec3f>;  // a convex polygon, part of a triangle
+
+// Splits a convex polygon by the plane coord[axis] = pos into its two sides.
+void clip(const Piece& poly, int axis, float pos, Piece& below, Piece& above) {
+  for (std::size_t i = 0; i < poly.size(); ++i) {
+    const Vec3f& a = poly[i];
+    const Vec3f& b = poly[(i + 1) % poly.size()];
+    const float da = a[axis] - pos, db = b[axis] - pos;
+    if (da <= 0) below.push_back(a);
+    if (da >= 0) above.push_back(a);
+    if ((da < 0 && db > 0) || (da > 0 && db < 0)) {
+      Vec3f x = a + (b - a) * (da / (da - db));
+      x[axis] = pos;
+      below.push_back(x);
+      above.push_back(x);
+    }
+  }
+}
+
+Box3f piece_bounds(const Piece& poly, const Box3f& within) {
+  Box3f b;
+  for (const Vec3f& p : poly) b.extend(p);
+  b.lo = max(b.lo, within.lo);
+  b.hi = min(b.hi, within.hi);
+  // Float rounding in the clipped vertices: widen by a few ulps of the coordinates.
+  const float m = std::max({std::fabs(b.lo.x), std::fabs(b.lo.y), std::fabs(b.lo.z),
+                            std::fabs(b.hi.x), std::fabs(b.hi.y), std::fabs(b.hi.z)});
+  const float pad = m * 2e-6f + 1e-30f;
+  b.lo -= Vec3f{pad, pad, pad};
+  b.hi += Vec3f{pad, pad, pad};
+  return b;
+}
+
+void split_piece(const Piece& poly, const Box3f& box, float max_area, int depth,
+                 std::uint32_t prim, BuildRefs& out) {
+  if (depth == 0 || box.half_area() <= max_area) {
+    out.bounds.push_back(box);
+    out.prim.push_back(prim);
+    return;
+  }
+  const Vec3f e = box.extent();
+  const int axis = e.x > e.y ? (e.x > e.z ? 0 : 2) : (e.y > e.z ? 1 : 2);
+  const float pos = (box.lo[axis] + box.hi[axis]) * 0.5f;
+  Piece below, above;
+  clip(poly, axis, pos, below, above);
+  Box3f lower = box, upper = box;
+  lower.hi[axis] = pos;
+  upper.lo[axis] = pos;
+  if (below.size() >= 3) split_piece(below, piece_bounds(below, lower), max_area, depth - 1, prim, out);
+  if (above.size() >= 3) split_piece(above, piece_bounds(above, upper), max_area, depth - 1, prim, out);
+}
+
+}  // namespace
+
+BuildRefs split_large_triangles(const std::vector<PrimRecord>& prims,
+                                const std::vector<Box3f>& bounds, int max_depth) {
+  double total = 0;
+  for (const Box3f& b : bounds) total += b.half_area();
+  const float max_area = bounds.empty() ? 0.0f : static_cast<float>(2.0 * total / bounds.size());
+  BuildRefs out;
+  for (std::uint32_t i = 0; i < prims.size(); ++i) {
+    const PrimRecord& p = prims[i];
+    const bool triangle =
+        p.kind == PrimKind::flat_triangle || p.kind == PrimKind::smooth_triangle;
+    if (!triangle || bounds[i].half_area() <= max_area) {
+      out.bounds.push_back(bounds[i]);
+      out.prim.push_back(i);
+      continue;
+    }
+    split_piece({p.p0, p.p0 + p.p1, p.p0 + p.p2}, bounds[i], max_area, max_depth, i, out);
+  }
+  return out;
 }
 
 }  // namespace tracer

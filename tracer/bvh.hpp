@@ -25,6 +25,22 @@ struct BvhBuild {
 
 BvhBuild build_bvh(const std::vector<Box3f>& prim_bounds, int max_leaf);
 
+// Build references: the boxes the BVH is built over, each naming a primitive.
+// A primitive may have several (see split_large_triangles); the BVH copies it
+// into every leaf that holds one of its references.
+struct BuildRefs {
+  std::vector<Box3f> bounds;
+  std::vector<std::uint32_t> prim;
+};
+
+// Early split clipping: a triangle whose box is much larger than the average
+// box is cut in halves of its box (recursively, at most 2^max_depth pieces),
+// and each piece of the triangle gets its own tight box. Long thin triangles
+// then no longer make every box around them large. Other primitives keep one
+// reference with their own box.
+BuildRefs split_large_triangles(const std::vector<PrimRecord>& prims,
+                                const std::vector<Box3f>& bounds, int max_depth);
+
 // Sets lane i of a node to box b (an empty Box3f makes the lane unused).
 void set_lane_box(BvhNode& node, int lane, const Box3f& b);
 

@@ -135,7 +135,8 @@ class Packer {
   std::uint64_t payload_ = 0;
 };
 
-// Puts primitives (and their normal records) in BVH leaf order.
+// Puts primitives (and their normal records) in BVH leaf order; a primitive
+// listed in several leaves is copied into each.
 void reorder(Flattened& f, const std::vector<std::uint32_t>& order) {
   std::vector<PrimRecord> prims;
   std::vector<NormalRecord> normals;
@@ -206,13 +207,16 @@ Database build_database(const Scene& scene, const BuildOptions& opt) {
   auto& sec = h.sections;
   sec[int(Section::materials)] = packer.add(material_records(scene), "material");
   if (opt.accel == Accel::bvh) {
-    BvhBuild bvh = build_bvh(f.bounds, opt.bvh_max_leaf);
+    const BuildRefs refs = split_large_triangles(f.prims, f.bounds, opt.bvh_split_depth);
+    BvhBuild bvh = build_bvh(refs.bounds, opt.bvh_max_leaf);
+    for (std::uint32_t& k : bvh.order) k = refs.prim[k];
     reorder(f, bvh.order);
     db.stats.accel_seconds = seconds_since(t0);
     t0 = Clock::now();
     h.bvh_root = bvh.nodes[0];
     h.bvh_depth = bvh.depth;
     db.stats.bvh_nodes = bvh.nodes.size();
+    db.stats.bvh_references = refs.prim.size();
     sec[int(Section::bvh_nodes)] = packer.add(bvh.nodes, "BVH node");
   } else {
     GridBuild g = build_grid(f.bounds, h.bounds, opt.grid_density);

@@ -56,6 +56,7 @@ struct BuildOptions {
   Accel accel = Accel::bvh;
   std::uint32_t page_size = 1024;  // bytes; a power of two in [256, 65536]
   int bvh_max_leaf = 4;            // primitives per BVH leaf at most
+  int bvh_split_depth = 3;         // large triangles split into <= 2^depth references (0: none)
   float grid_density = 2.0f;       // grid cells per primitive (approximately)
 };
 
@@ -154,6 +155,7 @@ struct BuildStats {
   double accel_seconds = 0;  // BVH or grid build
   double pack_seconds = 0;
   std::uint64_t bvh_nodes = 0;
+  std::uint64_t bvh_references = 0;  // primitive copies in BVH leaves (>= primitives)
   std::uint64_t grid_cells = 0;
   std::uint64_t grid_references = 0;
   std::uint64_t payload_bytes = 0;  // record bytes, without page padding
