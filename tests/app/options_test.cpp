@@ -1,0 +1,75 @@
+// Option parsing: defaults, values, and one-line errors naming the option.
+#include "app/options.hpp"
+
+#include <gtest/gtest.h>
+
+#include <vector>
+
+namespace app {
+namespace {
+
+Options parse(std::vector<const char*> args) {
+  args.insert(args.begin(), "vmpray");
+  return parse_options(static_cast<int>(args.size()), args.data());
+}
+
+std::string error_of(std::vector<const char*> args) {
+  try {
+    parse(std::move(args));
+  } catch (const UsageError& e) {
+    return e.what();
+  }
+  return "";
+}
+
+TEST(Options, DefaultsRenderTheTeapotToTeapotPng) {
+  const Options o = parse({});
+  EXPECT_EQ(o.scene, "teapot");
+  EXPECT_EQ(o.output, "teapot.png");
+  EXPECT_EQ(o.page_size, 1024u);
+  EXPECT_EQ(o.accel, tracer::Accel::bvh);
+  EXPECT_EQ(o.max_depth, 5);
+  EXPECT_FALSE(o.spd_procedure);
+}
+
+TEST(Options, ParsesEveryValue) {
+  const Options o = parse({"scene.nff", "-o", "x.ppm", "--stats", "s.json", "--spd-procedure",
+                           "--accel", "grid", "--page-size", "4096", "--max-depth", "3",
+                           "--width", "64", "--height", "32", "--tessellate", "2", "--quiet"});
+  EXPECT_EQ(o.scene, "scene.nff");
+  EXPECT_EQ(o.output, "x.ppm");
+  EXPECT_EQ(o.stats_path, "s.json");
+  EXPECT_TRUE(o.spd_procedure);
+  EXPECT_EQ(o.accel, tracer::Accel::grid);
+  EXPECT_EQ(o.page_size, 4096u);
+  EXPECT_EQ(o.max_depth, 3);
+  EXPECT_EQ(o.width, 64);
+  EXPECT_EQ(o.height, 32);
+  EXPECT_EQ(o.tessellate, 2);
+  EXPECT_TRUE(o.quiet);
+}
+
+TEST(Options, BadValuesNameTheOption) {
+  EXPECT_NE(error_of({"--accel", "kdtree"}).find("--accel"), std::string::npos);
+  EXPECT_NE(error_of({"--page-size", "1000"}).find("--page-size"), std::string::npos);
+  EXPECT_NE(error_of({"--page-size", "128"}).find("--page-size"), std::string::npos);
+  EXPECT_NE(error_of({"--max-depth", "0"}).find("--max-depth"), std::string::npos);
+  EXPECT_NE(error_of({"--width", "-3"}).find("--width"), std::string::npos);
+  EXPECT_NE(error_of({"--page-size", "abc"}).find("page-size"), std::string::npos);
+  EXPECT_NE(error_of({"--frobnicate"}).find("frobnicate"), std::string::npos);
+}
+
+TEST(Options, HelpAndVersionAreActions) {
+  EXPECT_EQ(parse({"--help"}).action, Options::Action::help);
+  EXPECT_EQ(parse({"--version"}).action, Options::Action::version);
+  EXPECT_NE(usage_text().find("--page-size"), std::string::npos);
+}
+
+TEST(Options, OutputNameFollowsTheScene) {
+  EXPECT_EQ(default_output("tetra:9"), "tetra-9.png");
+  EXPECT_EQ(default_output("/a/b/rings-s4-t1.nff.gz"), "rings-s4-t1.png");
+  EXPECT_EQ(default_output("-"), "stdin.png");
+}
+
+}  // namespace
+}  // namespace app
