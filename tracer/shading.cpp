@@ -44,6 +44,24 @@ SurfaceFrame surface_frame(const Hit& hit, const Vec3f& p, const Vec3f& dir,
   return {geo, shading, entering};
 }
 
+// Where shadow rays of a smooth triangle start: the hit point lifted onto the
+// curved surface the vertex normals describe (Hanika's shadow-terminator
+// fix), so flat facets do not shadow themselves where the shading is smooth.
+// `facing` is the shading normal turned toward the viewer.
+Vec3f smooth_shadow_origin(const PrimRecord& r, const NormalRecord& n, const Hit& hit,
+                           const Vec3f& p, const Vec3f& facing) {
+  const Vec3f v[3] = {r.p0, r.p0 + r.p1, r.p0 + r.p2};
+  const float w[3] = {1.0f - hit.u - hit.v, hit.u, hit.v};
+  const float side = dot(n.n0 * w[0] + n.n1 * w[1] + n.n2 * w[2], facing) < 0.0f ? -1.0f : 1.0f;
+  const Vec3f nv[3] = {n.n0 * side, n.n1 * side, n.n2 * side};
+  Vec3f lifted = p;
+  for (int i = 0; i < 3; ++i) {
+    const float below = dot(p - v[i], nv[i]);
+    if (below < 0.0f) lifted -= nv[i] * (w[i] * below);
+  }
+  return lifted;
+}
+
 }  // namespace
 
 Color Tracer::shade(const Ray& ray, int depth, float weight, RayStats& stats) {
@@ -66,7 +84,9 @@ Color Tracer::shade_hit(const Ray& ray, const Hit& hit, int depth, float weight,
   if (smooth) normals = read<NormalRecord>(Section::normals, hit.prim.aux, stats);
   const SurfaceFrame f = surface_frame(hit, p, dir, smooth ? &normals : nullptr);
   const auto m = read<MaterialRecord>(Section::materials, hit.prim.material, stats);
-  Color c = direct_light(p, f.geo, f.shading, -dir, m, stats);
+  const Vec3f light_from =
+      smooth ? smooth_shadow_origin(hit.prim, normals, hit, p, f.shading) : p;
+  Color c = direct_light(light_from, f.geo, f.shading, -dir, m, stats);
 
   const bool deeper = depth < options_.max_depth;
   const float eps = header_.epsilon;
@@ -87,7 +107,10 @@ Color Tracer::shade_hit(const Ray& ray, const Hit& hit, int depth, float weight,
   if (deeper && (spd_reflect || (reflect_weight > 0.0f &&
                                  weight * reflect_weight >= options_.min_contribution))) {
     ++stats.reflected;
-    const Ray r{p + f.geo * eps, reflect(dir, f.shading)};
+    // A smooth normal can reflect the ray into the flat facet; mirror it on the facet then.
+    Vec3f r_dir = reflect(dir, f.shading);
+    if (dot(r_dir, f.geo) <= 0.0f) r_dir = reflect(dir, f.geo);
+    const Ray r{p + f.geo * eps, r_dir};
     c += shade(r, depth + 1, weight * reflect_weight, stats) * reflect_weight;
   }
   return c;
