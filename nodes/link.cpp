@@ -3,6 +3,8 @@
 
 #include <utility>
 
+#include "csp/virtual_time.hpp"
+
 namespace nodes {
 
 std::chrono::nanoseconds LinkModel::delay(std::size_t bytes) const {
@@ -27,7 +29,7 @@ void Link::run() {
     Packet packet = reply_.read();
     ++counters_.packets;
     counters_.bytes += packet.payload.size();
-    if (model_.enabled()) csp::sleep_for(model_.delay(packet.payload.size()));
+    if (model_.enabled()) csp::this_process::delay(model_.delay(packet.payload.size()));
     next_.write(std::move(packet));
   }
 }

@@ -10,8 +10,9 @@
 //                                               channel (or the local port);
 //                                               may block: only this process
 //                                               waits, never the router.
-// With a link model the packet is delayed (latency + bytes / bandwidth) by
-// csp::sleep_for between reply and next, modelling the wire.
+// With a link model the packet is delayed (latency + bytes / bandwidth)
+// between reply and next, modelling the wire: a real sleep, or virtual time
+// under csp's virtual-time scheduler (csp::this_process::delay).
 // Ends: the process stops when any of its channels is poisoned.
 #pragma once
 

@@ -70,6 +70,7 @@ struct Wiring {
   const MachineOptions& options;
   ItemGrid grid;
   std::uint64_t processes;  // sending processes, for packet ids
+  MachineTiming* timing;    // null unless in virtual time
 
   Outbox outbox(NodeId n, std::uint16_t port) const {
     const std::uint64_t ports = Ports::count(options.workers_per_node);
@@ -84,19 +85,28 @@ void spawn_node(const Wiring& w, NodeId n, NodeState& node) {
   node.mailbox = std::make_unique<Mailbox>(name + " page requests", static_cast<std::size_t>(w.processes) + 1);
   w.runtime.spawn(name + " page mailbox", thread,
                   [mb = node.mailbox.get(), in = w.net.port(n, Ports::page_server)] { mb->forward(in); });
-  w.runtime.spawn(name + " page server", thread, [n, &node, out = w.outbox(n, Ports::page_server)] {
-    PageServer(n, node.svm->memory(), node.mailbox->reader(), out, node.served).run();
+  std::function<void()> serve_hook = w.timing ? w.timing->serve_hook(static_cast<int>(n)) : nullptr;
+  w.runtime.spawn(name + " page server", thread, [n, &node, out = w.outbox(n, Ports::page_server), serve_hook] {
+    PageServer(n, node.svm->memory(), node.mailbox->reader(), out, node.served, serve_hook).run();
   });
   node.work.resize(static_cast<std::size_t>(k));
   for (int i = 0; i < k; ++i) {
     const auto port = static_cast<std::uint16_t>(Ports::first_worker + i);
     node.worker_out.push_back(std::make_unique<Outbox>(w.outbox(n, port)));
     Outbox& out = *node.worker_out.back();
-    SvmSource& source = node.svm->add_worker(make_page_fetch(w.placement, port, w.net.port(n, port), out));
     auto& counters = node.work[static_cast<std::size_t>(i)];
+    PageFetch fetch = make_page_fetch(w.placement, port, w.net.port(n, port), out);
+    std::function<void()> charge;
+    if (w.timing) {
+      ComputeMeter& meter = w.timing->add_meter(static_cast<int>(n), counters.rays);
+      fetch = MachineTiming::charging_fetch(meter, std::move(fetch));
+      charge = [&meter] { meter.charge(); };
+    }
+    SvmSource& source = node.svm->add_worker(std::move(fetch));
     w.runtime.spawn(name + " pixel computer " + std::to_string(i), thread,
-                    [&w, port, &source, &out, in = w.net.port(n, port), &counters] {
-                      PixelComputer(port, source, w.header, w.options.trace, w.grid, in, out, counters).run();
+                    [&w, port, &source, &out, in = w.net.port(n, port), &counters, charge] {
+                      PixelComputer(port, source, w.header, w.options.trace, w.grid, in, out, counters, charge)
+                          .run();
                     });
   }
 }
@@ -188,17 +198,24 @@ MachineResult run_machine(tracer::Database db, const MachineOptions& options) {
   auto nodes = distribute(db, placement, cache_pages);
 
   const auto started = std::chrono::steady_clock::now();
-  csp::Runtime runtime(thread_count(options, topology.size()));
+  std::optional<MachineTiming> timing;
+  if (options.timing) timing.emplace(*options.timing, static_cast<int>(topology.size()));
+  csp::RuntimeOptions runtime_options;
+  runtime_options.threads = thread_count(options, topology.size());
+  if (timing) runtime_options = timing->runtime_options(runtime_options.stack_size);
+  csp::Runtime runtime(std::move(runtime_options));
   NetworkOptions net_options;
   net_options.buffer_capacity = options.buffer_capacity;
   net_options.ports_per_node = Ports::count(options.workers_per_node);
   net_options.trace_routes = options.trace_routes;
+  if (timing) net_options.link = timing->model().link_model();
   Network net(runtime, topology, net_options);
 
   const bool corners = options.trace.spd_procedure;
   const ItemGrid grid{header.camera.width + (corners ? 1 : 0), corners};
   const auto items = static_cast<std::uint32_t>(grid.width) * static_cast<std::uint32_t>(header.camera.height + (corners ? 1 : 0));
-  const Wiring wiring{runtime, net, placement, header, options, grid, topology.size() * net_options.ports_per_node};
+  const Wiring wiring{runtime, net, placement, header, options, grid, topology.size() * net_options.ports_per_node,
+                      timing ? &*timing : nullptr};
   Host host;
   host.plan = std::make_unique<WorkPlan>(items, options.grain, options.schedule, static_cast<int>(topology.size()),
                                          options.workers_per_node);
@@ -210,6 +227,11 @@ MachineResult run_machine(tracer::Database db, const MachineOptions& options) {
   MachineResult result;
   MachineReport& report = result.report;
   report.wall_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
+  if (timing) {
+    report.cost_model = timing->model().describe();
+    report.predicted_seconds = timing->predicted_seconds();
+    report.compute_seconds = timing->compute_seconds();
+  }
   report.topology = topology.spec();
   report.nodes = static_cast<int>(topology.size());
   report.threads = runtime.threads();

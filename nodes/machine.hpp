@@ -42,6 +42,7 @@
 #include "nodes/page_server.hpp"
 #include "nodes/pixel_computer.hpp"
 #include "nodes/svm.hpp"
+#include "nodes/timing.hpp"
 #include "nodes/work_plan.hpp"
 #include "tracer/database.hpp"
 #include "tracer/image.hpp"
@@ -62,6 +63,7 @@ struct MachineOptions {
   std::uint64_t trace_routes = 0;      // record the routes of the first N packets
   std::size_t buffer_capacity = 4;     // packets per network queue
   tracer::TraceOptions trace;
+  std::optional<CostModel> timing;     // virtual time under this model (the run takes one thread)
   Progress progress;                   // called by the collector (on its thread)
 };
 
@@ -85,6 +87,9 @@ struct MachineReport {
   std::uint32_t page_count = 0;
   std::uint64_t items = 0;  // pixels, or SPD corner samples
   double wall_seconds = 0;
+  std::string cost_model;          // CostModel::describe(), empty without virtual time
+  double predicted_seconds = 0;    // virtual time at the end of the run
+  double compute_seconds = 0;      // virtual compute time summed over the pixel computers
   std::vector<NodeReport> per_node;
   FarmerCounters farmer;
   std::uint64_t collected = 0;

@@ -9,8 +9,13 @@
 namespace nodes {
 
 PageServer::PageServer(NodeId node, const NodeMemory& memory, csp::In<Packet> requests, Outbox out,
-                       ServerCounters& counters)
-    : node_(node), memory_(memory), requests_(std::move(requests)), out_(std::move(out)), counters_(counters) {}
+                       ServerCounters& counters, std::function<void()> before_reply)
+    : node_(node),
+      memory_(memory),
+      requests_(std::move(requests)),
+      out_(std::move(out)),
+      counters_(counters),
+      before_reply_(std::move(before_reply)) {}
 
 void PageServer::run() {
   for (;;) {
@@ -35,6 +40,7 @@ void PageServer::serve(const Packet& request) {
     throw std::logic_error("node " + std::to_string(node_) + " asked for page " + std::to_string(r.page) +
                            " it does not own");
   const std::span<const std::byte> bytes(memory_.own_page(entry), memory_.page_size());
+  if (before_reply_) before_reply_();
   out_.send(make_packet(request.source, r.reply_port, MessageKind::page_reply, encode_page_reply(r.page, bytes)));
   ++counters_.pages_served;
   counters_.bytes_served += bytes.size();

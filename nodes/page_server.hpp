@@ -12,6 +12,7 @@
 #pragma once
 
 #include <cstdint>
+#include <functional>
 
 #include "csp/csp.hpp"
 #include "nodes/messages.hpp"
@@ -28,7 +29,7 @@ struct ServerCounters {
 class PageServer {
  public:
   PageServer(NodeId node, const NodeMemory& memory, csp::In<Packet> requests, Outbox out,
-             ServerCounters& counters);
+             ServerCounters& counters, std::function<void()> before_reply = {});
   void run();
 
  private:
@@ -39,6 +40,7 @@ class PageServer {
   csp::In<Packet> requests_;
   Outbox out_;
   ServerCounters& counters_;
+  std::function<void()> before_reply_;  // virtual time charges the handler here
 };
 
 }  // namespace nodes

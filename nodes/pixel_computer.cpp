@@ -20,14 +20,15 @@ Packet expect(csp::In<Packet>& in, MessageKind a, MessageKind b) {
 
 PixelComputer::PixelComputer(std::uint16_t port, SvmSource& source, const tracer::DatabaseHeader& header,
                              tracer::TraceOptions options, ItemGrid grid, csp::In<Packet> in, Outbox& out,
-                             WorkerCounters& counters)
+                             WorkerCounters& counters, std::function<void()> after_tile)
     : port_(port),
       source_(source),
       tracer_(header, source, options),
       grid_(grid),
       in_(std::move(in)),
       out_(out),
-      counters_(counters) {}
+      counters_(counters),
+      after_tile_(std::move(after_tile)) {}
 
 void PixelComputer::run() {
   for (;;) {
@@ -37,6 +38,7 @@ void PixelComputer::run() {
     if (static_cast<MessageKind>(answer.kind) == MessageKind::stop) break;
     const Tile tile = decode_tile(answer.payload);
     compute(tile);
+    if (after_tile_) after_tile_();
     source_.release();
     out_.send(make_packet(0, Ports::collector, MessageKind::result, encode_result(tile, colors_)));
   }

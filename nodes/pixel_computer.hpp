@@ -15,6 +15,7 @@
 #pragma once
 
 #include <cstdint>
+#include <functional>
 
 #include "csp/csp.hpp"
 #include "nodes/messages.hpp"
@@ -40,7 +41,7 @@ class PixelComputer {
  public:
   PixelComputer(std::uint16_t port, SvmSource& source, const tracer::DatabaseHeader& header,
                 tracer::TraceOptions options, ItemGrid grid, csp::In<Packet> in, Outbox& out,
-                WorkerCounters& counters);
+                WorkerCounters& counters, std::function<void()> after_tile = {});
   void run();
 
  private:
@@ -54,6 +55,7 @@ class PixelComputer {
   Outbox& out_;
   WorkerCounters& counters_;
   std::vector<tracer::Color> colors_;
+  std::function<void()> after_tile_;  // before the result is sent: virtual time charges the work here
 };
 
 // The miss path of a worker's SvmSource: page_request to the owner, then
