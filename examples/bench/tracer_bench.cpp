@@ -60,11 +60,12 @@ Workload vmpray_primary_shadow(const tracer::Database& db) {
   return w;
 }
 
-Workload vmpray_whitted(const tracer::Database& db) {
+Workload vmpray_whitted(const tracer::Database& db, std::uint64_t* page_calls = nullptr) {
   tracer::InMemoryPageSource pages(db);
   tracer::RayStats stats;
   const double t0 = cpu_seconds();
   tracer::render_frame(db.header, pages, {}, stats);
+  if (page_calls) *page_calls = stats.page_calls;
   return {stats.rays(), cpu_seconds() - t0};
 }
 
@@ -144,14 +145,17 @@ void bench_scene(const std::string& spec) {
   std::printf("  embree %6.2f Mrays/s  ratio vmpray/embree %.2f", ref.mrays(), ours.mrays() / ref.mrays());
 #endif
   std::printf("\n");
-  const Workload whitted = vmpray_whitted(db);
-  std::printf("  whitted         vmpray %6.2f Mrays/s (%llu rays, %.2f s)\n", whitted.mrays(),
-              static_cast<unsigned long long>(whitted.rays), whitted.seconds);
+  std::uint64_t calls = 0;
+  const Workload whitted = vmpray_whitted(db, &calls);
+  std::printf("  whitted @ 1024  vmpray %6.2f Mrays/s (%llu rays, %.2f s, %.2f page() calls/ray)\n",
+              whitted.mrays(), static_cast<unsigned long long>(whitted.rays), whitted.seconds,
+              double(calls) / double(whitted.rays));
+  // 64 KB pages: page() is almost never called, the closest to unpaged access.
   for (std::uint32_t ps : {256u, 65536u}) {
     const tracer::Database other = build_database(scene, {.page_size = ps});
-    const Workload w = vmpray_whitted(other);
-    std::printf("  whitted @%5u  vmpray %6.2f Mrays/s  time ratio vs 1024: %.3f\n", ps, w.mrays(),
-                w.seconds / whitted.seconds);
+    const Workload w = vmpray_whitted(other, &calls);
+    std::printf("  whitted @%5u  vmpray %6.2f Mrays/s (%.2f page() calls/ray)  time ratio vs 1024: %.3f\n",
+                ps, w.mrays(), double(calls) / double(w.rays), w.seconds / whitted.seconds);
   }
 }
 
