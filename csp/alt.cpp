@@ -99,9 +99,8 @@ std::size_t Alt::wait_locked(std::size_t timeout_guard, Clock::time_point deadli
     if (guards_[i].enabled && guards_[i].kind == Kind::input) guards_[i].channel->readers_.push_back(*record++);
   }
 
-  // Park holding only the last lock; the others may go first, because a
-  // waker on another thread can only queue this fiber for this thread's
-  // dispatcher, which runs after the fiber has suspended.
+  // park() releases the last lock just before suspending; the others may go
+  // first, for the reason given there.
   detail::Spinlock no_channel;
   detail::Spinlock& last = channels_.empty() ? no_channel : channels_.back()->lock_;
   if (channels_.empty()) no_channel.lock();

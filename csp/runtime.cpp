@@ -4,6 +4,7 @@
 #include <boost/fiber/fiber.hpp>
 #include <boost/fiber/fixedsize_stack.hpp>
 #include <boost/fiber/operations.hpp>
+#include <barrier>
 #include <exception>
 #include <mutex>
 #include <stdexcept>
@@ -135,7 +136,7 @@ struct Runtime::Impl {
     }
   }
 
-  void worker_main(unsigned index);
+  void worker_main(unsigned index, std::barrier<>& finished);
   boost::fibers::fiber launch(Spawn s);
   void run_process(Process& p, const std::function<void()>& body);
 
@@ -147,7 +148,7 @@ struct Runtime::Impl {
   bool started = false;
 };
 
-void Runtime::Impl::worker_main(unsigned index) {
+void Runtime::Impl::worker_main(unsigned index, std::barrier<>& finished) {
   detail::on_runtime_thread = true;
   Scheduler* algo = options.scheduler ? options.scheduler(index) : new FifoScheduler;
   boost::fibers::context::active()->get_scheduler()->set_algo(boost::fibers::algo::algorithm::ptr_t(algo));
@@ -168,6 +169,10 @@ void Runtime::Impl::worker_main(unsigned index) {
     for (Spawn& s : batch) fibers.push_back(launch(std::move(s)));
   }
   for (boost::fibers::fiber& f : fibers) f.join();
+  // A fiber of another thread may still be inside this thread's scheduler,
+  // waking it; the scheduler dies with the thread, so wait for every thread
+  // to finish its fibers first.
+  finished.arrive_and_wait();
   detail::on_runtime_thread = false;
 }
 
@@ -207,8 +212,9 @@ void Runtime::run() {
   impl_->started = true;
   if (impl_->tracker.alive() == 0) return;
   std::vector<std::thread> threads;
+  std::barrier<> finished(impl_->options.threads);
   for (unsigned i = 0; i < impl_->options.threads; ++i) {
-    threads.emplace_back([this, i] { impl_->worker_main(i); });
+    threads.emplace_back([this, i, &finished] { impl_->worker_main(i, finished); });
   }
   for (std::thread& t : threads) t.join();
 

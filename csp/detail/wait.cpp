@@ -93,6 +93,11 @@ void flush_wakes() {
   deferred_wakes.clear();
 }
 
+// Both parks release the lock themselves before suspending (rather than
+// handing it to Boost, whose unlock is invisible to ThreadSanitizer). That is
+// safe: no other fiber of this thread runs before the suspension, and a waker
+// on another thread can only queue this fiber for this thread's dispatcher,
+// which runs after the suspension.
 WaitState park(Waiter& w, SpinlockLock& lk) {
   boost::fibers::context* ctx = boost::fibers::context::active();
   w.ctx = ctx;
@@ -108,9 +113,10 @@ WaitState park(Waiter& w, SpinlockLock& lk) {
       return WaitState::aborted;
     }
   }
-  flush_wakes();
   ctx->twstatus.store(0, std::memory_order_release);
-  ctx->suspend(lk);
+  lk.unlock();
+  flush_wakes();
+  ctx->suspend();
   if (p) p->waiting.store(nullptr, std::memory_order_relaxed);
   return w.state.load(std::memory_order_acquire);
 }
@@ -118,9 +124,10 @@ WaitState park(Waiter& w, SpinlockLock& lk) {
 void park_until(Waiter& w, SpinlockLock& lk, Clock::time_point deadline) {
   boost::fibers::context* ctx = boost::fibers::context::active();
   w.ctx = ctx;
-  flush_wakes();
   ctx->twstatus.store(timed_token(w), std::memory_order_release);
-  ctx->wait_until(deadline, lk);
+  lk.unlock();
+  flush_wakes();
+  ctx->wait_until(deadline);
 }
 
 WaitState resolve_timeout(Waiter& w) {

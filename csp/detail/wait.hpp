@@ -142,8 +142,8 @@ class ChannelLock {
 };
 
 // Parks the calling fiber on w until claimed. lk (locked) guards the records
-// of w and is released once the fiber is suspended; other locks must already
-// be released. Returns the outcome; `aborted` means the run is deadlocked and
+// of w and is released just before the fiber suspends; other locks must
+// already be released. Returns the outcome; `aborted` means the run is deadlocked and
 // the caller must unlink its records, then call unwind_deadlock().
 WaitState park(Waiter& w, SpinlockLock& lk);
 // Timed park: returns with lk *unlocked*; the caller relocks and resolves a
