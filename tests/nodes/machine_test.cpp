@@ -86,20 +86,33 @@ std::string describe(const Case& c) {
 TEST(Machine, ImageIsBitIdenticalToSingleProcessRenderAcrossConfigurations) {
   const std::vector<Case> cases{
       {"hypercube", 1, 1, 1024, 4, Schedule::dynamic, 1, 1},
-      {"hypercube", 2, 1, 256, 1, Schedule::dynamic, 1, 2},
-      {"ring", 3, 2, 1024, 4, Schedule::dynamic, 2, 2},
+      {"hypercube", 2, 1, 256, 1, Schedule::dynamic, 1, 1},
+      {"ring", 3, 2, 1024, 4, Schedule::dynamic, 2, 1},
       {"complete", 3, 0, 65536, 7, Schedule::static_split, 1, 1},
-      {"mesh", 3, 8, 1024, 4, Schedule::dynamic, 3, 2},
-      {"torus", 4, 1, 256, 4, Schedule::dynamic, 3, 2},
-      {"hypercube", 8, 16, 1024, 1, Schedule::static_split, 2, 2},
-      {"mesh", 16, 4, 256, 4, Schedule::dynamic, 1, 2},
+      {"mesh", 3, 8, 1024, 4, Schedule::dynamic, 3, 1},
+      {"torus", 4, 1, 256, 4, Schedule::dynamic, 3, 1},
+      {"hypercube", 8, 16, 1024, 1, Schedule::static_split, 2, 1},
+      {"mesh", 16, 4, 256, 4, Schedule::dynamic, 1, 1},
       {"torus", 16, 0, 1024, 64, Schedule::dynamic, 2, 1},
-      {"hypercube", 16, 2, 1024, 576, Schedule::dynamic, 1, 2},
-      {"ring", 16, 3, 1024, 4, Schedule::static_split, 1, 2},
-      {"complete", 8, 1, 1024, 4, Schedule::dynamic, 3, 2},
-      {"hypercube", 64, 4, 256, 2, Schedule::dynamic, 1, 2},
-      {"torus", 64, 1, 1024, 4, Schedule::static_split, 2, 2},
-      {"hypercube", 16, 2, 1024, 4, Schedule::dynamic, 2, 2, "balls:1", 24},
+      {"hypercube", 16, 2, 1024, 576, Schedule::dynamic, 1, 1},
+      {"ring", 16, 3, 1024, 4, Schedule::static_split, 1, 1},
+      {"complete", 8, 1, 1024, 4, Schedule::dynamic, 3, 1},
+      {"hypercube", 64, 4, 256, 2, Schedule::dynamic, 1, 1},
+      {"torus", 64, 1, 1024, 4, Schedule::static_split, 2, 1},
+      {"hypercube", 16, 2, 1024, 4, Schedule::dynamic, 2, 1, "balls:1", 24},
+  };
+  for (const auto& c : cases) {
+    const auto result = run_case(c);
+    EXPECT_TRUE(same_bits(result.image.pixels(), cached_reference(c.scene, c.size))) << describe(c);
+  }
+}
+
+// Processors spread over two OS threads: links between them cross threads.
+TEST(Machine, ImageIsBitIdenticalOnTwoThreads) {
+  const std::vector<Case> cases{
+      {"hypercube", 2, 1, 256, 1, Schedule::dynamic, 1, 2},
+      {"torus", 4, 1, 256, 4, Schedule::dynamic, 3, 2},
+      {"mesh", 4, 3, 1024, 4, Schedule::dynamic, 2, 2},
   };
   for (const auto& c : cases) {
     const auto result = run_case(c);
@@ -108,7 +121,7 @@ TEST(Machine, ImageIsBitIdenticalToSingleProcessRenderAcrossConfigurations) {
 }
 
 TEST(Machine, ImageIsBitIdenticalOn256Nodes) {
-  const Case c{"hypercube", 256, 2, 256, 1, Schedule::dynamic, 1, 2, "teapot:2", 16};
+  const Case c{"hypercube", 256, 2, 256, 1, Schedule::dynamic, 1, 1, "teapot:2", 16};
   EXPECT_TRUE(same_bits(run_case(c).image.pixels(), cached_reference(c.scene, c.size)));
 }
 
@@ -116,7 +129,7 @@ TEST(Machine, SpdProcedureMatchesSingleProcessSpdRender) {
   MachineOptions options;
   options.topology = "mesh";
   options.nodes = 4;
-  options.threads = 2;
+  options.threads = 1;
   options.cache_pages = 3;
   options.workers_per_node = 2;
   options.trace.spd_procedure = true;
@@ -126,7 +139,7 @@ TEST(Machine, SpdProcedureMatchesSingleProcessSpdRender) {
 }
 
 TEST(Machine, EveryPixelIsComputedExactlyOnce) {
-  const Case c{"torus", 16, 4, 1024, 3, Schedule::dynamic, 2, 2};
+  const Case c{"torus", 16, 4, 1024, 3, Schedule::dynamic, 2, 1};
   const auto result = run_case(c);
   const auto& r = result.report;
   const std::uint64_t pixels = 24 * 24;
@@ -139,8 +152,8 @@ TEST(Machine, EveryPixelIsComputedExactlyOnce) {
 }
 
 TEST(Machine, ResidentSceneBytesStayWithinOwnShareAndCache) {
-  for (const auto& c : {Case{"hypercube", 16, 3, 256, 4, Schedule::dynamic, 3, 2},
-                        Case{"ring", 8, 1, 1024, 1, Schedule::dynamic, 1, 2}}) {
+  for (const auto& c : {Case{"hypercube", 16, 3, 256, 4, Schedule::dynamic, 3, 1},
+                        Case{"ring", 8, 1, 1024, 1, Schedule::dynamic, 1, 1}}) {
     const auto result = run_case(c);
     for (const auto& node : result.report.per_node) {
       EXPECT_LE(node.peak_resident_bytes, node.own_bytes + std::size_t{c.cache_pages} * c.page_size)
@@ -154,9 +167,9 @@ TEST(Machine, LargeSceneOn64NodesKeepsASmallFractionPerProcessor) {
   MachineOptions options;
   options.topology = "hypercube";
   options.nodes = 64;
-  options.threads = 2;
+  options.threads = 1;
   options.cache_pages = 64;
-  auto db = make_db("tetra:5", 1024, 16);
+  auto db = make_db("tetra:7", 1024, 16);
   const std::uint64_t database_bytes = db.header.bytes();
   ASSERT_GT(db.header.page_count, 64u * 8u);
   const auto result = nodes::run_machine(std::move(db), options);
@@ -164,7 +177,7 @@ TEST(Machine, LargeSceneOn64NodesKeepsASmallFractionPerProcessor) {
     EXPECT_LE(node.peak_resident_bytes, node.own_bytes + 64u * 1024u);
     EXPECT_LT(static_cast<double>(node.peak_resident_bytes), 0.1 * static_cast<double>(database_bytes));
   }
-  EXPECT_TRUE(same_bits(result.image.pixels(), cached_reference("tetra:5", 16)));
+  EXPECT_TRUE(same_bits(result.image.pixels(), cached_reference("tetra:7", 16)));
 }
 
 TEST(Machine, MissRatioFallsAsTheCacheGrowsAndVanishesWhenItHoldsEverything) {
@@ -172,7 +185,7 @@ TEST(Machine, MissRatioFallsAsTheCacheGrowsAndVanishesWhenItHoldsEverything) {
   // so LRU's inclusion property makes misses non-increasing in cache size.
   double previous = 1.0;
   for (std::uint32_t cache : {1u, 2u, 4u, 16u, 64u, 0u}) {
-    const auto result = run_case({"hypercube", 4, cache, 256, 4, Schedule::static_split, 1, 2});
+    const auto result = run_case({"hypercube", 4, cache, 256, 4, Schedule::static_split, 1, 1});
     const auto svm = result.report.svm();
     EXPECT_LE(svm.miss_ratio(), previous) << "cache " << cache;
     previous = svm.miss_ratio();
@@ -191,7 +204,7 @@ TEST(Machine, MissRatioFallsAsTheCacheGrowsAndVanishesWhenItHoldsEverything) {
 }
 
 TEST(Machine, PageCommunicationsEqualMissesWithSharedCaches) {
-  const auto result = run_case({"mesh", 9, 2, 256, 2, Schedule::dynamic, 3, 2});
+  const auto result = run_case({"mesh", 9, 2, 256, 2, Schedule::dynamic, 3, 1});
   EXPECT_EQ(result.report.served().pages_served, result.report.svm().misses);
   EXPECT_EQ(result.report.served().bytes_served, result.report.svm().misses * 256u);
 }
