@@ -20,8 +20,6 @@ namespace detail {
 
 namespace {
 
-thread_local bool on_runtime_thread = false;  // the thread runs a csp::Scheduler
-
 struct Failure {
   std::string process;
   std::exception_ptr error;
@@ -68,7 +66,7 @@ Ending run_body(const std::function<void()>& body, std::exception_ptr& error) {
 
 // Binds the calling fiber to its process record (or unbinds it with null).
 void bind_fiber(Process* p) {
-  if (!on_runtime_thread) return;
+  if (!thread_scheduler()) return;
   if (auto* props = boost::fibers::context::active()->get_properties()) {
     static_cast<ProcessProps*>(props)->process = p;
   }
@@ -79,12 +77,6 @@ boost::fibers::fiber start_fiber(std::size_t stack_size, std::function<void()> f
 }
 
 }  // namespace
-
-Process* current_process() {
-  if (!on_runtime_thread) return nullptr;
-  auto* props = boost::fibers::context::active()->get_properties();
-  return props ? static_cast<ProcessProps*>(props)->process : nullptr;
-}
 
 // A process placed on a thread but not started yet.
 struct Spawn {
@@ -149,9 +141,10 @@ struct Runtime::Impl {
 };
 
 void Runtime::Impl::worker_main(unsigned index, std::barrier<>& finished) {
-  detail::on_runtime_thread = true;
   Scheduler* algo = options.scheduler ? options.scheduler(index) : new FifoScheduler;
-  boost::fibers::context::active()->get_scheduler()->set_algo(boost::fibers::algo::algorithm::ptr_t(algo));
+  boost::fibers::scheduler* scheduler = boost::fibers::context::active()->get_scheduler();
+  scheduler->set_algo(boost::fibers::algo::algorithm::ptr_t(algo));
+  detail::set_thread_scheduler(scheduler);
   std::vector<boost::fibers::fiber> fibers;
   Worker& w = *workers[index];
   for (bool stop = false; !stop;) {
@@ -173,7 +166,7 @@ void Runtime::Impl::worker_main(unsigned index, std::barrier<>& finished) {
   // waking it; the scheduler dies with the thread, so wait for every thread
   // to finish its fibers first.
   finished.arrive_and_wait();
-  detail::on_runtime_thread = false;
+  detail::set_thread_scheduler(nullptr);
 }
 
 boost::fibers::fiber Runtime::Impl::launch(Spawn s) {

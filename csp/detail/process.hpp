@@ -19,6 +19,8 @@
 #include <string>
 #include <vector>
 
+#include <boost/fiber/scheduler.hpp>
+
 #include "csp/detail/wait.hpp"
 
 namespace csp::detail {
@@ -64,6 +66,13 @@ class Tracker {
 
 // The process the calling fiber runs, or null outside a Runtime.
 Process* current_process();
+// The process fiber ctx runs (ctx: the calling fiber's context).
+Process* process_of(boost::fibers::context* ctx);
+
+// The scheduler of the calling runtime thread (null on other threads); a
+// runtime thread sets it on start and clears it on exit.
+boost::fibers::scheduler* thread_scheduler();
+void set_thread_scheduler(boost::fibers::scheduler* s);
 
 }  // namespace csp::detail
 

@@ -4,6 +4,7 @@
 #include <cstdint>
 
 #include "csp/detail/process.hpp"
+#include "csp/scheduler.hpp"
 
 namespace csp::detail {
 
@@ -17,6 +18,10 @@ std::intptr_t timed_token(const Waiter& w) { return reinterpret_cast<std::intptr
 // Contexts on other threads, claimed under a lock still held. Emptied before
 // the fiber suspends, so it never carries over to another fiber.
 thread_local std::vector<boost::fibers::context*> deferred_wakes;
+
+// Cached here because context::active() is a costly TLS lookup in Boost's
+// shared library, and a thread's scheduler never changes.
+thread_local boost::fibers::scheduler* runtime_scheduler = nullptr;
 
 }  // namespace
 
@@ -77,9 +82,10 @@ void complete(Waiter& w, WaitState outcome, std::size_t fired) {
   std::intptr_t expected = token;
   if (ctx->twstatus.compare_exchange_strong(expected, -1, std::memory_order_acq_rel) || expected == 0) {
     // Safe to defer: ctx stays parked until it is scheduled.
-    boost::fibers::context* self = boost::fibers::context::active();
-    if (self->get_scheduler() == ctx->get_scheduler()) {
-      self->schedule(ctx);
+    boost::fibers::scheduler* local = runtime_scheduler;
+    if (!local) local = boost::fibers::context::active()->get_scheduler();
+    if (ctx->get_scheduler() == local) {
+      local->schedule(ctx);
     } else {
       deferred_wakes.push_back(ctx);
     }
@@ -88,9 +94,22 @@ void complete(Waiter& w, WaitState outcome, std::size_t fired) {
 
 void flush_wakes() {
   if (deferred_wakes.empty()) return;
-  boost::fibers::context* self = boost::fibers::context::active();
-  for (boost::fibers::context* ctx : deferred_wakes) self->schedule(ctx);
+  for (boost::fibers::context* ctx : deferred_wakes) ctx->get_scheduler()->schedule_from_remote(ctx);
   deferred_wakes.clear();
+}
+
+boost::fibers::scheduler* thread_scheduler() { return runtime_scheduler; }
+void set_thread_scheduler(boost::fibers::scheduler* s) { runtime_scheduler = s; }
+
+Process* process_of(boost::fibers::context* ctx) {
+  if (!runtime_scheduler) return nullptr;
+  auto* props = ctx->get_properties();
+  return props ? static_cast<ProcessProps*>(props)->process : nullptr;
+}
+
+Process* current_process() {
+  if (!runtime_scheduler) return nullptr;
+  return process_of(boost::fibers::context::active());
 }
 
 // Both parks release the lock themselves before suspending (rather than
@@ -101,7 +120,7 @@ void flush_wakes() {
 WaitState park(Waiter& w, SpinlockLock& lk) {
   boost::fibers::context* ctx = boost::fibers::context::active();
   w.ctx = ctx;
-  Process* p = current_process();
+  Process* p = process_of(ctx);
   if (p) {
     const bool runnable = !p->tracker->aborting() && p->tracker->block(*p, w);
     if (!runnable && w.abortable) {
