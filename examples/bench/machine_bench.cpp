@@ -1,0 +1,115 @@
+// machine_bench: wall time of the VM_pRAY machine (shared virtual memory,
+// dynamic farming, hypercube network) against the same renderer over one
+// shared in-memory database with plain std::threads pulling rows, measured
+// side by side on the same threads; and the speedup of T threads over 1.
+//
+// usage: machine_bench [SCENE [SIZE [THREADS]]]   default: teapot 512 2
+#include <atomic>
+#include <chrono>
+#include <cstdio>
+#include <cstring>
+#include <exception>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "nodes/machine.hpp"
+#include "tracer/generators.hpp"
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+tracer::Database make_db(const std::string& spec, int size) {
+  tracer::Scene scene = tracer::generate_scene(spec);
+  scene.camera.width = size;
+  scene.camera.height = size;
+  return tracer::build_database(scene);
+}
+
+// Rows pulled from a shared counter by plain threads over one database.
+double shared_memory_seconds(const tracer::Database& db, unsigned threads, std::vector<tracer::Color>& image) {
+  const int w = db.header.camera.width, h = db.header.camera.height;
+  image.assign(static_cast<std::size_t>(w) * static_cast<std::size_t>(h), {});
+  std::atomic<int> next_row{0};
+  const auto start = Clock::now();
+  std::vector<std::thread> pool;
+  for (unsigned t = 0; t < threads; ++t)
+    pool.emplace_back([&] {
+      tracer::InMemoryPageSource pages(db);
+      tracer::Tracer tracer(db.header, pages);
+      tracer::RayStats stats;
+      for (int y = next_row++; y < h; y = next_row++)
+        for (int x = 0; x < w; ++x) image[static_cast<std::size_t>(y) * w + x] = tracer.trace_pixel(x, y, stats);
+    });
+  for (auto& t : pool) t.join();
+  return std::chrono::duration<double>(Clock::now() - start).count();
+}
+
+struct MachineRun {
+  double seconds = -1;  // < 0: failed
+  double miss_ratio = 0;
+  bool same_image = false;
+  std::string error;
+};
+
+MachineRun machine_seconds(const std::string& spec, int size, int nodes, unsigned threads,
+                           const std::vector<tracer::Color>& reference) {
+  MachineRun run;
+  try {
+    auto db = make_db(spec, size);
+    nodes::MachineOptions options;
+    options.topology = "hypercube";
+    options.nodes = static_cast<std::size_t>(nodes);
+    options.threads = threads;
+    options.cache_pages = std::max<std::uint32_t>(1, db.header.page_count / 8);
+    const auto result = nodes::run_machine(std::move(db), options);
+    run.seconds = result.report.wall_seconds;
+    run.miss_ratio = result.report.svm().miss_ratio();
+    const auto& px = result.image.pixels();
+    run.same_image = px.size() == reference.size() &&
+                     std::memcmp(px.data(), reference.data(), px.size() * sizeof(tracer::Color)) == 0;
+  } catch (const std::exception& e) {
+    run.error = e.what();
+    run.error = run.error.substr(0, run.error.find('\n'));
+  }
+  return run;
+}
+
+void print_run(const char* label, const MachineRun& r, double baseline) {
+  if (r.seconds < 0) {
+    std::printf("%-34s failed: %s\n", label, r.error.c_str());
+    return;
+  }
+  std::printf("%-34s %8.3f s   ratio to shared memory %5.2fx   miss ratio %.4f   image %s\n", label, r.seconds,
+              r.seconds / baseline, r.miss_ratio, r.same_image ? "identical" : "DIFFERS");
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  const std::string spec = argc > 1 ? argv[1] : "teapot";
+  const int size = argc > 2 ? std::stoi(argv[2]) : 512;
+  const unsigned threads = argc > 3 ? static_cast<unsigned>(std::stoul(argv[3])) : 2u;
+  const auto db = make_db(spec, size);
+  std::printf("scene %s at %dx%d, %u database pages of %u bytes, cache = 1/8 of the database per node\n",
+              spec.c_str(), size, size, db.header.page_count, db.header.page_size);
+
+  std::vector<tracer::Color> image;
+  const double shared1 = shared_memory_seconds(db, 1, image);
+  const double shared_t = shared_memory_seconds(db, threads, image);
+  std::printf("shared memory, 1 thread          %8.3f s\n", shared1);
+  std::printf("shared memory, %u threads         %8.3f s   speedup %.2fx\n", threads, shared_t, shared1 / shared_t);
+
+  for (int nodes : {16, 64}) {
+    const MachineRun one = machine_seconds(spec, size, nodes, 1, image);
+    const MachineRun many = machine_seconds(spec, size, nodes, threads, image);
+    const std::string l1 = "machine hypercube " + std::to_string(nodes) + ", 1 thread";
+    const std::string lt = "machine hypercube " + std::to_string(nodes) + ", " + std::to_string(threads) + " threads";
+    print_run(l1.c_str(), one, shared1);
+    print_run(lt.c_str(), many, shared_t);
+    if (one.seconds > 0 && many.seconds > 0)
+      std::printf("  speedup of %u threads over 1: %.2fx\n", threads, one.seconds / many.seconds);
+  }
+  return 0;
+}
