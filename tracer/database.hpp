@@ -172,13 +172,17 @@ struct Database {
 Database build_database(const Scene& scene, const BuildOptions& options = {});
 
 // The single-process page source: every page in memory, shared read-only.
+// It keeps a flat table of page addresses: one load per page() call.
 class InMemoryPageSource final : public PageSource {
  public:
-  explicit InMemoryPageSource(const Database& db) : pages_(&db.pages) {}
-  const std::byte* page(PageId id) override { return (*pages_)[id].data(); }
+  explicit InMemoryPageSource(const Database& db) {
+    pages_.reserve(db.pages.size());
+    for (const auto& p : db.pages) pages_.push_back(p.data());
+  }
+  const std::byte* page(PageId id) override { return pages_[id]; }
 
  private:
-  const std::vector<std::vector<std::byte>>* pages_;
+  std::vector<const std::byte*> pages_;
 };
 
 }  // namespace tracer

@@ -136,7 +136,8 @@ inline void lane_refs(const std::byte* node, std::uint32_t child[4], std::uint32
 }  // namespace
 
 template <bool Any>
-bool Tracer::traverse_bvh(const Ray& ray, float t_min, float& t_max, Hit* hit, RayStats& stats) {
+bool Tracer::traverse_bvh(const Ray& ray, float t_min, float& t_max_io, Hit* hit, RayStats& stats) {
+  float t_max = t_max_io;  // a local, so stores to the stack or the hit need not reload it
   const RayInverse inv(ray);
   const bool negative[3] = {inv.inv_dir.x < 0, inv.inv_dir.y < 0, inv.inv_dir.z < 0};
   bool found = false;
@@ -164,6 +165,7 @@ bool Tracer::traverse_bvh(const Ray& ray, float t_min, float& t_max, Hit* hit, R
       do {
         if (sp == 0) {
           stats.box_tests += box_tests;
+          t_max_io = t_max;
           return found;
         }
         e = stack_[--sp];
@@ -176,6 +178,7 @@ bool Tracer::traverse_bvh(const Ray& ray, float t_min, float& t_max, Hit* hit, R
         if (test_prim<Any>(e.child + k, ray, t_min, t_max, hit, stats)) {
           if (Any) {
             stats.box_tests += box_tests;
+            t_max_io = t_max;
             return true;
           }
           found = true;
