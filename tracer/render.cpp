@@ -151,12 +151,14 @@ bool Tracer::traverse_bvh(const Ray& ray, float t_min, float& t_max_io, Hit* hit
     unsigned mask = slab_test4(node, ray, inv, negative, t_min, t_max, t);
     std::uint32_t child[4], count[4];
     lane_refs(node, child, count);
-    // Stack the lanes met, farthest first, so the nearest is popped next.
+    // Stack the lanes met, farthest first, so the nearest is popped next
+    // (any-hit rays need no order).
     const std::size_t base = sp;
     for (; mask; mask &= mask - 1) {
       const int lane = std::countr_zero(mask);
       std::size_t k = sp++;
-      for (; k > base && stack_[k - 1].t < t[lane]; --k) stack_[k] = stack_[k - 1];
+      if constexpr (!Any)
+        for (; k > base && stack_[k - 1].t < t[lane]; --k) stack_[k] = stack_[k - 1];
       stack_[k] = {child[lane], count[lane], t[lane]};
     }
     // Run leaves and pop until the next inner node.
