@@ -19,7 +19,10 @@
 //    packing, so the floats the tracer computes with do not depend on page size.
 //
 // PageSource contract: the pointer returned by page(id) is valid only until
-// the next call to page() on the same source; readers memcpy records out.
+// the next call to page() on the same source; readers copy out (memcpy) what
+// they need before their next page() call and never keep a page pointer
+// across one. So a source may evict any page inside page() (a one-page cache
+// is enough), and fibers sharing a node's cache may switch inside page().
 #pragma once
 
 #include <cstddef>
