@@ -38,8 +38,8 @@ void PixelComputer::run() {
     if (static_cast<MessageKind>(answer.kind) == MessageKind::stop) break;
     const Tile tile = decode_tile(answer.payload);
     compute(tile);
+    source_.release();  // before the hook too: it may suspend this fiber
     if (after_tile_) after_tile_();
-    source_.release();
     out_.send(make_packet(0, Ports::collector, MessageKind::result, encode_result(tile, colors_)));
   }
   out_.send(make_packet(0, Ports::farmer, MessageKind::worker_done));
