@@ -15,6 +15,7 @@ using detail::WaitState;
 
 std::size_t Alt::add(Guard g) {
   guards_.push_back(std::move(g));
+  dirty_ = true;
   return guards_.size() - 1;
 }
 
@@ -22,6 +23,7 @@ void Alt::enable(std::size_t guard, bool on) {
   if (guard >= guards_.size()) {
     throw std::out_of_range("Alt::enable: no guard " + std::to_string(guard));
   }
+  if (guards_[guard].enabled != on) dirty_ = true;
   guards_[guard].enabled = on;
 }
 
@@ -34,26 +36,11 @@ std::size_t Alt::select() {
 std::size_t Alt::pri_select() { return select_from(0); }
 
 std::size_t Alt::select_from(std::size_t first) {
-  // Collect the enabled channels and the earliest enabled timeout.
-  const Clock::time_point start = Clock::now();
-  channels_.clear();
-  std::size_t timeout_guard = none;
-  bool any_ready_kind = false;
-  for (std::size_t i = 0; i < guards_.size(); ++i) {
-    const Guard& g = guards_[i];
-    if (!g.enabled) continue;
-    if (g.kind == Kind::input) channels_.push_back(g.channel.get());
-    if (g.kind == Kind::skip) any_ready_kind = true;
-    if (g.kind == Kind::timeout && (timeout_guard == none || g.after < guards_[timeout_guard].after)) {
-      timeout_guard = i;
-    }
-  }
-  if (channels_.empty() && timeout_guard == none && !any_ready_kind) {
+  if (dirty_) prepare();
+  if (channels_.empty() && timeout_guard_ == none && !has_skip_) {
     throw std::logic_error("Alt::select: every guard is disabled (occam STOP)");
   }
-  std::sort(channels_.begin(), channels_.end(), std::less<>());
-  channels_.erase(std::unique(channels_.begin(), channels_.end()), channels_.end());
-
+  const Clock::time_point start = timeout_guard_ == none ? Clock::time_point() : Clock::now();
   lock_channels();
   const std::size_t ready = poll_locked(first);
   if (ready != none) {
@@ -61,8 +48,28 @@ std::size_t Alt::select_from(std::size_t first) {
     return ready;
   }
   const Clock::time_point deadline =
-      timeout_guard == none ? Clock::time_point::max() : start + guards_[timeout_guard].after;
-  return wait_locked(timeout_guard, deadline);
+      timeout_guard_ == none ? Clock::time_point::max() : start + guards_[timeout_guard_].after;
+  return wait_locked(timeout_guard_, deadline);
+}
+
+// Derives from the enabled guards what every select needs: the distinct
+// channels in address order (the locking order), the earliest timeout, SKIP.
+void Alt::prepare() {
+  channels_.clear();
+  timeout_guard_ = none;
+  has_skip_ = false;
+  for (std::size_t i = 0; i < guards_.size(); ++i) {
+    const Guard& g = guards_[i];
+    if (!g.enabled) continue;
+    if (g.kind == Kind::input) channels_.push_back(g.channel.get());
+    if (g.kind == Kind::skip) has_skip_ = true;
+    if (g.kind == Kind::timeout && (timeout_guard_ == none || g.after < guards_[timeout_guard_].after)) {
+      timeout_guard_ = i;
+    }
+  }
+  std::sort(channels_.begin(), channels_.end(), std::less<>());
+  channels_.erase(std::unique(channels_.begin(), channels_.end()), channels_.end());
+  dirty_ = false;
 }
 
 std::size_t Alt::poll_locked(std::size_t first) const {

@@ -51,6 +51,7 @@ class Alt {
 
   std::size_t add(Guard g);
   std::size_t select_from(std::size_t first);
+  void prepare();
   std::size_t poll_locked(std::size_t first) const;
   std::size_t wait_locked(std::size_t timeout_guard, detail::Clock::time_point deadline);
   void lock_channels();
@@ -60,10 +61,12 @@ class Alt {
 
   std::vector<Guard> guards_;
   std::size_t favourite_ = 0;
-  // Scratch reused by every select: distinct enabled channels in address
-  // order, and one record per enabled input guard.
-  std::vector<detail::ChannelBase*> channels_;
-  std::vector<detail::Record> records_;
+  // Derived from the enabled guards by prepare(), again only after a change.
+  bool dirty_ = true;
+  std::vector<detail::ChannelBase*> channels_;  // distinct, in address order
+  std::size_t timeout_guard_ = none;            // earliest enabled timeout
+  bool has_skip_ = false;
+  std::vector<detail::Record> records_;         // scratch: one per enabled input
 };
 
 }  // namespace csp

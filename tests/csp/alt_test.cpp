@@ -89,6 +89,30 @@ TEST(Alt, DisabledGuardIsNeverChosen) {
   EXPECT_EQ(chosen, std::vector<std::size_t>(5, 1));
 }
 
+TEST(Alt, GuardsMayChangeBetweenSelects) {
+  csp::Channel<int> a("a", 4);
+  csp::Channel<int> b("b", 4);
+  for (int i = 0; i < 4; ++i) {
+    a.writer().write(i);
+    b.writer().write(i);
+  }
+  csp::Alt alt;
+  auto ia = a.reader();
+  auto ib = b.reader();
+  alt.add_input(ia);
+  alt.add_input(ib);
+  alt.enable(0, false);
+  EXPECT_EQ(alt.pri_select(), 1u);
+  ib.read();
+  alt.enable(0, true);
+  EXPECT_EQ(alt.pri_select(), 0u);
+  ia.read();
+  const std::size_t skip = alt.add_skip();
+  alt.enable(0, false);
+  alt.enable(1, false);
+  EXPECT_EQ(alt.pri_select(), skip);
+}
+
 TEST(Alt, AllGuardsDisabledIsAnError) {
   csp::Channel<int> c("c");
   csp::Alt alt;
