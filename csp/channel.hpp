@@ -13,6 +13,8 @@
 // - At most one of (parked readers, parked writers with data) is non-empty.
 // - Poison is permanent and wakes every waiter; every later operation on
 //   either end throws Poisoned, even with values still buffered.
+// - try_write on a rendezvous channel succeeds only if a reader is parked in
+//   read(); a parked ALT would still have to run before taking the value.
 // Who wakes whom: writers wake readers (and fire ALTs), readers wake writers,
 // poison wakes both; see detail/wait.hpp for the claiming rules.
 #pragma once
@@ -199,7 +201,7 @@ class Channel {
 template <class T>
 class In {
  public:
-  In() = default;
+  In() = default;  // unbound: assign an end from a Channel before use
   T read() { return state_->read(); }
   std::optional<T> try_read() { return state_->try_read(); }
   std::optional<T> read_for(std::chrono::steady_clock::duration d) {
@@ -219,7 +221,7 @@ class In {
 template <class T>
 class Out {
  public:
-  Out() = default;
+  Out() = default;  // unbound: assign an end from a Channel before use
   void write(T value) { state_->write(std::move(value)); }
   bool try_write(T& value) { return state_->try_write(value); }
   bool poisoned() const { return state_->poisoned(); }

@@ -138,6 +138,7 @@ struct Runtime::Impl {
   std::mutex failures_mutex;
   std::vector<Failure> failures;  // guarded by failures_mutex
   bool started = false;
+  bool finished = false;  // every thread has exited: nothing can start any more
 };
 
 void Runtime::Impl::worker_main(unsigned index, std::barrier<>& finished) {
@@ -192,6 +193,7 @@ Runtime::~Runtime() = default;
 unsigned Runtime::threads() const { return impl_->options.threads; }
 
 void Runtime::spawn(std::string name, unsigned thread, std::function<void()> body) {
+  if (impl_->finished) throw std::logic_error("Runtime::spawn: the run has ended, '" + name + "' cannot start");
   auto p = std::make_shared<Process>();
   p->name = std::move(name);
   p->thread = thread % threads();
@@ -203,13 +205,17 @@ void Runtime::spawn(std::string name, unsigned thread, std::function<void()> bod
 void Runtime::run() {
   if (impl_->started) throw std::logic_error("Runtime::run: a Runtime runs once");
   impl_->started = true;
-  if (impl_->tracker.alive() == 0) return;
+  if (impl_->tracker.alive() == 0) {
+    impl_->finished = true;
+    return;
+  }
   std::vector<std::thread> threads;
   std::barrier<> finished(impl_->options.threads);
   for (unsigned i = 0; i < impl_->options.threads; ++i) {
     threads.emplace_back([this, i, &finished] { impl_->worker_main(i, finished); });
   }
   for (std::thread& t : threads) t.join();
+  impl_->finished = true;
 
   std::string dump = impl_->tracker.deadlock_dump();
   if (!dump.empty()) {

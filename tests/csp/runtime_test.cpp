@@ -30,6 +30,14 @@ TEST(Runtime, RunWithoutProcessesReturns) {
   csp::Runtime rt(2);
   rt.run();
   EXPECT_THROW(rt.run(), std::logic_error);
+  EXPECT_THROW(rt.spawn("late", 0, [] {}), std::logic_error);
+}
+
+TEST(Runtime, SpawnAfterTheRunIsAnError) {
+  csp::Runtime rt(1);
+  rt.spawn("only", 0, [] {});
+  rt.run();
+  EXPECT_THROW(rt.spawn("late", 0, [] {}), std::logic_error);
 }
 
 TEST(Runtime, ProcessesKnowTheirNames) {
