@@ -10,6 +10,7 @@
 #include "app/report.hpp"
 #include "app/scene_input.hpp"
 #include "app/single.hpp"
+#include "app/sweep.hpp"
 
 namespace {
 
@@ -35,6 +36,7 @@ bool has_image_extension(const std::string& path) {
 }  // namespace
 
 int main(int argc, char** argv) {
+  if (argc > 1 && std::string(argv[1]) == "sweep") return app::sweep_main(argc - 1, argv + 1);
   app::Options options;
   try {
     options = app::parse_options(argc, argv);

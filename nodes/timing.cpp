@@ -23,9 +23,11 @@ using Seconds = std::chrono::duration<double>;
 // software page-table look-up about a fifth. Only their ratio matters here:
 // `unit` is fitted to Teapot on one node (Table 2: 3h12mn2s at 512x512).
 constexpr double ipsc2_box = 1.0, ipsc2_prim = 2.0, ipsc2_shade = 5.0, ipsc2_page = 0.2;
-// Fitted: `vmpray sweep nodes --scene teapot --nodes 1 --profile ipsc2
-// --fit-seconds 11522` (see app/experiments.hpp).
-constexpr double ipsc2_unit = 14.6e-6;
+// Fitted by `vmpray sweep nodes teapot --size 512 --nodes 1 --cache-pages 3072
+// --fit-seconds 11522` (Teapot, 3h12mn2s on one node; see app/experiments.hpp).
+constexpr double ipsc2_unit = 377.935e-6;
+// The virtual clock counts picoseconds in 64 bits: about 106 days.
+constexpr double max_virtual_seconds = 9e6;
 
 double time_seconds(const std::string& text) {
   static const std::pair<const char*, double> units[] = {
@@ -226,6 +228,9 @@ void ComputeMeter::charge() {
   // Work is cumulative in the counters: price the totals, then give the clock
   // the difference, so rounding to picoseconds never accumulates.
   charged_ = model_.compute_seconds(rays_) + cpu_->stolen / cpu_->workers;
+  if (!(charged_ < max_virtual_seconds))
+    throw std::overflow_error("virtual time beyond " + std::to_string(max_virtual_seconds) +
+                              " s: the cost model is far too slow");
   const auto total_ps = static_cast<std::int64_t>(std::llround(charged_ * 1e12));
   const std::int64_t step = total_ps - charged_ps_;
   charged_ps_ = total_ps;

@@ -1,0 +1,59 @@
+// The paper's experiments as functions: one machine run in virtual time
+// reduced to the figures the paper reports (synthesis time, speedup,
+// efficiency, miss ratio, page communications), and the fit of the compute
+// constant to a published time.
+//
+// Every point is a deterministic virtual-time run (nodes/timing.hpp), so a
+// point's figures depend only on its inputs. Speedup and efficiency are
+// against the same scene on one node under the same model: E = T1 / (N * TN).
+#pragma once
+
+#include <cstdint>
+#include <optional>
+#include <string>
+
+#include "nodes/machine.hpp"
+#include "nodes/timing.hpp"
+#include "tracer/database.hpp"
+
+namespace app {
+
+struct ExperimentSetup {
+  std::string topology = "hypercube";
+  std::size_t nodes = 1;
+  std::optional<std::uint32_t> cache_pages;  // default: the machine's (1/8 of the database)
+  std::uint32_t grain = 4;
+  nodes::CostModel model = nodes::ipsc2_profile();
+};
+
+struct ExperimentPoint {
+  std::string topology;      // canonical spec
+  int nodes = 0;
+  std::uint32_t cache_pages = 0;
+  double predicted_seconds = 0;
+  double wall_seconds = 0;
+  double serial_seconds = 0;  // T1 under the same model (0 if not known)
+  std::uint64_t rays = 0;
+  std::uint64_t page_accesses = 0;
+  std::uint64_t misses = 0;           // page requests sent
+  double miss_ratio = 0;
+  double pages_per_pixel = 0;         // distinct pages touched per sample, as in Table 1
+  double mean_hops = 0;
+  std::uint64_t messages = 0;
+
+  double speedup() const { return predicted_seconds > 0 ? serial_seconds / predicted_seconds : 0; }
+  double efficiency() const { return nodes > 0 ? speedup() / nodes : 0; }
+};
+
+// One run of db's frame under setup; db is copied (the machine consumes its copy).
+ExperimentPoint run_point(const tracer::Database& db, const ExperimentSetup& setup);
+
+// The unit that makes db's one-node run take `seconds` under model: compute
+// time is proportional to unit and the one-node run has no remote pages, so
+// two runs (a probe unit, and unit 0 for the message time) fix it.
+double fit_unit(const tracer::Database& db, const nodes::CostModel& model, double seconds);
+
+// "3h12mn2s" as in the paper's Table 2 (also "51mn32s", "4.2s" below a minute).
+std::string paper_duration(double seconds);
+
+}  // namespace app

@@ -1,0 +1,182 @@
+// `vmpray sweep`: option parsing, the runs, and the tables, plots and page
+// they produce (see sweep.hpp).
+#include "app/sweep.hpp"
+
+#include <boost/program_options.hpp>
+#include <iomanip>
+#include <iostream>
+#include <sstream>
+
+#include "app/options.hpp"
+#include "app/scene_input.hpp"
+
+namespace app {
+
+namespace po = boost::program_options;
+
+namespace {
+
+template <class T>
+std::vector<T> parse_list(const std::string& text, const std::string& option) {
+  std::vector<T> values;
+  std::istringstream items(text);
+  for (std::string item; std::getline(items, item, ',');) {
+    std::size_t used = 0;
+    long long v = -1;
+    try {
+      v = std::stoll(item, &used);
+    } catch (const std::exception&) {
+      used = 0;
+    }
+    if (used != item.size() || v < 1) throw UsageError(option + ": expected positive integers, got '" + item + "'");
+    values.push_back(static_cast<T>(v));
+  }
+  if (values.empty()) throw UsageError(option + ": empty list");
+  return values;
+}
+
+std::vector<std::string> split(const std::string& text) {
+  std::vector<std::string> parts;
+  std::istringstream items(text);
+  for (std::string item; std::getline(items, item, ',');)
+    if (!item.empty()) parts.push_back(item);
+  return parts;
+}
+
+struct RawSweep {
+  std::string kind, topologies = "hypercube", nodes, cache, profile = "ipsc2", costs, out;
+};
+
+po::options_description describe(SweepOptions& o, RawSweep& raw) {
+  po::options_description d("Sweep options");
+  d.add_options()
+      ("help,h", "show this help and exit")
+      ("scene", po::value(&o.scene), "scene: NFF file or built-in (teapot, mountain, rings4, ...)")
+      ("size", po::value(&o.size), "image width and height in pixels (default 64; the paper: 512)")
+      ("page-size", po::value(&o.page_size), "database page size in bytes (default 1024)")
+      ("topology", po::value(&raw.topologies), "topologies, comma-separated (default hypercube)")
+      ("nodes", po::value(&raw.nodes), "processor counts, comma-separated (nodes: default 1,2,...,64; cache: 16)")
+      ("cache-pages", po::value(&raw.cache), "cache sizes in pages, comma-separated (cache: the axis)")
+      ("grain", po::value(&o.grain), "pixels per work item (default 4)")
+      ("profile", po::value(&raw.profile), "machine profile: ipsc2, native, or a key = value file")
+      ("cost", po::value(&raw.costs), "costs over the profile: box=..,prim=..,shade=..,page=..,serve=..,hop=..,bw=..")
+      ("fit-seconds", po::value(&o.fit_seconds), "fit the compute unit so the one-node run takes this long")
+      ("out", po::value(&raw.out), "output directory (default sweep-KIND)")
+      ("quiet,q", po::bool_switch(&o.quiet), "print nothing but errors");
+  return d;
+}
+
+nodes::CostModel model_from(const std::string& profile, const std::string& costs) {
+  nodes::CostModel model;
+  try {
+    model = profile == "ipsc2" || profile == "native" ? nodes::profile_named(profile)
+                                                      : nodes::read_profile_file(profile);
+    if (!costs.empty()) nodes::apply_costs(model, costs, "--cost");
+  } catch (const std::invalid_argument& e) {
+    throw UsageError(e.what());
+  }
+  return model;
+}
+
+void check_sweep(SweepOptions& o, const RawSweep& raw) {
+  if (raw.kind == "nodes") o.kind = SweepOptions::Kind::nodes;
+  else if (raw.kind == "cache") o.kind = SweepOptions::Kind::cache;
+  else throw UsageError("sweep: expected 'nodes' or 'cache', got '" + raw.kind + "'");
+  if (o.size < 1 || o.size > 4096) throw UsageError("--size: expected 1..4096");
+  if (o.grain < 1) throw UsageError("--grain: expected at least 1");
+  if (o.fit_seconds < 0) throw UsageError("--fit-seconds: expected a positive time");
+  o.topologies = split(raw.topologies);
+  if (o.topologies.empty()) throw UsageError("--topology: empty list");
+  if (!raw.nodes.empty()) o.nodes = parse_list<std::size_t>(raw.nodes, "--nodes");
+  else if (o.kind == SweepOptions::Kind::cache) o.nodes = {16};
+  if (!raw.cache.empty()) o.cache_pages = parse_list<std::uint32_t>(raw.cache, "--cache-pages");
+  else if (o.kind == SweepOptions::Kind::cache) o.cache_pages = {8, 16, 32, 64, 128, 256, 512};
+  o.out_dir = raw.out.empty() ? "sweep-" + raw.kind : raw.out;
+}
+
+tracer::Database load_database(const SweepOptions& o) {
+  Options render;
+  render.scene = o.scene;
+  render.width = o.size;
+  render.height = o.size;
+  render.page_size = o.page_size;
+  return tracer::build_database(load_scene(render), {.accel = tracer::Accel::bvh, .page_size = o.page_size});
+}
+
+std::string fixed(double v, int digits) {
+  std::ostringstream out;
+  out << std::fixed << std::setprecision(digits) << v;
+  return out.str();
+}
+
+}  // namespace
+
+SweepOptions parse_sweep_options(int argc, const char* const argv[]) {
+  SweepOptions o;
+  RawSweep raw;
+  po::options_description all = describe(o, raw);
+  all.add_options()("kind", po::value(&raw.kind));
+  po::positional_options_description positional;
+  positional.add("kind", 1).add("scene", 1);
+  po::variables_map vm;
+  try {
+    po::store(po::command_line_parser(argc, argv).options(all).positional(positional).run(), vm);
+    po::notify(vm);
+  } catch (const po::error& e) {
+    throw UsageError(e.what());
+  }
+  if (vm.count("help")) throw UsageError("help");
+  check_sweep(o, raw);
+  o.model = model_from(raw.profile, raw.costs);
+  return o;
+}
+
+std::string sweep_usage() {
+  SweepOptions o;
+  RawSweep raw;
+  std::ostringstream out;
+  out << "Usage: vmpray sweep nodes|cache [SCENE] [options]\n"
+         "  nodes: predicted synthesis time, speedup and efficiency against processors (Table 2)\n"
+         "  cache: efficiency, miss ratio and page communications against cache size (Figure 8)\n"
+         "Runs the machine in virtual time (deterministic) and writes CSV, JSON, SVG, PNG and HTML.\n\n"
+      << describe(o, raw);
+  return out.str();
+}
+
+SweepTable run_sweep(const SweepOptions& o, std::ostream* progress) {
+  const tracer::Database db = load_database(o);
+  SweepTable table;
+  table.kind = o.kind;
+  table.scene = db.header.scene_name.empty() ? o.scene : db.header.scene_name;
+  table.width = db.header.camera.width;
+  table.height = db.header.camera.height;
+  table.page_count = db.header.page_count;
+  table.model = o.model;
+  if (o.fit_seconds > 0) table.model.unit = fit_unit(db, o.model, o.fit_seconds);
+  ExperimentSetup setup;
+  setup.grain = o.grain;
+  setup.model = table.model;
+  setup.nodes = 1;
+  if (!o.cache_pages.empty()) setup.cache_pages = o.cache_pages.front();
+  table.serial_seconds = run_point(db, setup).predicted_seconds;
+  const bool by_nodes = o.kind == SweepOptions::Kind::nodes;
+  for (const std::string& topology : o.topologies) {
+    const std::size_t count = by_nodes ? o.nodes.size() : o.cache_pages.size();
+    for (std::size_t i = 0; i < count; ++i) {
+      setup.topology = topology;
+      setup.nodes = by_nodes ? o.nodes[i] : o.nodes.front();
+      if (!by_nodes) setup.cache_pages = o.cache_pages[i];
+      ExperimentPoint p = run_point(db, setup);
+      p.serial_seconds = table.serial_seconds;
+      if (progress)
+        *progress << p.topology << " N=" << p.nodes << " cache=" << p.cache_pages << ": "
+                  << paper_duration(p.predicted_seconds) << ", efficiency " << fixed(100 * p.efficiency(), 1)
+                  << "%, miss ratio " << fixed(100 * p.miss_ratio, 2) << "% (wall " << fixed(p.wall_seconds, 1)
+                  << " s)\n";
+      table.points.push_back(p);
+    }
+  }
+  return table;
+}
+
+}  // namespace app

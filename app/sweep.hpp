@@ -1,0 +1,62 @@
+// `vmpray sweep nodes|cache`: the paper's experiments, one command each.
+//
+//   sweep nodes  Table 2: predicted synthesis time, speedup and efficiency
+//                against the number of processors, for each topology asked.
+//   sweep cache  Figure 8: efficiency, miss ratio and page communications
+//                against the cache size (pages) for one machine.
+// Each writes DIR/<kind>.csv, DIR/<kind>.json, DIR/<kind>.svg (all panels),
+// one PNG per panel and DIR/<kind>.html (table + plots), and prints the table.
+// Every point is a deterministic virtual-time run; T1 (for speedup and
+// efficiency) is the one-node run of the same scene under the same model.
+#pragma once
+
+#include <filesystem>
+#include <iosfwd>
+#include <string>
+#include <vector>
+
+#include "app/experiments.hpp"
+
+namespace app {
+
+struct SweepOptions {
+  enum class Kind { nodes, cache };
+  Kind kind = Kind::nodes;
+  std::string scene = "teapot";
+  int size = 64;                          // image side in pixels
+  std::uint32_t page_size = 1024;
+  std::vector<std::string> topologies{"hypercube"};
+  std::vector<std::size_t> nodes{1, 2, 4, 8, 16, 32, 64};  // sweep nodes: the axis; cache: the first
+  std::vector<std::uint32_t> cache_pages;  // sweep cache: the axis; nodes: the first (empty: default)
+  std::uint32_t grain = 4;
+  nodes::CostModel model = nodes::ipsc2_profile();
+  double fit_seconds = 0;                 // > 0: fit model.unit so T1 takes this long
+  std::filesystem::path out_dir;          // default: sweep-<kind>
+  bool quiet = false;
+};
+
+struct SweepTable {
+  SweepOptions::Kind kind = SweepOptions::Kind::nodes;
+  std::string scene;
+  int width = 0, height = 0;
+  std::uint32_t page_count = 0;
+  nodes::CostModel model;
+  double serial_seconds = 0;  // T1
+  std::vector<ExperimentPoint> points;
+};
+
+// argv[0] is "sweep". Throws UsageError (options.hpp) for a bad command line.
+SweepOptions parse_sweep_options(int argc, const char* const argv[]);
+std::string sweep_usage();
+
+SweepTable run_sweep(const SweepOptions& options, std::ostream* progress);
+
+std::string sweep_csv(const SweepTable& table);
+std::string sweep_json(const SweepTable& table);
+// Writes csv, json, svg, png panels and html into dir; returns the files written.
+std::vector<std::filesystem::path> write_sweep(const SweepTable& table, const std::filesystem::path& dir);
+
+// The whole subcommand: exit status 0, 1 (run error) or 2 (usage), errors one line on stderr.
+int sweep_main(int argc, const char* const argv[]);
+
+}  // namespace app

@@ -1,0 +1,195 @@
+// What a sweep writes: CSV and JSON tables, the plots (SVG, one PNG per
+// panel), the HTML page, and the subcommand's entry point (see sweep.hpp).
+#include <cmath>
+#include <fstream>
+#include <iomanip>
+#include <iostream>
+#include <map>
+#include <sstream>
+
+#include "app/options.hpp"
+#include "app/sweep.hpp"
+#include "app/viz/plot.hpp"
+#include "app/viz/plot_raster.hpp"
+#include "app/viz/report.hpp"
+
+namespace app {
+
+namespace {
+
+std::string number(double v) {
+  if (!std::isfinite(v)) return "null";
+  std::ostringstream out;
+  out << std::setprecision(10) << v;
+  return out.str();
+}
+
+std::string quoted(const std::string& s) {
+  std::string out = "\"";
+  for (char c : s) {
+    if (c == '"' || c == '\\') out += '\\';
+    if (static_cast<unsigned char>(c) >= 0x20) out += c;
+  }
+  return out + "\"";
+}
+
+const char* const csv_header =
+    "scene,topology,nodes,cache_pages,predicted_seconds,paper_time,speedup,efficiency,miss_ratio,"
+    "page_requests,page_accesses,pages_per_pixel,mean_hops,messages,rays,wall_seconds";
+
+std::string kind_name(SweepOptions::Kind kind) { return kind == SweepOptions::Kind::nodes ? "nodes" : "cache"; }
+
+// One series per topology: y(point) against the sweep's axis.
+std::vector<viz::Series> series_of(const SweepTable& t, double (*y)(const ExperimentPoint&)) {
+  std::map<std::string, std::size_t> index;
+  std::vector<viz::Series> series;
+  for (const ExperimentPoint& p : t.points) {
+    auto [it, fresh] = index.try_emplace(p.topology, series.size());
+    if (fresh) series.push_back(viz::Series{.name = p.topology});
+    const double x = t.kind == SweepOptions::Kind::nodes ? p.nodes : p.cache_pages;
+    series[it->second].points.push_back({x, y(p)});
+  }
+  return series;
+}
+
+std::vector<viz::LinePlot> nodes_plots(const SweepTable& t) {
+  viz::LinePlot time{.title = t.scene + ": predicted synthesis time", .x_label = "processors",
+                     .y_label = "seconds", .x_scale = viz::AxisScale::log2, .y_scale = viz::AxisScale::log10};
+  time.series = series_of(t, [](const ExperimentPoint& p) { return p.predicted_seconds; });
+  viz::LinePlot eff{.title = t.scene + ": efficiency", .x_label = "processors", .y_label = "efficiency (%)",
+                    .x_scale = viz::AxisScale::log2, .y_min = 0.0, .y_max = 105.0};
+  eff.series = series_of(t, [](const ExperimentPoint& p) { return 100 * p.efficiency(); });
+  eff.thresholds.push_back({78, "paper: 78% at 64"});
+  viz::LinePlot speed{.title = t.scene + ": speedup", .x_label = "processors", .y_label = "speedup",
+                      .x_scale = viz::AxisScale::log2, .y_scale = viz::AxisScale::log2};
+  speed.series = series_of(t, [](const ExperimentPoint& p) { return p.speedup(); });
+  viz::Series ideal{.name = "ideal", .style = viz::LineStyle::dashed, .markers = false};
+  for (const auto& p : speed.series.front().points) ideal.points.push_back({p.x, p.x});
+  speed.series.push_back(ideal);
+  return {time, speed, eff};
+}
+
+std::vector<viz::LinePlot> cache_plots(const SweepTable& t) {
+  viz::LinePlot eff{.title = t.scene + ": efficiency", .x_label = "cache (pages)", .y_label = "efficiency (%)",
+                    .x_scale = viz::AxisScale::log2, .y_min = 0.0, .y_max = 105.0};
+  eff.series = series_of(t, [](const ExperimentPoint& p) { return 100 * p.efficiency(); });
+  eff.thresholds.push_back({50, "50% threshold"});
+  viz::LinePlot miss{.title = t.scene + ": miss ratio", .x_label = "cache (pages)", .y_label = "miss ratio (%)",
+                     .x_scale = viz::AxisScale::log2};
+  miss.series = series_of(t, [](const ExperimentPoint& p) { return 100 * p.miss_ratio; });
+  viz::LinePlot comm{.title = t.scene + ": page communications", .x_label = "cache (pages)",
+                     .y_label = "pages sent", .x_scale = viz::AxisScale::log2};
+  comm.series = series_of(t, [](const ExperimentPoint& p) { return double(p.misses); });
+  return {eff, miss, comm};
+}
+
+viz::Table html_table(const SweepTable& t) {
+  viz::Table table{.caption = "Virtual-time runs (" + t.model.describe() + ")",
+                   .header = {"topology", "N", "cache", "predicted", "speedup", "efficiency", "miss ratio",
+                              "page requests", "mean hops", "wall s"}};
+  for (const ExperimentPoint& p : t.points) {
+    std::ostringstream eff, miss, hops, speed, wall;
+    eff << std::fixed << std::setprecision(1) << 100 * p.efficiency() << "%";
+    miss << std::fixed << std::setprecision(2) << 100 * p.miss_ratio << "%";
+    hops << std::fixed << std::setprecision(2) << p.mean_hops;
+    speed << std::fixed << std::setprecision(2) << p.speedup();
+    wall << std::fixed << std::setprecision(1) << p.wall_seconds;
+    table.rows.push_back({p.topology, std::to_string(p.nodes), std::to_string(p.cache_pages),
+                          paper_duration(p.predicted_seconds), speed.str(), eff.str(), miss.str(),
+                          std::to_string(p.misses), hops.str(), wall.str()});
+  }
+  return table;
+}
+
+void write_text(const std::filesystem::path& path, const std::string& text) {
+  std::ofstream out(path, std::ios::binary);
+  out << text;
+  if (!out.flush()) throw std::runtime_error(path.string() + ": cannot write");
+}
+
+}  // namespace
+
+std::string sweep_csv(const SweepTable& t) {
+  std::ostringstream out;
+  out << csv_header << "\n";
+  for (const ExperimentPoint& p : t.points) {
+    out << t.scene << "," << p.topology << "," << p.nodes << "," << p.cache_pages << "," << number(p.predicted_seconds)
+        << "," << paper_duration(p.predicted_seconds) << "," << number(p.speedup()) << "," << number(p.efficiency())
+        << "," << number(p.miss_ratio) << "," << p.misses << "," << p.page_accesses << ","
+        << number(p.pages_per_pixel) << "," << number(p.mean_hops) << "," << p.messages << "," << p.rays << ","
+        << number(p.wall_seconds) << "\n";
+  }
+  return out.str();
+}
+
+std::string sweep_json(const SweepTable& t) {
+  std::ostringstream out;
+  out << "{\n  \"sweep\": " << quoted(kind_name(t.kind)) << ",\n  \"scene\": " << quoted(t.scene)
+      << ",\n  \"width\": " << t.width << ",\n  \"height\": " << t.height << ",\n  \"pages\": " << t.page_count
+      << ",\n  \"cost_model\": " << quoted(t.model.describe()) << ",\n  \"serial_seconds\": "
+      << number(t.serial_seconds) << ",\n  \"points\": [";
+  for (std::size_t i = 0; i < t.points.size(); ++i) {
+    const ExperimentPoint& p = t.points[i];
+    out << (i ? "," : "") << "\n    {\"topology\": " << quoted(p.topology) << ", \"nodes\": " << p.nodes
+        << ", \"cache_pages\": " << p.cache_pages << ", \"predicted_seconds\": " << number(p.predicted_seconds)
+        << ", \"speedup\": " << number(p.speedup()) << ", \"efficiency\": " << number(p.efficiency())
+        << ", \"miss_ratio\": " << number(p.miss_ratio) << ", \"page_requests\": " << p.misses
+        << ", \"page_accesses\": " << p.page_accesses << ", \"pages_per_pixel\": " << number(p.pages_per_pixel)
+        << ", \"mean_hops\": " << number(p.mean_hops) << ", \"messages\": " << p.messages << ", \"rays\": " << p.rays
+        << ", \"wall_seconds\": " << number(p.wall_seconds) << "}";
+  }
+  out << "\n  ]\n}\n";
+  return out.str();
+}
+
+std::vector<std::filesystem::path> write_sweep(const SweepTable& t, const std::filesystem::path& dir) {
+  std::filesystem::create_directories(dir);
+  const std::string stem = kind_name(t.kind);
+  const auto plots = t.kind == SweepOptions::Kind::nodes ? nodes_plots(t) : cache_plots(t);
+  std::vector<std::filesystem::path> files{dir / (stem + ".csv"), dir / (stem + ".json"), dir / (stem + ".svg")};
+  write_text(files[0], sweep_csv(t));
+  write_text(files[1], sweep_json(t));
+  write_text(files[2], viz::plots_svg(plots, static_cast<int>(plots.size())));
+  for (std::size_t i = 0; i < plots.size(); ++i) {
+    files.push_back(dir / (stem + "-" + std::to_string(i + 1) + "-plot.png"));
+    viz::plot_image(plots[i]).write_image(files.back().string());
+  }
+  viz::Report report{.title = "vmpray sweep " + stem + ": " + t.scene};
+  viz::Section section{.heading = t.scene + " at " + std::to_string(t.width) + "x" + std::to_string(t.height) +
+                                  ", " + std::to_string(t.page_count) + " pages"};
+  section.blocks.push_back(viz::Paragraph{"T1 (one node, same model) = " + paper_duration(t.serial_seconds) +
+                                          "; efficiency = T1 / (N * TN)."});
+  section.blocks.push_back(html_table(t));
+  section.blocks.push_back(viz::SvgFigure{.caption = stem + " sweep", .svg = viz::plots_svg(plots, 1)});
+  report.sections.push_back(section);
+  for (const auto& f : viz::write_html_report(dir / (stem + ".html"), report)) files.push_back(f);
+  return files;
+}
+
+int sweep_main(int argc, const char* const argv[]) {
+  SweepOptions options;
+  try {
+    options = parse_sweep_options(argc, argv);
+  } catch (const UsageError& e) {
+    if (std::string(e.what()) == "help") {
+      std::cout << sweep_usage();
+      return 0;
+    }
+    std::cerr << "vmpray sweep: " << e.what() << " (see vmpray sweep --help)\n";
+    return 2;
+  }
+  try {
+    const SweepTable table = run_sweep(options, options.quiet ? nullptr : &std::cerr);
+    const auto files = write_sweep(table, options.out_dir);
+    if (!options.quiet) {
+      std::cout << sweep_csv(table);
+      std::cout << "wrote " << files.size() << " files in " << options.out_dir.string() << "\n";
+    }
+    return 0;
+  } catch (const std::exception& e) {
+    std::cerr << "vmpray sweep: " << e.what() << "\n";
+    return 1;
+  }
+}
+
+}  // namespace app

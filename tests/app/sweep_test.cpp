@@ -1,0 +1,135 @@
+// vmpray sweep: option errors, the CSV/JSON tables and SVG plots it writes
+// (parsed here), the HTML page linking only files it wrote, and the same
+// sweep giving the same predictions twice.
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+#include <regex>
+#include <set>
+#include <sstream>
+
+#include "app/options.hpp"
+#include "app/sweep.hpp"
+#include "tests/viz/xml_check.hpp"
+
+namespace {
+
+namespace fs = std::filesystem;
+
+app::SweepOptions parse(std::vector<const char*> args) {
+  args.insert(args.begin(), "sweep");
+  return app::parse_sweep_options(static_cast<int>(args.size()), args.data());
+}
+
+std::string read(const fs::path& p) {
+  std::ifstream in(p, std::ios::binary);
+  std::ostringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+std::vector<std::vector<std::string>> csv_rows(const std::string& text) {
+  std::vector<std::vector<std::string>> rows;
+  std::istringstream lines(text);
+  for (std::string line; std::getline(lines, line);) {
+    std::vector<std::string> cells;
+    std::istringstream items(line);
+    for (std::string cell; std::getline(items, cell, ',');) cells.push_back(cell);
+    rows.push_back(cells);
+  }
+  return rows;
+}
+
+fs::path fresh_dir(const std::string& name) {
+  const fs::path dir = fs::path(::testing::TempDir()) / name;
+  fs::remove_all(dir);
+  return dir;
+}
+
+TEST(SweepOptions, BadValuesNameTheOption) {
+  const std::vector<std::pair<std::vector<const char*>, std::string>> cases{
+      {{"sideways"}, "sweep: expected 'nodes' or 'cache'"},
+      {{"nodes", "--nodes", "1,x"}, "--nodes"},
+      {{"cache", "--cache-pages", "0"}, "--cache-pages"},
+      {{"nodes", "--cost", "box=slow"}, "--cost"},
+      {{"nodes", "--size", "0"}, "--size"},
+  };
+  for (const auto& [args, option] : cases) {
+    try {
+      parse(args);
+      ADD_FAILURE() << option << " accepted";
+    } catch (const app::UsageError& e) {
+      EXPECT_NE(std::string(e.what()).find(option), std::string::npos) << e.what();
+    }
+  }
+}
+
+TEST(SweepOptions, CacheSweepDefaultsToSixteenNodes) {
+  const auto o = parse({"cache", "rings4", "--cache-pages", "4,8"});
+  EXPECT_EQ(o.kind, app::SweepOptions::Kind::cache);
+  EXPECT_EQ(o.scene, "rings4");
+  EXPECT_EQ(o.nodes, std::vector<std::size_t>{16});
+  EXPECT_EQ(o.cache_pages, (std::vector<std::uint32_t>{4, 8}));
+}
+
+TEST(Sweep, NodesSweepWritesWellFormedTablesAndPlots) {
+  const fs::path dir = fresh_dir("vmpray_sweep_nodes");
+  auto o = parse({"nodes", "teapot:2", "--size", "12", "--nodes", "1,2,4", "--topology", "hypercube,ring"});
+  const app::SweepTable table = app::run_sweep(o, nullptr);
+  const auto files = app::write_sweep(table, dir);
+
+  const auto rows = csv_rows(read(dir / "nodes.csv"));
+  ASSERT_EQ(rows.size(), 7u);  // header + 2 topologies x 3 sizes
+  for (const auto& row : rows) EXPECT_EQ(row.size(), rows.front().size());
+  EXPECT_EQ(rows[1][2], "1");
+  EXPECT_DOUBLE_EQ(std::stod(rows[1][7]), 1.0);  // efficiency of N = 1
+  for (std::size_t i = 1; i < rows.size(); ++i) EXPECT_GT(std::stod(rows[i][4]), 0.0);
+
+  const std::string json = read(dir / "nodes.json");
+  EXPECT_EQ(std::count(json.begin(), json.end(), '{'), std::count(json.begin(), json.end(), '}'));
+  EXPECT_EQ(std::count(json.begin(), json.end(), '['), std::count(json.begin(), json.end(), ']'));
+  EXPECT_NE(json.find("\"efficiency\": 1,"), std::string::npos);
+  EXPECT_EQ(json.find("nan"), std::string::npos);
+
+  const auto svg = viz::test::check_xml(read(dir / "nodes.svg"));
+  EXPECT_TRUE(svg.ok) << svg.error;
+  for (const auto& f : files) EXPECT_TRUE(fs::exists(f)) << f;
+}
+
+TEST(Sweep, CacheSweepCountsFewerMissesWithMoreCache) {
+  auto o = parse({"cache", "teapot:2", "--size", "12", "--nodes", "4", "--cache-pages", "2,64"});
+  const app::SweepTable table = app::run_sweep(o, nullptr);
+  ASSERT_EQ(table.points.size(), 2u);
+  EXPECT_GT(table.points[0].misses, table.points[1].misses);
+  EXPECT_GT(table.points[0].miss_ratio, table.points[1].miss_ratio);
+}
+
+TEST(Sweep, HtmlPageLinksOnlyFilesItWrote) {
+  const fs::path dir = fresh_dir("vmpray_sweep_html");
+  auto o = parse({"cache", "teapot:2", "--size", "8", "--nodes", "2", "--cache-pages", "4,8"});
+  const auto files = app::write_sweep(app::run_sweep(o, nullptr), dir);
+  std::set<std::string> written;
+  for (const auto& f : files) written.insert(f.filename().string());
+  const std::string html = read(dir / "cache.html");
+  const std::regex link(R"((?:src|href)=\"([^\"]*)\")");
+  for (auto it = std::sregex_iterator(html.begin(), html.end(), link); it != std::sregex_iterator(); ++it)
+    EXPECT_TRUE(written.count((*it)[1].str())) << (*it)[1].str();
+  for (const auto& entry : fs::directory_iterator(dir)) EXPECT_TRUE(written.count(entry.path().filename().string()));
+}
+
+TEST(Sweep, SameSweepGivesSamePredictions) {
+  auto o = parse({"nodes", "teapot:2", "--size", "10", "--nodes", "4"});
+  const auto a = app::run_sweep(o, nullptr);
+  const auto b = app::run_sweep(o, nullptr);
+  EXPECT_EQ(a.serial_seconds, b.serial_seconds);
+  ASSERT_EQ(a.points.size(), b.points.size());
+  for (std::size_t i = 0; i < a.points.size(); ++i) {
+    EXPECT_EQ(a.points[i].predicted_seconds, b.points[i].predicted_seconds);
+    EXPECT_EQ(a.points[i].misses, b.points[i].misses);
+    EXPECT_EQ(a.points[i].rays, b.points[i].rays);
+    EXPECT_EQ(a.points[i].mean_hops, b.points[i].mean_hops);
+  }
+}
+
+}  // namespace
