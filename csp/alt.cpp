@@ -106,29 +106,40 @@ std::size_t Alt::wait_locked(std::size_t timeout_guard, Clock::time_point deadli
     if (guards_[i].enabled && guards_[i].kind == Kind::input) guards_[i].channel->readers_.push_back(*record++);
   }
 
-  // park() releases the last lock just before suspending; the others may go
-  // first, for the reason given there.
+  // Armed under every lock, since a waker may claim w as soon as one is
+  // released; then all but the last lock go, sleep() releases that one.
+  const bool timed = timeout_guard != none;
+  if (!detail::arm(w, timed)) {
+    unlink_records();
+    unlock_channels();
+    detail::unwind_deadlock();
+  }
   detail::Spinlock no_channel;
   detail::Spinlock& last = channels_.empty() ? no_channel : channels_.back()->lock_;
   if (channels_.empty()) no_channel.lock();
   for (std::size_t c = 0; c + 1 < channels_.size(); ++c) channels_[c]->lock_.unlock();
   detail::SpinlockLock lk(last, std::adopt_lock);
   WaitState s = WaitState::waiting;
-  if (timeout_guard == none) {
-    s = detail::park(w, lk);
+  if (timed) {
+    detail::sleep_until(w, lk, deadline);
   } else {
-    detail::park_until(w, lk, deadline);
+    s = detail::sleep(w, lk);
   }
 
   lock_channels();
-  if (timeout_guard != none) s = detail::resolve_timeout(w);
-  record = records_.begin();
-  for (const Guard& g : guards_) {
-    if (g.enabled && g.kind == Kind::input) g.channel->readers_.erase(*record++);
-  }
+  if (timed) s = detail::resolve_timeout(w);
+  unlink_records();
   unlock_channels();
   if (s == WaitState::aborted) detail::unwind_deadlock();
   return s == WaitState::timed_out ? timeout_guard : w.fired;
+}
+
+// Channels locked: removes the records a waker has not already taken.
+void Alt::unlink_records() {
+  auto record = records_.begin();
+  for (const Guard& g : guards_) {
+    if (g.enabled && g.kind == Kind::input) g.channel->readers_.erase(*record++);
+  }
 }
 
 void Alt::lock_channels() {

@@ -54,6 +54,7 @@ class Alt {
   void prepare();
   std::size_t poll_locked(std::size_t first) const;
   std::size_t wait_locked(std::size_t timeout_guard, detail::Clock::time_point deadline);
+  void unlink_records();
   void lock_channels();
   void unlock_channels();
 

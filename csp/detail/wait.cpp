@@ -112,41 +112,53 @@ Process* current_process() {
   return process_of(boost::fibers::context::active());
 }
 
-// Both parks release the lock themselves before suspending (rather than
+bool arm(Waiter& w, bool timed) {
+  boost::fibers::context* ctx = boost::fibers::context::active();
+  w.ctx = ctx;
+  if (timed) {
+    ctx->twstatus.store(timed_token(w), std::memory_order_release);
+    return true;
+  }
+  ctx->twstatus.store(0, std::memory_order_release);
+  Process* p = process_of(ctx);
+  if (!p) return true;
+  const bool runnable = !p->tracker->aborting() && p->tracker->block(*p, w);
+  if (runnable || !w.abortable) return true;
+  // Nobody can wake us (or the run is unwinding): do not park.
+  w.state.store(WaitState::aborted, std::memory_order_relaxed);
+  p->waiting.store(nullptr, std::memory_order_relaxed);
+  return false;
+}
+
+// Both sleeps release the lock themselves before suspending (rather than
 // handing it to Boost, whose unlock is invisible to ThreadSanitizer). That is
 // safe: no other fiber of this thread runs before the suspension, and a waker
 // on another thread can only queue this fiber for this thread's dispatcher,
 // which runs after the suspension.
-WaitState park(Waiter& w, SpinlockLock& lk) {
-  boost::fibers::context* ctx = boost::fibers::context::active();
-  w.ctx = ctx;
-  Process* p = process_of(ctx);
-  if (p) {
-    const bool runnable = !p->tracker->aborting() && p->tracker->block(*p, w);
-    if (!runnable && w.abortable) {
-      // Nobody can wake us (or the run is unwinding): do not park.
-      w.state.store(WaitState::aborted, std::memory_order_relaxed);
-      p->waiting.store(nullptr, std::memory_order_relaxed);
-      lk.unlock();
-      flush_wakes();
-      return WaitState::aborted;
-    }
-  }
-  ctx->twstatus.store(0, std::memory_order_release);
+WaitState sleep(Waiter& w, SpinlockLock& lk) {
   lk.unlock();
   flush_wakes();
-  ctx->suspend();
-  if (p) p->waiting.store(nullptr, std::memory_order_relaxed);
+  w.ctx->suspend();
+  if (w.process) w.process->waiting.store(nullptr, std::memory_order_relaxed);
   return w.state.load(std::memory_order_acquire);
 }
 
-void park_until(Waiter& w, SpinlockLock& lk, Clock::time_point deadline) {
-  boost::fibers::context* ctx = boost::fibers::context::active();
-  w.ctx = ctx;
-  ctx->twstatus.store(timed_token(w), std::memory_order_release);
+void sleep_until(Waiter& w, SpinlockLock& lk, Clock::time_point deadline) {
   lk.unlock();
   flush_wakes();
-  ctx->wait_until(deadline);
+  w.ctx->wait_until(deadline);
+}
+
+WaitState park(Waiter& w, SpinlockLock& lk) {
+  if (arm(w, false)) return sleep(w, lk);
+  lk.unlock();
+  flush_wakes();
+  return WaitState::aborted;
+}
+
+void park_until(Waiter& w, SpinlockLock& lk, Clock::time_point deadline) {
+  arm(w, true);
+  sleep_until(w, lk, deadline);
 }
 
 WaitState resolve_timeout(Waiter& w) {

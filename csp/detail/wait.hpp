@@ -141,13 +141,19 @@ class ChannelLock {
   SpinlockLock lk_;
 };
 
-// Parks the calling fiber on w until claimed. lk (locked) guards the records
-// of w and is released just before the fiber suspends; other locks must
-// already be released. Returns the outcome; `aborted` means the run is deadlocked and
-// the caller must unlink its records, then call unwind_deadlock().
+// Parking is two steps. arm(), with the lock of every channel holding a
+// record of w, makes w claimable: it records the fiber, and for an untimed
+// wait counts the process as blocked; it returns false (w is then `aborted`)
+// if the run is deadlocked and the caller must unlink and unwind instead.
+// sleep() / sleep_until() then release lk — the one lock still held; others
+// may be released between the steps — and suspend until claimed (or until
+// the deadline: the caller relocks and resolves a `waiting` state, a timeout
+// nobody claimed, with resolve_timeout()). sleep() returns the outcome.
+bool arm(Waiter& w, bool timed);
+WaitState sleep(Waiter& w, SpinlockLock& lk);
+void sleep_until(Waiter& w, SpinlockLock& lk, Clock::time_point deadline);
+// Both steps for a wait under a single lock; lk is unlocked on return.
 WaitState park(Waiter& w, SpinlockLock& lk);
-// Timed park: returns with lk *unlocked*; the caller relocks and resolves a
-// `waiting` state (a timeout nobody claimed) with resolve_timeout().
 void park_until(Waiter& w, SpinlockLock& lk, Clock::time_point deadline);
 WaitState resolve_timeout(Waiter& w);  // caller holds every lock w's records live under
 
