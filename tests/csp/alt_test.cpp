@@ -210,4 +210,33 @@ TEST(Alt, BufferedInputWakesParkedAlt) {
   EXPECT_EQ(sum, 5050);
 }
 
+TEST(Alt, CrossThreadStressLosesNothing) {
+  constexpr int writers = 8;
+  constexpr int per_writer = 2000;
+  std::vector<csp::Channel<int>> chans;
+  for (int i = 0; i < writers; ++i) chans.emplace_back("w" + std::to_string(i), i % 2);
+  long sum = 0;
+  csp::Runtime rt(2);
+  for (int i = 0; i < writers; ++i) {
+    rt.spawn("writer" + std::to_string(i), i, [out = chans[i].writer()]() mutable {
+      for (int k = 1; k <= per_writer; ++k) out.write(k);
+    });
+  }
+  rt.spawn("alt", 0, [&] {
+    csp::Alt alt;
+    std::vector<csp::In<int>> ins;
+    for (auto& c : chans) ins.push_back(c.reader());
+    for (auto& in : ins) alt.add_input(in);
+    const std::size_t timeout = alt.add_timeout(1ms);
+    for (int got = 0; got < writers * per_writer;) {
+      const std::size_t i = alt.select();
+      if (i == timeout) continue;  // a timed wait racing the writers
+      sum += ins[i].read();
+      ++got;
+    }
+  });
+  rt.run();
+  EXPECT_EQ(sum, long{writers} * per_writer * (per_writer + 1) / 2);
+}
+
 }  // namespace
