@@ -1,11 +1,15 @@
-// vmpray: render an NFF or built-in scene in this process and report rays,
-// intersection tests and database pages. Exit 0 on success, 2 for a bad
-// command line, 1 for a runtime error; errors are one line on stderr, and a
-// failed run leaves no output file.
+// vmpray: render an NFF or built-in scene on the simulated VM_pRAY machine
+// (default: the teapot on a 16-node hypercube, each node caching 1/8 of the
+// database) or, with --single, in this process; write the image and report
+// rays, page accesses and traffic, the network and per-node work (JSON with
+// --stats). `vmpray sweep ...` runs the paper's experiments (app/sweep.hpp).
+// Exit 0 on success, 2 for a bad command line, 1 for a runtime error; errors
+// are one line on stderr, and a failed run leaves no output file.
 #include <cctype>
 #include <chrono>
 #include <iostream>
 
+#include "app/machine_run.hpp"
 #include "app/options.hpp"
 #include "app/report.hpp"
 #include "app/scene_input.hpp"
@@ -19,11 +23,13 @@ int run(const app::Options& o) {
   const tracer::Scene scene = app::load_scene(o);
   const double load_seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-  app::RenderResult result = app::render_single(o, scene);
+  app::RenderResult result = o.single ? app::render_single(o, scene) : app::render_machine(o, scene);
   result.report.load_seconds = load_seconds;
   result.image.write_image(o.output);
   if (!o.stats_path.empty()) app::write_stats_json(o.stats_path, result.report);
   if (!o.quiet) app::print_report(std::cout, result.report);
+  // Asked for by name, so printed even when --quiet.
+  if (result.report.machine) std::cout << nodes::format_routes(result.report.machine->report);
   return 0;
 }
 

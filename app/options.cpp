@@ -6,13 +6,23 @@
 #include <boost/program_options.hpp>
 #include <sstream>
 
+#include "topology/spec.hpp"
 #include "tracer/generators.hpp"
 
 namespace app {
 namespace po = boost::program_options;
 namespace {
 
-po::options_description describe(Options& o, std::string& accel, std::int64_t& page_size) {
+// Values that need checking or converting before they reach Options.
+struct Raw {
+  std::string accel;
+  std::int64_t page_size = 0;
+  std::string topology, schedule, distribution;
+  std::int64_t nodes = 0, threads = 0, cache_pages = 0, cache_kb = 0, grain = 0, workers = 0,
+               trace_routes = 0;
+};
+
+po::options_description describe_render(Options& o, Raw& raw) {
   po::options_description d("Options");
   d.add_options()
       ("help,h", "show this help and exit")
@@ -21,8 +31,8 @@ po::options_description describe(Options& o, std::string& accel, std::int64_t& p
       ("stats", po::value(&o.stats_path), "write the report as JSON to this file")
       ("spd-procedure", po::bool_switch(&o.spd_procedure),
        "SPD testing procedure: pixel-corner eye rays, depth 5, no adaptive cut-off")
-      ("accel", po::value(&accel)->default_value("bvh"), "acceleration structure: bvh or grid")
-      ("page-size", po::value(&page_size)->default_value(1024),
+      ("accel", po::value(&raw.accel)->default_value("bvh"), "acceleration structure: bvh or grid")
+      ("page-size", po::value(&raw.page_size)->default_value(1024),
        "database page size in bytes, a power of two from 256 to 65536")
       ("max-depth", po::value(&o.max_depth)->default_value(5), "maximum ray depth (eye ray = 1)")
       ("width", po::value(&o.width), "image width (default: the scene's)")
@@ -33,21 +43,99 @@ po::options_description describe(Options& o, std::string& accel, std::int64_t& p
   return d;
 }
 
-void check_values(Options& o, const std::string& accel, std::int64_t page_size) {
-  if (accel == "bvh") o.accel = tracer::Accel::bvh;
-  else if (accel == "grid") o.accel = tracer::Accel::grid;
-  else throw UsageError("--accel: expected bvh or grid, got '" + accel + "'");
+po::options_description describe_machine(Options& o, Raw& raw) {
+  po::options_description d("Machine options (the image is the same for every setting)");
+  d.add_options()
+      ("single", po::bool_switch(&o.single),
+       "render in this process with the whole database in memory, no machine")
+      ("topology", po::value(&raw.topology)->default_value("hypercube"),
+       "hypercube, mesh, torus, ring or complete (with --nodes), or a full spec: "
+       "hypercube:4, mesh:4x4, torus:4x4, ring:16, complete:16")
+      ("nodes", po::value(&raw.nodes), "processors (default 16, or the full spec's)")
+      ("threads", po::value(&raw.threads)->default_value(0),
+       "OS threads carrying the processors (0: hardware cores; at most --nodes)")
+      ("cache-pages", po::value(&raw.cache_pages),
+       "remote pages cached per node (default: 1/8 of the database)")
+      ("cache-kb", po::value(&raw.cache_kb), "the cache per node in KB instead of pages")
+      ("grain", po::value(&raw.grain)->default_value(4), "pixels handed out per work request")
+      ("schedule", po::value(&raw.schedule)->default_value("dynamic"),
+       "dynamic (pixels to whoever asks) or static (fixed shares)")
+      ("workers-per-node", po::value(&raw.workers)->default_value(1),
+       "pixel computers per processor")
+      ("distribution", po::value(&raw.distribution)->default_value("modulo"),
+       "page p on node p mod N (modulo), or consecutive runs of pages (block)")
+      ("trace-routes", po::value(&raw.trace_routes)->default_value(0),
+       "print the routes of the first N packets hop by hop")
+      ("compare-serial", po::bool_switch(&o.compare_serial),
+       "also run the 1-node machine; report speedup and efficiency T1/(N*TN)");
+  return d;
+}
+
+template <class T>
+T in_range(std::int64_t v, std::int64_t lo, std::int64_t hi, const char* option) {
+  if (v < lo || v > hi)
+    throw UsageError(std::string(option) + ": expected " + std::to_string(lo) + ".." +
+                     std::to_string(hi) + ", got " + std::to_string(v));
+  return static_cast<T>(v);
+}
+
+void check_render(Options& o, const Raw& raw) {
+  if (raw.accel == "bvh") o.accel = tracer::Accel::bvh;
+  else if (raw.accel == "grid") o.accel = tracer::Accel::grid;
+  else throw UsageError("--accel: expected bvh or grid, got '" + raw.accel + "'");
   try {
-    tracer::validate_page_size(static_cast<std::uint64_t>(std::max<std::int64_t>(page_size, 0)));
+    tracer::validate_page_size(static_cast<std::uint64_t>(std::max<std::int64_t>(raw.page_size, 0)));
   } catch (const tracer::DatabaseError& e) {
     throw UsageError(std::string("--page-size: ") + e.what());
   }
-  o.page_size = static_cast<std::uint32_t>(page_size);
+  o.page_size = static_cast<std::uint32_t>(raw.page_size);
   if (o.max_depth < 1 || o.max_depth > 64) throw UsageError("--max-depth: expected 1..64");
   if (o.width < 0 || o.width > 16384) throw UsageError("--width: expected 1..16384");
   if (o.height < 0 || o.height > 16384) throw UsageError("--height: expected 1..16384");
   if (o.tessellate < 0 || o.tessellate > 256) throw UsageError("--tessellate: expected 1..256");
   if (o.output.empty()) o.output = default_output(o.scene);
+}
+
+// A bare kind takes --nodes (default 16); a full spec stands alone or must agree.
+void check_topology(nodes::MachineOptions& m, const Raw& raw, const po::variables_map& vm) {
+  m.topology = raw.topology;
+  if (vm.count("nodes")) m.nodes = in_range<std::size_t>(raw.nodes, 1, 1 << 20, "--nodes");
+  else if (raw.topology.find(':') != std::string::npos) m.nodes.reset();
+  try {
+    topology::parse_topology(m.topology, m.nodes);
+  } catch (const std::invalid_argument& e) {
+    throw UsageError(std::string("--topology: ") + e.what());
+  }
+}
+
+void check_cache(Options& o, const Raw& raw, const po::variables_map& vm) {
+  nodes::MachineOptions& m = o.machine;
+  if (vm.count("cache-pages") && vm.count("cache-kb"))
+    throw UsageError("--cache-pages and --cache-kb: give one of them, not both");
+  if (vm.count("cache-pages"))
+    m.cache_pages = in_range<std::uint32_t>(raw.cache_pages, 1, UINT32_MAX, "--cache-pages");
+  if (vm.count("cache-kb")) {
+    m.cache_kb = in_range<std::uint64_t>(raw.cache_kb, 1, std::int64_t(1) << 40, "--cache-kb");
+    if (*m.cache_kb * 1024 < o.page_size)
+      throw UsageError("--cache-kb: " + std::to_string(*m.cache_kb) + " KB is less than one page (" +
+                       std::to_string(o.page_size) + " bytes)");
+  }
+}
+
+void check_machine(Options& o, const Raw& raw, const po::variables_map& vm) {
+  nodes::MachineOptions& m = o.machine;
+  check_topology(m, raw, vm);
+  check_cache(o, raw, vm);
+  m.threads = in_range<unsigned>(raw.threads, 0, 4096, "--threads");
+  m.grain = in_range<std::uint32_t>(raw.grain, 1, 1 << 20, "--grain");
+  m.workers_per_node = in_range<int>(raw.workers, 1, 64, "--workers-per-node");
+  m.trace_routes = in_range<std::uint64_t>(raw.trace_routes, 0, 1 << 20, "--trace-routes");
+  if (raw.schedule == "dynamic") m.schedule = nodes::Schedule::dynamic;
+  else if (raw.schedule == "static") m.schedule = nodes::Schedule::static_split;
+  else throw UsageError("--schedule: expected dynamic or static, got '" + raw.schedule + "'");
+  if (raw.distribution == "modulo") m.distribution = nodes::Distribution::modulo;
+  else if (raw.distribution == "block") m.distribution = nodes::Distribution::block;
+  else throw UsageError("--distribution: expected modulo or block, got '" + raw.distribution + "'");
 }
 
 }  // namespace
@@ -65,13 +153,11 @@ std::string default_output(const std::string& scene) {
 
 Options parse_options(int argc, const char* const argv[]) {
   Options o;
-  std::string accel;
-  std::int64_t page_size = 0;
-  auto desc = describe(o, accel, page_size);
+  Raw raw;
   po::options_description hidden;
   hidden.add_options()("scene", po::value(&o.scene));
   po::options_description all;
-  all.add(desc).add(hidden);
+  all.add(describe_render(o, raw)).add(describe_machine(o, raw)).add(hidden);
   po::positional_options_description positional;
   positional.add("scene", 1);
   po::variables_map vm;
@@ -83,19 +169,21 @@ Options parse_options(int argc, const char* const argv[]) {
   }
   if (vm.count("help")) o.action = Options::Action::help;
   else if (vm.count("version")) o.action = Options::Action::version;
-  check_values(o, accel, page_size);
+  check_render(o, raw);
+  check_machine(o, raw, vm);
   return o;
 }
 
 std::string usage_text() {
   Options o;
-  std::string accel;
-  std::int64_t page_size = 0;
+  Raw raw;
   std::ostringstream out;
   out << "Usage: vmpray [SCENE] [options]\n"
          "Ray traces SCENE (an NFF file, '-' for stdin, or a built-in scene; default teapot)\n"
-         "and writes an image and a report of rays, intersection tests and database pages.\n\n"
-      << describe(o, accel, page_size) << "\nBuilt-in scenes (NAME[:SIZE][:tRES]):\n";
+         "on a simulated distributed-memory machine (default: a 16-node hypercube) whose\n"
+         "processors share the scene database as object pages in a virtual memory, and\n"
+         "writes an image and a report of rays, page traffic, network and per-node work.\n\n"
+      << describe_render(o, raw) << "\n" << describe_machine(o, raw) << "\nBuilt-in scenes (NAME[:SIZE][:tRES]):\n";
   for (const auto& s : tracer::builtin_scenes()) out << "  " << s.name << "  " << s.description << "\n";
   return out.str();
 }

@@ -1,11 +1,14 @@
 // Command-line options of `vmpray`: one struct and its parser. The parser only
 // checks values; it opens no files (scene and output are checked by the caller).
+// Invariant: a parsed Options has a topology that fits its node count and a
+// cache of at least one page (as far as that can be told without the scene).
 #pragma once
 
 #include <cstdint>
 #include <stdexcept>
 #include <string>
 
+#include "nodes/machine.hpp"
 #include "tracer/database.hpp"
 
 namespace app {
@@ -30,6 +33,12 @@ struct Options {
   int height = 0;
   int tessellate = 0;  // 0: keep spheres and cones as they are
   bool quiet = false;
+  // The distributed machine (the default) or the plain in-process renderer.
+  bool single = false;
+  bool compare_serial = false;  // also run the 1-node machine: speedup, efficiency
+  // Topology, nodes, threads, cache, grain, schedule, workers, distribution and
+  // route tracing; trace and progress are filled in at run time.
+  nodes::MachineOptions machine;
 };
 
 // Throws UsageError. argv[0] is the program name.

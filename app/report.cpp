@@ -11,6 +11,8 @@ namespace {
 
 const char* accel_name(tracer::Accel a) { return a == tracer::Accel::bvh ? "bvh" : "grid"; }
 
+}  // namespace
+
 std::string json_string(const std::string& s) {
   std::string out = "\"";
   for (char c : s) {
@@ -23,8 +25,6 @@ std::string json_string(const std::string& s) {
   }
   return out + "\"";
 }
-
-}  // namespace
 
 void print_report(std::ostream& out, const RunReport& r) {
   const auto& s = r.rays;
@@ -47,6 +47,7 @@ void print_report(std::ostream& out, const RunReport& r) {
       << "time           load " << r.load_seconds << " s, build "
       << r.build.triangulate_seconds + r.build.accel_seconds + r.build.pack_seconds
       << " s, render " << r.render_seconds << " s, " << r.mrays_per_second() << " Mrays/s\n";
+  if (r.machine) print_machine_report(out, *r.machine);
 }
 
 void write_stats_json(const std::string& path, const RunReport& r) {
@@ -74,7 +75,12 @@ void write_stats_json(const std::string& path, const RunReport& r) {
     << "  \"seconds\": {\"load\": " << r.load_seconds << ", \"triangulate\": "
     << r.build.triangulate_seconds << ", \"accel_build\": " << r.build.accel_seconds
     << ", \"pack\": " << r.build.pack_seconds << ", \"render\": " << r.render_seconds << "},\n"
-    << "  \"mrays_per_second\": " << r.mrays_per_second() << "\n}\n";
+    << "  \"mrays_per_second\": " << r.mrays_per_second();
+  if (r.machine) {
+    f << ",\n  \"machine\": ";
+    write_machine_json(f, *r.machine, "  ");
+  }
+  f << "\n}\n";
   if (!f) throw std::runtime_error(path + ": write failed");
 }
 

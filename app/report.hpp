@@ -1,11 +1,14 @@
-// The run report: what was rendered, the database, rays and timing; printed
-// for people and written as JSON (same fields) for scripts.
+// The run report: what was rendered, the database, rays and timing, and for
+// a machine run its pages, network and per-node work; printed for people and
+// written as JSON (same fields) for scripts.
 #pragma once
 
 #include <cstdint>
+#include <optional>
 #include <ostream>
 #include <string>
 
+#include "app/machine_report.hpp"
 #include "tracer/database.hpp"
 #include "tracer/stats.hpp"
 
@@ -27,6 +30,7 @@ struct RunReport {
   double load_seconds = 0;
   double render_seconds = 0;
   tracer::RayStats rays;
+  std::optional<MachineSummary> machine;  // none for the single-process renderer
 
   double mrays_per_second() const {
     return render_seconds > 0 ? double(rays.rays()) / render_seconds * 1e-6 : 0.0;
@@ -34,6 +38,8 @@ struct RunReport {
 };
 
 void print_report(std::ostream& out, const RunReport& r);
+// s as a JSON string literal, quotes included.
+std::string json_string(const std::string& s);
 // Throws std::runtime_error naming the path if the file cannot be written.
 void write_stats_json(const std::string& path, const RunReport& r);
 

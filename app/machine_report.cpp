@@ -1,0 +1,166 @@
+// Human-readable and JSON forms of MachineSummary; see machine_report.hpp.
+#include "app/machine_report.hpp"
+
+#include <algorithm>
+#include <iomanip>
+
+#include "app/report.hpp"
+#include "nodes/messages.hpp"
+#include "topology/spec.hpp"
+
+namespace app {
+namespace {
+
+std::string kind_name(std::uint8_t kind) { return std::string(nodes::message_kind_name(kind)); }
+
+// Up to 16 nodes fit a table; beyond that only the least and most loaded.
+constexpr std::size_t kTableNodes = 16;
+
+void print_node_row(std::ostream& out, std::size_t n, const nodes::NodeReport& r) {
+  out << "  " << std::setw(5) << n << std::setw(10) << r.work.items << std::setw(12)
+      << r.work.rays.rays() << std::setw(12) << r.svm.accesses << std::setw(10) << r.svm.misses
+      << std::setw(11) << r.svm.miss_ratio() << std::setw(10) << r.served.pages_served << "\n";
+}
+
+void print_per_node(std::ostream& out, const nodes::MachineReport& r) {
+  out << "per node       pixels imbalance " << r.item_imbalance() << ", rays imbalance "
+      << r.ray_imbalance() << " (max/mean)\n"
+      << "  " << std::setw(5) << "node" << std::setw(10) << "pixels" << std::setw(12) << "rays"
+      << std::setw(12) << "accesses" << std::setw(10) << "misses" << std::setw(11) << "miss ratio"
+      << std::setw(10) << "served" << "\n";
+  const auto& nodes = r.per_node;
+  if (nodes.size() <= kTableNodes) {
+    for (std::size_t n = 0; n < nodes.size(); ++n) print_node_row(out, n, nodes[n]);
+    return;
+  }
+  const auto by_rays = [](const nodes::NodeReport& a, const nodes::NodeReport& b) {
+    return a.work.rays.rays() < b.work.rays.rays();
+  };
+  const auto least = std::min_element(nodes.begin(), nodes.end(), by_rays);
+  const auto most = std::max_element(nodes.begin(), nodes.end(), by_rays);
+  out << "  fewest rays:\n";
+  print_node_row(out, static_cast<std::size_t>(least - nodes.begin()), *least);
+  out << "  most rays:\n";
+  print_node_row(out, static_cast<std::size_t>(most - nodes.begin()), *most);
+}
+
+void json_svm(std::ostream& out, const nodes::SvmStats& s) {
+  out << "{\"accesses\": " << s.accesses << ", \"local_hits\": " << s.own_hits
+      << ", \"cache_hits\": " << s.cache_hits << ", \"misses\": " << s.misses
+      << ", \"coalesced\": " << s.coalesced << ", \"miss_ratio\": " << s.miss_ratio() << "}";
+}
+
+void json_per_node(std::ostream& out, const nodes::MachineReport& r, const std::string& indent) {
+  out << "[";
+  for (std::size_t n = 0; n < r.per_node.size(); ++n) {
+    const nodes::NodeReport& x = r.per_node[n];
+    out << (n ? "," : "") << "\n" << indent << "  {\"node\": " << n << ", \"pixels\": " << x.work.items
+        << ", \"tiles\": " << x.work.tiles << ", \"rays\": " << x.work.rays.rays() << ", \"svm\": ";
+    json_svm(out, x.svm);
+    out << ", \"pages_served\": " << x.served.pages_served << ", \"bytes_served\": "
+        << x.served.bytes_served << ", \"own_bytes\": " << x.own_bytes << ", \"cache_pages\": "
+        << x.cache_capacity << ", \"evictions\": " << x.evictions << ", \"peak_resident_bytes\": "
+        << x.peak_resident_bytes << "}";
+  }
+  out << "\n" << indent << "]";
+}
+
+void json_network(std::ostream& out, const nodes::NetworkStats& s) {
+  out << "{\"packets\": " << s.hops.packets << ", \"mean_hops\": " << s.hops.mean()
+      << ", \"max_hops\": " << s.hops.max_hops << ", \"by_kind\": {";
+  bool first = true;
+  for (const auto& [kind, h] : s.hops_by_kind) {
+    out << (first ? "" : ", ") << json_string(kind_name(kind)) << ": {\"packets\": " << h.packets
+        << ", \"mean_hops\": " << h.mean() << ", \"max_hops\": " << h.max_hops << "}";
+    first = false;
+  }
+  out << "}, \"busiest_link\": ";
+  const auto busiest = std::max_element(
+      s.links.begin(), s.links.end(),
+      [](const nodes::LinkStats& a, const nodes::LinkStats& b) { return a.packets < b.packets; });
+  if (busiest == s.links.end()) out << "null";
+  else
+    out << "{\"from\": " << busiest->from << ", \"to\": " << busiest->to << ", \"packets\": "
+        << busiest->packets << ", \"bytes\": " << busiest->bytes << "}";
+  out << "}";
+}
+
+void json_routes(std::ostream& out, const nodes::NetworkStats& s) {
+  out << "[";
+  for (std::size_t i = 0; i < s.routes.size(); ++i)
+    out << (i ? ", " : "") << json_string(nodes::format_route(s.routes[i], kind_name));
+  out << "]";
+}
+
+}  // namespace
+
+double MachineSummary::speedup() const {
+  return serial && report.wall_seconds > 0 ? serial->seconds / report.wall_seconds : 0.0;
+}
+
+double MachineSummary::efficiency() const {
+  return report.nodes > 0 ? speedup() / report.nodes : 0.0;
+}
+
+void print_machine_report(std::ostream& out, const MachineSummary& m) {
+  const nodes::MachineReport& r = m.report;
+  const nodes::SvmStats svm = r.svm();
+  const nodes::ServerCounters served = r.served();
+  out << std::fixed << std::setprecision(4);
+  out << "machine        " << r.topology << ": " << r.nodes << " nodes, " << r.workers_per_node
+      << " pixel computer(s) each, " << r.threads << " thread(s), cache " << r.cache_pages
+      << " pages (" << double(r.cache_pages) * r.page_size / 1024.0 << " KB) per node\n"
+      << "svm            " << svm.accesses << " page accesses: " << svm.own_hits << " local, "
+      << svm.cache_hits << " cache hits, " << svm.misses << " misses (" << svm.coalesced
+      << " coalesced), miss ratio " << svm.miss_ratio() << "\n"
+      << "page traffic   " << served.pages_served << " page communications, "
+      << served.bytes_served << " bytes; " << r.rays().pages_per_sample()
+      << " distinct pages per pixel\n";
+  print_per_node(out, r);
+  out << nodes::format_summary(r.network, topology::parse_topology(r.topology), kind_name);
+  out << std::setprecision(3) << "wall time      " << r.wall_seconds << " s on " << r.threads
+      << " thread(s)";
+  if (!r.cost_model.empty()) out << "; predicted " << r.predicted_seconds << " s (" << r.cost_model << ")";
+  out << "\n";
+  if (m.serial)
+    out << "speedup        " << m.speedup() << " (1 node: " << m.serial->seconds << " s on "
+        << m.serial->threads << " thread(s); " << r.nodes << " nodes: " << r.wall_seconds
+        << " s on " << r.threads << "), efficiency " << m.efficiency() << "\n";
+}
+
+void write_machine_json(std::ostream& out, const MachineSummary& m, const std::string& indent) {
+  const nodes::MachineReport& r = m.report;
+  const nodes::ServerCounters served = r.served();
+  const std::string in = indent + "  ";
+  out << "{\n"
+      << in << "\"topology\": " << json_string(r.topology) << ", \"nodes\": " << r.nodes
+      << ", \"threads\": " << r.threads << ", \"workers_per_node\": " << r.workers_per_node << ",\n"
+      << in << "\"cache_pages\": " << r.cache_pages << ", \"cache_kb\": "
+      << double(r.cache_pages) * r.page_size / 1024.0 << ", \"database_pages\": " << r.page_count
+      << ", \"database_kb\": " << double(r.page_count) * r.page_size / 1024.0 << ",\n"
+      << in << "\"svm\": ";
+  json_svm(out, r.svm());
+  out << ",\n"
+      << in << "\"page_communications\": " << served.pages_served << ", \"page_bytes\": "
+      << served.bytes_served << ", \"pages_per_pixel\": " << r.rays().pages_per_sample() << ",\n"
+      << in << "\"imbalance\": {\"pixels\": " << r.item_imbalance() << ", \"rays\": "
+      << r.ray_imbalance() << "},\n"
+      << in << "\"per_node\": ";
+  json_per_node(out, r, in);
+  out << ",\n" << in << "\"network\": ";
+  json_network(out, r.network);
+  out << ",\n" << in << "\"routes\": ";
+  json_routes(out, r.network);
+  out << ",\n" << in << "\"wall_seconds\": " << r.wall_seconds;
+  if (!r.cost_model.empty())
+    out << ", \"cost_model\": " << json_string(r.cost_model) << ", \"predicted_seconds\": "
+        << r.predicted_seconds;
+  out << ",\n" << in << "\"serial\": ";
+  if (m.serial)
+    out << "{\"seconds\": " << m.serial->seconds << ", \"threads\": " << m.serial->threads
+        << ", \"speedup\": " << m.speedup() << ", \"efficiency\": " << m.efficiency() << "}";
+  else out << "null";
+  out << "\n" << indent << "}";
+}
+
+}  // namespace app

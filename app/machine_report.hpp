@@ -1,0 +1,34 @@
+// The machine part of the run report, as in the paper: page accesses and the
+// miss ratio, page communications, pages per pixel, per-node work and its
+// imbalance, the network's messages and hops, wall time, and speedup and
+// efficiency against the 1-node machine when that was run too.
+// Printed for people and written as a JSON object (same fields) for scripts.
+#pragma once
+
+#include <optional>
+#include <ostream>
+#include <string>
+
+#include "nodes/machine.hpp"
+
+namespace app {
+
+// The 1-node machine on the same scene, for speedup T1/TN and efficiency T1/(N*TN).
+struct SerialComparison {
+  double seconds = 0;
+  unsigned threads = 0;
+};
+
+struct MachineSummary {
+  nodes::MachineReport report;
+  std::optional<SerialComparison> serial;
+
+  double speedup() const;
+  double efficiency() const;
+};
+
+void print_machine_report(std::ostream& out, const MachineSummary& m);
+// One JSON object, no trailing newline; nested lines start with indent.
+void write_machine_json(std::ostream& out, const MachineSummary& m, const std::string& indent);
+
+}  // namespace app

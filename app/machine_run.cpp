@@ -1,0 +1,50 @@
+// Machine rendering; see machine_run.hpp.
+#include "app/machine_run.hpp"
+
+#include <utility>
+
+#include "app/progress.hpp"
+
+namespace app {
+namespace {
+
+// Runs db on the machine of `machine`, with a progress bar labelled `unit`.
+nodes::MachineResult run_with_progress(tracer::Database db, nodes::MachineOptions machine,
+                                       const Options& o, const char* unit) {
+  const auto& camera = db.header.camera;
+  ProgressBar bar(std::uint64_t(camera.width) * camera.height, unit, !o.quiet && stderr_is_terminal());
+  // The collector calls this on its own thread only, so the bar needs no lock.
+  machine.progress = [&bar](std::uint64_t done, std::uint64_t) { bar.update(done); };
+  nodes::MachineResult result = nodes::run_machine(std::move(db), machine);
+  bar.finish();
+  return result;
+}
+
+SerialComparison run_serial(const tracer::Database& db, const nodes::MachineOptions& machine,
+                            const Options& o) {
+  nodes::MachineOptions one = machine;
+  one.topology = "complete";
+  one.nodes = 1;
+  one.trace_routes = 0;
+  const nodes::MachineResult r = run_with_progress(db, one, o, "pixels (1 node)");
+  return {r.report.wall_seconds, r.report.threads};
+}
+
+}  // namespace
+
+RenderResult render_machine(const Options& o, const tracer::Scene& scene) {
+  tracer::Database db = build_database(scene, {.accel = o.accel, .page_size = o.page_size});
+  RenderResult out{tracer::Image(scene.camera.width, scene.camera.height), describe_run(o, db)};
+  nodes::MachineOptions machine = o.machine;
+  machine.trace = {.max_depth = o.max_depth, .spd_procedure = o.spd_procedure};
+  std::optional<SerialComparison> serial;
+  if (o.compare_serial) serial = run_serial(db, machine, o);
+  nodes::MachineResult result = run_with_progress(std::move(db), machine, o, "pixels");
+  out.image = std::move(result.image);
+  out.report.rays = result.report.rays();
+  out.report.render_seconds = result.report.wall_seconds;
+  out.report.machine = MachineSummary{std::move(result.report), serial};
+  return out;
+}
+
+}  // namespace app
