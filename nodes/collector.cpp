@@ -1,20 +1,25 @@
 // Frame collector process (see collector.hpp).
 #include "nodes/collector.hpp"
 
+#include <algorithm>
 #include <stdexcept>
 #include <string>
 
 namespace nodes {
 
-Collector::Collector(FrameAssembler& frame, csp::In<Packet> in, Outbox out, Progress progress)
-    : frame_(frame), in_(std::move(in)), out_(std::move(out)), progress_(std::move(progress)) {}
+Collector::Collector(FrameAssembler& frame, csp::In<Packet> in, Outbox out, Progress progress,
+                     std::vector<std::uint16_t>* owners)
+    : frame_(frame), in_(std::move(in)), out_(std::move(out)), progress_(std::move(progress)), owners_(owners) {}
 
 void Collector::run() {
   while (!frame_.complete()) {
     const Packet packet = in_.read();
     if (static_cast<MessageKind>(packet.kind) != MessageKind::result)
       throw std::logic_error("collector got a " + std::string(message_kind_name(packet.kind)) + " message");
-    frame_.add(decode_result(packet.payload));
+    const ResultView result = decode_result(packet.payload);
+    frame_.add(result);
+    if (owners_)
+      std::fill_n(owners_->begin() + result.tile.first, result.tile.count, static_cast<std::uint16_t>(packet.source));
     if (progress_) progress_(frame_.received(), frame_.items());
   }
   out_.send(make_packet(0, Ports::farmer, MessageKind::frame_done));

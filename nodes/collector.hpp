@@ -9,6 +9,7 @@
 
 #include <cstdint>
 #include <functional>
+#include <vector>
 
 #include "csp/csp.hpp"
 #include "nodes/frame_assembler.hpp"
@@ -20,7 +21,9 @@ using Progress = std::function<void(std::uint64_t done, std::uint64_t total)>;
 
 class Collector {
  public:
-  Collector(FrameAssembler& frame, csp::In<Packet> in, Outbox out, Progress progress);
+  // owners, if given (one entry per item), receives the node that computed each item.
+  Collector(FrameAssembler& frame, csp::In<Packet> in, Outbox out, Progress progress,
+            std::vector<std::uint16_t>* owners = nullptr);
   void run();
 
  private:
@@ -28,6 +31,7 @@ class Collector {
   csp::In<Packet> in_;
   Outbox out_;
   Progress progress_;
+  std::vector<std::uint16_t>* owners_;
 };
 
 }  // namespace nodes

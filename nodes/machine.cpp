@@ -32,6 +32,7 @@ struct Host {
   std::unique_ptr<FrameAssembler> frame;
   std::unique_ptr<Mailbox> mailbox;
   FarmerCounters farmer;
+  std::vector<std::uint16_t> owners;  // per item, filled by the collector
 };
 
 void validate(const MachineOptions& options) {
@@ -125,7 +126,7 @@ void spawn_host(const Wiring& w, Host& host) {
         .run();
   });
   w.runtime.spawn("collector", thread, [&w, &host, out = w.outbox(0, Ports::collector)] {
-    Collector(*host.frame, w.net.port(0, Ports::collector), out, w.options.progress).run();
+    Collector(*host.frame, w.net.port(0, Ports::collector), out, w.options.progress, &host.owners).run();
   });
 }
 
@@ -220,6 +221,7 @@ MachineResult run_machine(tracer::Database db, const MachineOptions& options) {
   host.plan = std::make_unique<WorkPlan>(items, options.grain, options.schedule, static_cast<int>(topology.size()),
                                          options.workers_per_node);
   host.frame = std::make_unique<FrameAssembler>(items);
+  host.owners.assign(items, 0);
   for (std::size_t n = 0; n < nodes.size(); ++n) spawn_node(wiring, static_cast<NodeId>(n), *nodes[n]);
   spawn_host(wiring, host);
   runtime.run();
@@ -243,6 +245,7 @@ MachineResult run_machine(tracer::Database db, const MachineOptions& options) {
   for (const auto& node : nodes) report.per_node.push_back(node_report(*node));
   report.farmer = host.farmer;
   report.collected = host.frame->received();
+  report.owners = std::move(host.owners);
   report.network = net.stats();
   result.image = assemble_image(header, grid, host.frame->colors());
   return result;

@@ -90,6 +90,7 @@ struct MachineReport {
   std::string cost_model;          // CostModel::describe(), empty without virtual time
   double predicted_seconds = 0;    // virtual time at the end of the run
   double compute_seconds = 0;      // virtual compute time summed over the pixel computers
+  std::vector<std::uint16_t> owners;  // per item (pixel or corner sample): the node that computed it
   std::vector<NodeReport> per_node;
   FarmerCounters farmer;
   std::uint64_t collected = 0;

@@ -1,0 +1,121 @@
+// Machine drawing, pixel ownership and the run's HTML page (see machine_pictures.hpp).
+#include "app/machine_pictures.hpp"
+
+#include <fstream>
+#include <iomanip>
+#include <sstream>
+#include <stdexcept>
+
+#include "app/experiments.hpp"
+#include "app/viz/ownership.hpp"
+#include "topology/spec.hpp"
+
+namespace app {
+
+namespace {
+
+viz::MachineKind drawing_kind(topology::Kind kind) {
+  switch (kind) {
+    case topology::Kind::hypercube: return viz::MachineKind::hypercube;
+    case topology::Kind::mesh: return viz::MachineKind::mesh;
+    case topology::Kind::torus: return viz::MachineKind::torus;
+    case topology::Kind::ring: return viz::MachineKind::ring;
+    case topology::Kind::complete: return viz::MachineKind::complete;
+  }
+  throw std::logic_error("unknown topology kind");
+}
+
+std::string fixed(double v, int digits) {
+  std::ostringstream out;
+  out << std::fixed << std::setprecision(digits) << v;
+  return out.str();
+}
+
+void write_file(const std::filesystem::path& path, const std::string& text) {
+  std::ofstream out(path, std::ios::binary);
+  out << text;
+  if (!out.flush()) throw std::runtime_error(path.string() + ": cannot write");
+}
+
+}  // namespace
+
+viz::MachineDrawing machine_drawing(const nodes::MachineReport& report) {
+  const topology::Topology topo = topology::parse_topology(report.topology);
+  viz::MachineDrawing m;
+  m.kind = drawing_kind(topo.kind());
+  const bool grid = topo.kind() == topology::Kind::mesh || topo.kind() == topology::Kind::torus;
+  m.dim_a = static_cast<int>(topo.kind() == topology::Kind::hypercube ? topo.dimension() : topo.width());
+  m.dim_b = grid ? static_cast<int>(topo.height()) : 1;
+  m.title = report.topology + ": pixels computed (fill), pages served (ring), link traffic";
+  for (const nodes::NodeReport& n : report.per_node)
+    m.nodes.push_back(viz::NodeWork{.pixels = n.work.items, .page_requests_served = n.served.pages_served});
+  for (const nodes::LinkStats& l : report.network.links)
+    m.links.push_back(viz::LinkTraffic{static_cast<int>(l.from), static_cast<int>(l.to), l.packets, l.bytes});
+  return m;
+}
+
+std::vector<std::uint16_t> pixel_owners(const nodes::MachineReport& report, int width, int height) {
+  const auto pixels = static_cast<std::size_t>(width) * static_cast<std::size_t>(height);
+  if (report.owners.size() == pixels) return report.owners;
+  const auto corners = static_cast<std::size_t>(width + 1) * static_cast<std::size_t>(height + 1);
+  if (report.owners.size() != corners)
+    throw std::invalid_argument("pixel owners: the run recorded " + std::to_string(report.owners.size()) +
+                                " items for a " + std::to_string(width) + "x" + std::to_string(height) + " image");
+  std::vector<std::uint16_t> owners(pixels);
+  for (int y = 0; y < height; ++y)
+    for (int x = 0; x < width; ++x)
+      owners[static_cast<std::size_t>(y) * width + x] = report.owners[static_cast<std::size_t>(y) * (width + 1) + x];
+  return owners;
+}
+
+viz::KeyValueTable machine_statistics(const nodes::MachineReport& r) {
+  const tracer::RayStats rays = r.rays();
+  const nodes::SvmStats svm = r.svm();
+  viz::KeyValueTable t{.caption = "Run"};
+  t.rows = {{"topology", r.topology},
+            {"processors", std::to_string(r.nodes)},
+            {"cache per node (pages)", std::to_string(r.cache_pages)},
+            {"database pages", std::to_string(r.page_count) + " of " + std::to_string(r.page_size) + " bytes"},
+            {"rays", std::to_string(rays.rays())},
+            {"page accesses", std::to_string(svm.accesses)},
+            {"page requests (misses)", std::to_string(svm.misses)},
+            {"miss ratio", fixed(100 * svm.miss_ratio(), 3) + "%"},
+            {"pages served", std::to_string(r.served().pages_served)},
+            {"mean hops per message", fixed(r.network.hops.mean(), 2)},
+            {"pixel imbalance (max/mean)", fixed(r.item_imbalance(), 3)},
+            {"wall time", fixed(r.wall_seconds, 2) + " s"}};
+  if (!r.cost_model.empty()) {
+    t.rows.push_back({"machine model", r.cost_model});
+    t.rows.push_back({"predicted synthesis time", paper_duration(r.predicted_seconds)});
+  }
+  return t;
+}
+
+std::vector<std::filesystem::path> write_machine_pictures(const PictureFiles& files, const std::string& title,
+                                                          const tracer::Image& image,
+                                                          const nodes::MachineReport& report) {
+  std::vector<std::filesystem::path> written;
+  const std::string machine = viz::machine_svg(machine_drawing(report));
+  const tracer::Image ownership =
+      viz::ownership_image(image.width(), image.height(), pixel_owners(report, image.width(), image.height()));
+  if (!files.machine_svg.empty()) {
+    write_file(files.machine_svg, machine);
+    written.push_back(files.machine_svg);
+  }
+  if (!files.ownership_png.empty()) {
+    ownership.write_image(files.ownership_png.string());
+    written.push_back(files.ownership_png);
+  }
+  if (!files.report_html.empty()) {
+    viz::Section run{.heading = title};
+    run.blocks.push_back(viz::ImageFigure{.caption = "rendered image", .image = image});
+    run.blocks.push_back(machine_statistics(report));
+    run.blocks.push_back(viz::SvgFigure{.caption = "the machine after the run", .svg = machine});
+    run.blocks.push_back(viz::ImageFigure{.caption = "which processor computed each pixel", .image = ownership});
+    for (const auto& f : viz::write_html_report(files.report_html, viz::Report{.title = title, .sections = {run}}))
+      written.push_back(f);
+  }
+  return written;
+}
+
+}  // namespace app

@@ -1,0 +1,40 @@
+// Pictures of a machine run: the topology with its link traffic and node work
+// (SVG), which processor computed each pixel (PNG), and one HTML page with
+// the image, the statistics, the machine picture and the ownership image.
+// Pure functions of a finished run's report; nothing here runs the machine.
+#pragma once
+
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include "app/viz/machine.hpp"
+#include "app/viz/report.hpp"
+#include "nodes/machine.hpp"
+#include "tracer/image.hpp"
+
+namespace app {
+
+// Nodes filled by pixels computed and ringed by page requests served; links by traffic.
+viz::MachineDrawing machine_drawing(const nodes::MachineReport& report);
+
+// The node that computed each of width x height pixels (row-major). With SPD
+// corner samples ((W+1) x (H+1) items) a pixel belongs to its top-left corner.
+std::vector<std::uint16_t> pixel_owners(const nodes::MachineReport& report, int width, int height);
+
+// The statistics of a run as rows for the HTML page.
+viz::KeyValueTable machine_statistics(const nodes::MachineReport& report);
+
+struct PictureFiles {
+  std::filesystem::path machine_svg;    // empty: not written
+  std::filesystem::path ownership_png;  // empty: not written
+  std::filesystem::path report_html;    // empty: not written
+};
+
+// Writes the pictures asked for; returns every file written. Throws
+// std::runtime_error naming the path if one cannot be written.
+std::vector<std::filesystem::path> write_machine_pictures(const PictureFiles& files, const std::string& title,
+                                                          const tracer::Image& image,
+                                                          const nodes::MachineReport& report);
+
+}  // namespace app

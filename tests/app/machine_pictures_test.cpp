@@ -1,0 +1,81 @@
+// Pictures of a machine run: owners recorded for every pixel match the
+// per-node pixel counts, the machine SVG is well formed with one node per
+// processor, and the HTML page links only files it wrote.
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+#include <regex>
+#include <set>
+#include <sstream>
+
+#include "app/machine_pictures.hpp"
+#include "tests/viz/xml_check.hpp"
+#include "tracer/generators.hpp"
+
+namespace {
+
+namespace fs = std::filesystem;
+
+nodes::MachineResult small_run(bool corners) {
+  tracer::Scene scene = tracer::generate_scene("teapot:2");
+  scene.camera.width = 12;
+  scene.camera.height = 10;
+  nodes::MachineOptions options;
+  options.topology = "mesh:2x2";
+  options.nodes = std::nullopt;
+  options.threads = 1;
+  options.trace.spd_procedure = corners;
+  options.timing = nodes::ipsc2_profile();
+  return nodes::run_machine(tracer::build_database(scene, {}), options);
+}
+
+std::string read(const fs::path& p) {
+  std::ifstream in(p, std::ios::binary);
+  std::ostringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+TEST(MachinePictures, OwnersAgreeWithPixelsComputedPerNode) {
+  const auto run = small_run(false);
+  const auto owners = app::pixel_owners(run.report, 12, 10);
+  ASSERT_EQ(owners.size(), 120u);
+  std::vector<std::uint64_t> counted(4);
+  for (auto o : owners) ++counted.at(o);
+  for (std::size_t n = 0; n < 4; ++n) EXPECT_EQ(counted[n], run.report.per_node[n].work.items) << "node " << n;
+}
+
+TEST(MachinePictures, CornerSamplesGiveOnePixelOwnerEach) {
+  const auto run = small_run(true);
+  EXPECT_EQ(run.report.owners.size(), 13u * 11u);
+  EXPECT_EQ(app::pixel_owners(run.report, 12, 10).size(), 120u);
+  EXPECT_THROW(app::pixel_owners(run.report, 20, 20), std::invalid_argument);
+}
+
+TEST(MachinePictures, WritesWellFormedSvgAndAPageLinkingOnlyItsFiles) {
+  const fs::path dir = fs::path(::testing::TempDir()) / "vmpray_machine_pictures";
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  const auto run = small_run(false);
+  const app::PictureFiles files{dir / "machine.svg", dir / "owners.png", dir / "run.html"};
+  const auto written = app::write_machine_pictures(files, "teapot on a 2x2 mesh", run.image, run.report);
+
+  const auto svg = viz::test::check_xml(read(files.machine_svg));
+  ASSERT_TRUE(svg.ok) << svg.error;
+  EXPECT_EQ(viz::test::count_class(svg, "node"), 4u);
+  EXPECT_EQ(tracer::read_png(files.ownership_png.string()).width, 12);
+
+  std::set<std::string> names;
+  for (const auto& f : written) names.insert(f.filename().string());
+  const std::string html = read(files.report_html);
+  EXPECT_NE(html.find("predicted synthesis time"), std::string::npos);
+  const std::regex link(R"((?:src|href)=\"([^\"]*)\")");
+  int links = 0;
+  for (auto it = std::sregex_iterator(html.begin(), html.end(), link); it != std::sregex_iterator(); ++it, ++links)
+    EXPECT_TRUE(names.count((*it)[1].str())) << (*it)[1].str();
+  EXPECT_GE(links, 2);  // the image and the ownership picture
+  for (const auto& entry : fs::directory_iterator(dir)) EXPECT_TRUE(names.count(entry.path().filename().string()));
+}
+
+}  // namespace
