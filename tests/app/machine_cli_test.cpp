@@ -1,0 +1,333 @@
+// The machine mode of vmpray: option parsing, and the binary end to end —
+// images identical to the single-process renderer, the machine fields of the
+// JSON report (parsed here by a small strict JSON reader), route traces,
+// and one-line errors with no output file for each kind of bad input.
+#include <gtest/gtest.h>
+
+#include <sys/wait.h>
+
+#include <algorithm>
+#include <cctype>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <memory>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "app/options.hpp"
+
+namespace {
+
+namespace fs = std::filesystem;
+
+// A JSON value; objects keep their keys in a map, numbers are doubles.
+struct Json {
+  enum class Type { null, boolean, number, string, array, object } type = Type::null;
+  double number = 0;
+  std::string text;
+  std::vector<Json> items;
+  std::map<std::string, Json> fields;
+
+  const Json& operator[](const std::string& key) const {
+    const auto it = fields.find(key);
+    if (it == fields.end()) throw std::runtime_error("no field " + key);
+    return it->second;
+  }
+};
+
+// Recursive descent over the whole text; throws on anything that is not JSON.
+class JsonReader {
+ public:
+  explicit JsonReader(std::string text) : s_(std::move(text)) {}
+
+  Json document() {
+    Json v = value();
+    skip_space();
+    if (i_ != s_.size()) fail("trailing characters");
+    return v;
+  }
+
+ private:
+  [[noreturn]] void fail(const std::string& what) {
+    throw std::runtime_error("JSON: " + what + " at " + std::to_string(i_));
+  }
+  void skip_space() {
+    while (i_ < s_.size() && std::isspace(static_cast<unsigned char>(s_[i_]))) ++i_;
+  }
+  bool eat(char c) {
+    skip_space();
+    if (i_ < s_.size() && s_[i_] == c) return ++i_, true;
+    return false;
+  }
+  void expect(char c) {
+    if (!eat(c)) fail(std::string("expected '") + c + "'");
+  }
+  bool word(const char* w) {
+    const std::string t(w);
+    if (s_.compare(i_, t.size(), t) != 0) return false;
+    i_ += t.size();
+    return true;
+  }
+
+  std::string string() {
+    expect('"');
+    std::string out;
+    while (i_ < s_.size() && s_[i_] != '"') {
+      if (s_[i_] == '\\') {
+        if (++i_ >= s_.size()) fail("bad escape");
+        if (s_[i_] == 'u') i_ += 4;  // control characters only; the text is not needed
+        else out += s_[i_];
+        ++i_;
+      } else if (static_cast<unsigned char>(s_[i_]) < 0x20) fail("control character in string");
+      else out += s_[i_++];
+    }
+    expect('"');
+    return out;
+  }
+
+  Json value() {
+    skip_space();
+    Json v;
+    if (i_ >= s_.size()) fail("unexpected end");
+    const char c = s_[i_];
+    if (c == '{') return object();
+    if (c == '[') return array();
+    if (c == '"') v.type = Json::Type::string, v.text = string();
+    else if (word("null")) v.type = Json::Type::null;
+    else if (word("true") || word("false")) v.type = Json::Type::boolean;
+    else number(v);
+    return v;
+  }
+
+  void number(Json& v) {
+    const std::size_t start = i_;
+    while (i_ < s_.size() && (std::isdigit(static_cast<unsigned char>(s_[i_])) ||
+                              std::string("+-.eE").find(s_[i_]) != std::string::npos))
+      ++i_;
+    if (start == i_) fail("unexpected character");
+    std::size_t used = 0;
+    v.number = std::stod(s_.substr(start, i_ - start), &used);
+    if (used != i_ - start) fail("malformed number");
+    v.type = Json::Type::number;
+  }
+
+  Json object() {
+    Json v;
+    v.type = Json::Type::object;
+    expect('{');
+    if (eat('}')) return v;
+    do {
+      skip_space();
+      std::string key = string();
+      expect(':');
+      if (!v.fields.emplace(key, value()).second) fail("duplicate key " + key);
+    } while (eat(','));
+    expect('}');
+    return v;
+  }
+
+  Json array() {
+    Json v;
+    v.type = Json::Type::array;
+    expect('[');
+    if (eat(']')) return v;
+    do v.items.push_back(value());
+    while (eat(','));
+    expect(']');
+    return v;
+  }
+
+  std::string s_;
+  std::size_t i_ = 0;
+};
+
+std::string read_file(const fs::path& p) {
+  std::ifstream in(p, std::ios::binary);
+  std::stringstream ss;
+  ss << in.rdbuf();
+  return ss.str();
+}
+
+struct Outcome {
+  int exit_code;
+  std::string out, err;
+};
+
+class MachineCli : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    dir_ = fs::temp_directory_path() /
+           ("vmpray_mcli_" + std::string(::testing::UnitTest::GetInstance()->current_test_info()->name()));
+    fs::remove_all(dir_);
+    fs::create_directories(dir_);
+  }
+  void TearDown() override { fs::remove_all(dir_); }
+
+  // Two threads at most: the suite shares the machine with other work.
+  Outcome run(const std::string& args) {
+    const std::string cmd = "cd '" + dir_.string() + "' && " + VMPRAY_BINARY + " " + args +
+                            " >stdout.txt 2>stderr.txt </dev/null";
+    const int status = std::system(cmd.c_str());
+    return {WEXITSTATUS(status), read_file(dir_ / "stdout.txt"), read_file(dir_ / "stderr.txt")};
+  }
+
+  static std::size_t lines(const std::string& s) { return std::count(s.begin(), s.end(), '\n'); }
+
+  fs::path dir_;
+};
+
+constexpr const char* kSmall = "tetra:3 --width 32 --height 32 --threads 2";
+
+TEST_F(MachineCli, DefaultMachineWritesImageAndJsonWithMachineFields) {
+  const Outcome r = run(std::string(kSmall) + " -o out.png --stats s.json");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_TRUE(fs::exists(dir_ / "out.png"));
+  const Json j = JsonReader(read_file(dir_ / "s.json")).document();
+  const Json& m = j["machine"];
+  EXPECT_EQ(m["topology"].text, "hypercube:4");
+  EXPECT_EQ(m["nodes"].number, 16);
+  ASSERT_EQ(m["per_node"].items.size(), 16u);
+  EXPECT_GT(m["svm"]["accesses"].number, 0);
+  EXPECT_GE(m["svm"]["miss_ratio"].number, 0);
+  EXPECT_LE(m["svm"]["miss_ratio"].number, 1);
+  double misses = 0, pixels = 0, rays = 0;
+  for (const Json& n : m["per_node"].items) {
+    misses += n["svm"]["misses"].number;
+    pixels += n["pixels"].number;
+    rays += n["rays"].number;
+  }
+  EXPECT_EQ(misses, m["page_communications"].number);  // every request answered once
+  EXPECT_EQ(pixels, 32 * 32);
+  EXPECT_EQ(rays, j["rays"]["total"].number);
+  EXPECT_GE(m["imbalance"]["pixels"].number, 1.0);
+  EXPECT_GT(m["network"]["packets"].number, 0);
+  EXPECT_EQ(m["serial"].type, Json::Type::null);
+}
+
+TEST_F(MachineCli, EveryMachineMakesTheSingleProcessImage) {
+  const std::string scene = "teapot:2 --width 24 --height 20 --threads 2 -q";
+  ASSERT_EQ(run(scene + " --single -o single.ppm").exit_code, 0);
+  const std::string single = read_file(dir_ / "single.ppm");
+  ASSERT_FALSE(single.empty());
+  const std::vector<std::string> machines{
+      "",
+      "--topology mesh:3x3 --cache-pages 1 --grain 7 --schedule static --distribution block",
+      "--topology ring --nodes 5 --workers-per-node 2 --page-size 256",
+      "--topology torus:4x2 --cache-kb 2 --grain 1",
+      "--topology complete:1",
+  };
+  for (const std::string& m : machines) {
+    const Outcome r = run(scene + " " + m + " -o machine.ppm");
+    ASSERT_EQ(r.exit_code, 0) << m << ": " << r.err;
+    EXPECT_TRUE(read_file(dir_ / "machine.ppm") == single) << m;
+  }
+}
+
+TEST_F(MachineCli, EachBadInputIsOneLineWithNoOutputFile) {
+  const std::vector<std::pair<std::string, int>> cases{
+      {"--cache-pages 0", 2},
+      {"--cache-kb 0", 2},
+      {"--cache-kb 1 --page-size 2048", 2},
+      {"--page-size 1000", 2},
+      {"--page-size 128", 2},
+      {"--topology hypercube --nodes 6", 2},
+      {"--topology mesh:4x4 --nodes 8", 2},
+      {"--topology star:4", 2},
+      {"--schedule random", 2},
+      {"--distribution stripes", 2},
+      {"--grain 0", 2},
+      {"no/such/scene.nff", 1},
+  };
+  for (const auto& [args, code] : cases) {
+    const Outcome r = run(args + " --width 8 --height 8 -o out.png --stats s.json");
+    EXPECT_EQ(r.exit_code, code) << args;
+    EXPECT_EQ(lines(r.err), 1u) << args << ": " << r.err;
+    EXPECT_FALSE(fs::exists(dir_ / "out.png")) << args;
+    EXPECT_FALSE(fs::exists(dir_ / "s.json")) << args;
+  }
+}
+
+TEST_F(MachineCli, ErrorsNameTheOption) {
+  EXPECT_NE(run("--cache-pages 0").err.find("--cache-pages"), std::string::npos);
+  EXPECT_NE(run("--topology ring:8 --nodes 4").err.find("--topology"), std::string::npos);
+  EXPECT_NE(run("--page-size 3000").err.find("--page-size"), std::string::npos);
+}
+
+TEST_F(MachineCli, TraceRoutesPrintsThatManyRouteLines) {
+  const Outcome r = run(std::string(kSmall) + " -q --trace-routes 3 -o out.png");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_EQ(lines(r.out), 3u) << r.out;
+  std::istringstream in(r.out);
+  for (std::string line; std::getline(in, line);) EXPECT_NE(line.find(" hops)"), std::string::npos) << line;
+}
+
+TEST_F(MachineCli, CompareSerialReportsSpeedupAndEfficiency) {
+  const Outcome r = run(std::string(kSmall) + " --nodes 4 --compare-serial -o out.png --stats s.json");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_NE(r.out.find("efficiency"), std::string::npos);
+  const Json& serial = JsonReader(read_file(dir_ / "s.json")).document()["machine"]["serial"];
+  ASSERT_EQ(serial.type, Json::Type::object);
+  EXPECT_GT(serial["seconds"].number, 0);
+  EXPECT_EQ(serial["threads"].number, 1);
+  EXPECT_NEAR(serial["efficiency"].number, serial["speedup"].number / 4, 1e-6);
+}
+
+TEST_F(MachineCli, ReportShowsMissRatioPageTrafficAndPerNodeTable) {
+  const Outcome r = run(std::string(kSmall) + " --topology ring:4 -o out.png");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  for (const char* field : {"miss ratio", "page communications", "distinct pages per pixel",
+                            "imbalance", "busiest link", "wall time"})
+    EXPECT_NE(r.out.find(field), std::string::npos) << field;
+}
+
+app::Options parse(std::vector<const char*> args) {
+  args.insert(args.begin(), "vmpray");
+  return app::parse_options(static_cast<int>(args.size()), args.data());
+}
+
+TEST(MachineOptions, DefaultIsASixteenNodeHypercubeWithTheDefaultCache) {
+  const app::Options o = parse({});
+  EXPECT_FALSE(o.single);
+  EXPECT_EQ(o.machine.topology, "hypercube");
+  EXPECT_EQ(o.machine.nodes, 16u);
+  EXPECT_FALSE(o.machine.cache_pages);
+  EXPECT_FALSE(o.machine.cache_kb);
+  EXPECT_EQ(o.machine.schedule, nodes::Schedule::dynamic);
+  EXPECT_EQ(o.machine.distribution, nodes::Distribution::modulo);
+}
+
+TEST(MachineOptions, AFullSpecNeedsNoNodeCount) {
+  const app::Options o = parse({"--topology", "mesh:4x2"});
+  EXPECT_EQ(o.machine.topology, "mesh:4x2");
+  EXPECT_FALSE(o.machine.nodes);
+  EXPECT_EQ(parse({"--topology", "torus:2x2", "--nodes", "4"}).machine.nodes, 4u);
+}
+
+TEST(MachineOptions, ValuesReachTheMachine) {
+  const app::Options o = parse({"--cache-kb", "8", "--grain", "9", "--schedule", "static",
+                                "--workers-per-node", "3", "--distribution", "block",
+                                "--trace-routes", "5", "--threads", "2", "--compare-serial"});
+  EXPECT_EQ(o.machine.cache_kb, 8u);
+  EXPECT_EQ(o.machine.grain, 9u);
+  EXPECT_EQ(o.machine.schedule, nodes::Schedule::static_split);
+  EXPECT_EQ(o.machine.workers_per_node, 3);
+  EXPECT_EQ(o.machine.distribution, nodes::Distribution::block);
+  EXPECT_EQ(o.machine.trace_routes, 5u);
+  EXPECT_EQ(o.machine.threads, 2u);
+  EXPECT_TRUE(o.compare_serial);
+}
+
+TEST(MachineOptions, BothCacheSizesIsAnError) {
+  EXPECT_THROW(parse({"--cache-pages", "4", "--cache-kb", "4"}), app::UsageError);
+}
+
+TEST(JsonReader, RejectsMalformedText) {
+  EXPECT_THROW(JsonReader("{\"a\": 1,}").document(), std::runtime_error);
+  EXPECT_THROW(JsonReader("{\"a\": 1} x").document(), std::runtime_error);
+  EXPECT_EQ(JsonReader("{\"a\": [1, 2.5e1]}").document()["a"].items[1].number, 25);
+}
+
+}  // namespace
