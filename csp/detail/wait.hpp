@@ -17,7 +17,7 @@
 // cannot run before they are rescheduled.
 //
 // Deadlock accounting: an untimed park of a process counts it as blocked; the
-// claimer uncounts it before rescheduling (see Tracker in runtime.cpp).
+// claimer uncounts it before rescheduling (see Tracker in detail/process.hpp).
 #pragma once
 
 #include <atomic>
@@ -120,7 +120,7 @@ void complete(Waiter& w, WaitState outcome, std::size_t fired);
 void flush_wakes();
 
 // A held channel lock that issues the deferred cross-thread wakes when it is
-// released (by the destructor, or by park() suspending the fiber).
+// released (by the destructor, or by sleep() just before the fiber suspends).
 class ChannelLock {
  public:
   explicit ChannelLock(Spinlock& l) : lk_(l) {}
