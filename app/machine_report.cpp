@@ -95,7 +95,9 @@ void json_routes(std::ostream& out, const nodes::NetworkStats& s) {
 }  // namespace
 
 double MachineSummary::speedup() const {
-  return serial && report.wall_seconds > 0 ? serial->seconds / report.wall_seconds : 0.0;
+  // In virtual time both runs are predicted times (serial->seconds too).
+  const double tn = report.cost_model.empty() ? report.wall_seconds : report.predicted_seconds;
+  return serial && tn > 0 ? serial->seconds / tn : 0.0;
 }
 
 double MachineSummary::efficiency() const {
@@ -106,11 +108,11 @@ void print_machine_report(std::ostream& out, const MachineSummary& m) {
   const nodes::MachineReport& r = m.report;
   const nodes::SvmStats svm = r.svm();
   const nodes::ServerCounters served = r.served();
-  out << std::fixed << std::setprecision(4);
+  out << std::fixed << std::setprecision(1);
   out << "machine        " << r.topology << ": " << r.nodes << " nodes, " << r.workers_per_node
       << " pixel computer(s) each, " << r.threads << " thread(s), cache " << r.cache_pages
       << " pages (" << double(r.cache_pages) * r.page_size / 1024.0 << " KB) per node\n"
-      << "svm            " << svm.accesses << " page accesses: " << svm.own_hits << " local, "
+      << std::setprecision(4) << "svm            " << svm.accesses << " page accesses: " << svm.own_hits << " local, "
       << svm.cache_hits << " cache hits, " << svm.misses << " misses (" << svm.coalesced
       << " coalesced), miss ratio " << svm.miss_ratio() << "\n"
       << "page traffic   " << served.pages_served << " page communications, "
@@ -124,7 +126,7 @@ void print_machine_report(std::ostream& out, const MachineSummary& m) {
   out << "\n";
   if (m.serial)
     out << "speedup        " << m.speedup() << " (1 node: " << m.serial->seconds << " s on "
-        << m.serial->threads << " thread(s); " << r.nodes << " nodes: " << r.wall_seconds
+        << m.serial->threads << " thread(s); " << r.nodes << " nodes: " << (r.cost_model.empty() ? r.wall_seconds : r.predicted_seconds)
         << " s on " << r.threads << "), efficiency " << m.efficiency() << "\n";
 }
 
