@@ -94,10 +94,12 @@ void json_routes(std::ostream& out, const nodes::NetworkStats& s) {
 
 }  // namespace
 
+double MachineSummary::parallel_seconds() const {
+  return report.cost_model.empty() ? report.wall_seconds : report.predicted_seconds;
+}
+
 double MachineSummary::speedup() const {
-  // In virtual time both runs are predicted times (serial->seconds too).
-  const double tn = report.cost_model.empty() ? report.wall_seconds : report.predicted_seconds;
-  return serial && tn > 0 ? serial->seconds / tn : 0.0;
+  return serial && parallel_seconds() > 0 ? serial->seconds / parallel_seconds() : 0.0;
 }
 
 double MachineSummary::efficiency() const {
@@ -112,8 +114,8 @@ void print_machine_report(std::ostream& out, const MachineSummary& m) {
   out << "machine        " << r.topology << ": " << r.nodes << " nodes, " << r.workers_per_node
       << " pixel computer(s) each, " << r.threads << " thread(s), cache " << r.cache_pages
       << " pages (" << double(r.cache_pages) * r.page_size / 1024.0 << " KB) per node\n"
-      << std::setprecision(4) << "svm            " << svm.accesses << " page accesses: " << svm.own_hits << " local, "
-      << svm.cache_hits << " cache hits, " << svm.misses << " misses (" << svm.coalesced
+      << std::setprecision(4) << "svm            " << svm.accesses << " page accesses: "
+      << svm.own_hits << " local, " << svm.cache_hits << " cache hits, " << svm.misses << " misses (" << svm.coalesced
       << " coalesced), miss ratio " << svm.miss_ratio() << "\n"
       << "page traffic   " << served.pages_served << " page communications, "
       << served.bytes_served << " bytes; " << r.rays().pages_per_sample()
@@ -126,8 +128,9 @@ void print_machine_report(std::ostream& out, const MachineSummary& m) {
   out << "\n";
   if (m.serial)
     out << "speedup        " << m.speedup() << " (1 node: " << m.serial->seconds << " s on "
-        << m.serial->threads << " thread(s); " << r.nodes << " nodes: " << (r.cost_model.empty() ? r.wall_seconds : r.predicted_seconds)
-        << " s on " << r.threads << "), efficiency " << m.efficiency() << "\n";
+        << m.serial->threads << " thread(s); " << r.nodes << " nodes: " << m.parallel_seconds()
+        << " s on " << r.threads << (r.cost_model.empty() ? "" : ", predicted")
+        << "), efficiency " << m.efficiency() << "\n";
 }
 
 void write_machine_json(std::ostream& out, const MachineSummary& m, const std::string& indent) {
@@ -160,6 +163,7 @@ void write_machine_json(std::ostream& out, const MachineSummary& m, const std::s
   out << ",\n" << in << "\"serial\": ";
   if (m.serial)
     out << "{\"seconds\": " << m.serial->seconds << ", \"threads\": " << m.serial->threads
+        << ", \"parallel_seconds\": " << m.parallel_seconds()
         << ", \"speedup\": " << m.speedup() << ", \"efficiency\": " << m.efficiency() << "}";
   else out << "null";
   out << "\n" << indent << "}";

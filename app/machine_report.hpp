@@ -14,6 +14,7 @@
 namespace app {
 
 // The 1-node machine on the same scene, for speedup T1/TN and efficiency T1/(N*TN).
+// seconds: wall time, or the predicted (virtual) time when the run has a cost model.
 struct SerialComparison {
   double seconds = 0;
   unsigned threads = 0;
@@ -23,6 +24,8 @@ struct MachineSummary {
   nodes::MachineReport report;
   std::optional<SerialComparison> serial;
 
+  // TN: the predicted time under a cost model, the wall time otherwise (as T1).
+  double parallel_seconds() const;
   double speedup() const;
   double efficiency() const;
 };
