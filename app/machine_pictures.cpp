@@ -95,6 +95,7 @@ std::vector<std::filesystem::path> write_machine_pictures(const PictureFiles& fi
                                                           const tracer::Image& image,
                                                           const nodes::MachineReport& report) {
   std::vector<std::filesystem::path> written;
+  if (files.machine_svg.empty() && files.ownership_png.empty() && files.report_html.empty()) return written;
   const std::string machine = viz::machine_svg(machine_drawing(report));
   const tracer::Image ownership =
       viz::ownership_image(image.width(), image.height(), pixel_owners(report, image.width(), image.height()));

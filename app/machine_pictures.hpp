@@ -31,7 +31,7 @@ struct PictureFiles {
   std::filesystem::path report_html;    // empty: not written
 };
 
-// Writes the pictures asked for; returns every file written. Throws
+// Writes the pictures asked for (none: nothing to do); returns every file written. Throws
 // std::runtime_error naming the path if one cannot be written.
 std::vector<std::filesystem::path> write_machine_pictures(const PictureFiles& files, const std::string& title,
                                                           const tracer::Image& image,

@@ -27,7 +27,7 @@ SerialComparison run_serial(const tracer::Database& db, const nodes::MachineOpti
   one.nodes = 1;
   one.trace_routes = 0;
   const nodes::MachineResult r = run_with_progress(db, one, o, "pixels (1 node)");
-  return {r.report.wall_seconds, r.report.threads};
+  return {machine.timing ? r.report.predicted_seconds : r.report.wall_seconds, r.report.threads};
 }
 
 }  // namespace
@@ -38,7 +38,8 @@ RenderResult render_machine(const Options& o, const tracer::Scene& scene) {
   nodes::MachineOptions machine = o.machine;
   machine.trace = {.max_depth = o.max_depth, .spd_procedure = o.spd_procedure};
   std::optional<SerialComparison> serial;
-  if (o.compare_serial) serial = run_serial(db, machine, o);
+  // In virtual time T1 is cheap and deterministic: always there for speedup and efficiency.
+  if (o.compare_serial || machine.timing) serial = run_serial(db, machine, o);
   nodes::MachineResult result = run_with_progress(std::move(db), machine, o, "pixels");
   out.image = std::move(result.image);
   out.report.rays = result.report.rays();

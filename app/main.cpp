@@ -10,6 +10,7 @@
 #include <iostream>
 
 #include "app/machine_run.hpp"
+#include "app/machine_pictures.hpp"
 #include "app/options.hpp"
 #include "app/report.hpp"
 #include "app/scene_input.hpp"
@@ -30,6 +31,9 @@ int run(const app::Options& o) {
   if (!o.quiet) app::print_report(std::cout, result.report);
   // Asked for by name, so printed even when --quiet.
   if (result.report.machine) std::cout << nodes::format_routes(result.report.machine->report);
+  if (result.report.machine)
+    app::write_machine_pictures({o.pictures.machine_svg, o.pictures.ownership_png, o.pictures.report_html},
+                                result.report.scene, result.image, result.report.machine->report);
   return 0;
 }
 

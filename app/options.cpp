@@ -20,6 +20,7 @@ struct Raw {
   std::string topology, schedule, distribution;
   std::int64_t nodes = 0, threads = 0, cache_pages = 0, cache_kb = 0, grain = 0, workers = 0,
                trace_routes = 0;
+  TimingChoice timing;
 };
 
 po::options_description describe_render(Options& o, Raw& raw) {
@@ -68,6 +69,7 @@ po::options_description describe_machine(Options& o, Raw& raw) {
        "print the routes of the first N packets hop by hop")
       ("compare-serial", po::bool_switch(&o.compare_serial),
        "also run the 1-node machine; report speedup and efficiency T1/(N*TN)");
+  add_timing_options(d, raw.timing, o.pictures);
   return d;
 }
 
@@ -136,6 +138,7 @@ void check_machine(Options& o, const Raw& raw, const po::variables_map& vm) {
   if (raw.distribution == "modulo") m.distribution = nodes::Distribution::modulo;
   else if (raw.distribution == "block") m.distribution = nodes::Distribution::block;
   else throw UsageError("--distribution: expected modulo or block, got '" + raw.distribution + "'");
+  m.timing = timing_from(raw.timing);
 }
 
 }  // namespace

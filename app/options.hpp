@@ -8,6 +8,7 @@
 #include <stdexcept>
 #include <string>
 
+#include "app/timing_options.hpp"
 #include "nodes/machine.hpp"
 #include "tracer/database.hpp"
 
@@ -39,6 +40,7 @@ struct Options {
   // Topology, nodes, threads, cache, grain, schedule, workers, distribution and
   // route tracing; trace and progress are filled in at run time.
   nodes::MachineOptions machine;
+  PicturePaths pictures;  // written after a machine render (timing_options.hpp)
 };
 
 // Throws UsageError. argv[0] is the program name.

@@ -9,6 +9,7 @@
 
 #include "app/options.hpp"
 #include "app/scene_input.hpp"
+#include "app/timing_options.hpp"
 
 namespace app {
 
@@ -66,18 +67,6 @@ po::options_description describe(SweepOptions& o, RawSweep& raw) {
   return d;
 }
 
-nodes::CostModel model_from(const std::string& profile, const std::string& costs) {
-  nodes::CostModel model;
-  try {
-    model = profile == "ipsc2" || profile == "native" ? nodes::profile_named(profile)
-                                                      : nodes::read_profile_file(profile);
-    if (!costs.empty()) nodes::apply_costs(model, costs, "--cost");
-  } catch (const std::invalid_argument& e) {
-    throw UsageError(e.what());
-  }
-  return model;
-}
-
 void check_sweep(SweepOptions& o, const RawSweep& raw) {
   if (raw.kind == "nodes") o.kind = SweepOptions::Kind::nodes;
   else if (raw.kind == "cache") o.kind = SweepOptions::Kind::cache;
@@ -127,7 +116,7 @@ SweepOptions parse_sweep_options(int argc, const char* const argv[]) {
   }
   if (vm.count("help")) throw UsageError("help");
   check_sweep(o, raw);
-  o.model = model_from(raw.profile, raw.costs);
+  o.model = cost_model_from(raw.profile, raw.costs);
   return o;
 }
 

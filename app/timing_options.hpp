@@ -1,0 +1,38 @@
+// The command-line face of virtual time and of the pictures of a machine run:
+// --timing real|virtual, --profile NAME|FILE, --cost key=value,...,
+// --machine-svg, --ownership, --report. Kept apart from options.cpp so the
+// sweep subcommand parses machine models the same way.
+#pragma once
+
+#include <optional>
+#include <string>
+
+#include <boost/program_options/options_description.hpp>
+
+#include "nodes/timing.hpp"
+
+namespace app {
+
+struct TimingChoice {
+  std::string timing = "real";     // real | virtual
+  std::string profile = "ipsc2";   // ipsc2 | native | a profile file
+  std::string costs;               // --cost items over the profile
+};
+
+struct PicturePaths {
+  std::string machine_svg;    // the machine with its traffic, after a machine render
+  std::string ownership_png;  // which processor computed each pixel
+  std::string report_html;    // image, statistics, machine picture and ownership together
+};
+
+void add_timing_options(boost::program_options::options_description& d, TimingChoice& timing,
+                        PicturePaths& pictures);
+
+// The model of --profile and --cost; UsageError naming the option (or
+// FILE:LINE for a profile file) when either is bad.
+nodes::CostModel cost_model_from(const std::string& profile, const std::string& costs);
+
+// The machine's timing: none for --timing real, the model for virtual.
+std::optional<nodes::CostModel> timing_from(const TimingChoice& choice);
+
+}  // namespace app
