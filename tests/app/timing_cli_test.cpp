@@ -1,0 +1,77 @@
+// `vmpray --timing virtual` end to end: the predicted time and statistics do
+// not depend on --threads, and bad timing options fail with one line naming
+// the option (or the profile file and line).
+#include <gtest/gtest.h>
+#include <sys/wait.h>
+
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <regex>
+#include <sstream>
+
+namespace {
+
+namespace fs = std::filesystem;
+
+class TimingCli : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    dir_ = fs::temp_directory_path() /
+           ("vmpray_timing_" + std::string(::testing::UnitTest::GetInstance()->current_test_info()->name()));
+    fs::remove_all(dir_);
+    fs::create_directories(dir_);
+  }
+  void TearDown() override { fs::remove_all(dir_); }
+
+  // Exit code; stderr in err_.
+  int run(const std::string& args) {
+    const std::string err_file = (dir_ / "stderr.txt").string();
+    const std::string cmd = "cd '" + dir_.string() + "' && " + VMPRAY_BINARY + " " + args + " >/dev/null 2>'" +
+                            err_file + "' </dev/null";
+    const int status = std::system(cmd.c_str());
+    err_ = read(err_file);
+    return WEXITSTATUS(status);
+  }
+
+  static std::string read(const fs::path& p) {
+    std::ifstream in(p);
+    std::stringstream s;
+    s << in.rdbuf();
+    return s.str();
+  }
+
+  // The JSON fields that must not depend on the thread count.
+  std::string deterministic_fields(const std::string& json) {
+    std::string out;
+    const std::regex field(R"re("(predicted_seconds|misses|pages_served|rays|items|parallel_seconds|seconds)": ([0-9.e+-]+))re");
+    for (auto it = std::sregex_iterator(json.begin(), json.end(), field); it != std::sregex_iterator(); ++it)
+      out += (*it)[1].str() + "=" + (*it)[2].str() + ";";
+    return out;
+  }
+
+  fs::path dir_;
+  std::string err_;
+};
+
+TEST_F(TimingCli, PredictionIsTheSameOnOneAndTwoThreads) {
+  const std::string common = "teapot:2 --width 16 --height 16 --nodes 8 --cache-pages 4 --timing virtual -q";
+  ASSERT_EQ(run(common + " --threads 1 --stats one.json -o one.png"), 0) << err_;
+  ASSERT_EQ(run(common + " --threads 2 --stats two.json -o two.png"), 0) << err_;
+  const std::string one = deterministic_fields(read(dir_ / "one.json"));
+  EXPECT_NE(one.find("predicted_seconds="), std::string::npos) << one;
+  EXPECT_EQ(one, deterministic_fields(read(dir_ / "two.json")));
+}
+
+TEST_F(TimingCli, BadTimingOptionsNameTheOptionOnOneLine) {
+  EXPECT_EQ(run("teapot:2 --width 8 --height 8 --timing sideways"), 2);
+  EXPECT_NE(err_.find("--timing"), std::string::npos) << err_;
+  EXPECT_EQ(run("teapot:2 --width 8 --height 8 --timing virtual --cost box=quick"), 2);
+  EXPECT_NE(err_.find("--cost"), std::string::npos) << err_;
+  std::ofstream(dir_ / "machine.txt") << "profile = ipsc2\nhop: 3us\n";
+  EXPECT_EQ(run("teapot:2 --width 8 --height 8 --timing virtual --profile machine.txt"), 2);
+  EXPECT_NE(err_.find("machine.txt:2:"), std::string::npos) << err_;
+  EXPECT_EQ(std::count(err_.begin(), err_.end(), '\n'), 1) << err_;
+}
+
+}  // namespace
