@@ -11,6 +11,8 @@
 #include <sstream>
 #include <string>
 
+#include "sanitizer_noise.hpp"
+
 namespace {
 
 namespace fs = std::filesystem;
@@ -38,7 +40,7 @@ class Cli : public ::testing::Test {
     std::ifstream in(err_file);
     std::stringstream ss;
     ss << in.rdbuf();
-    return {WEXITSTATUS(status), ss.str()};
+    return {WEXITSTATUS(status), without_sanitizer_noise(ss.str())};
   }
 
   std::size_t lines(const std::string& s) { return std::count(s.begin(), s.end(), '\n'); }
