@@ -39,13 +39,15 @@ const char* const csv_header =
 
 std::string kind_name(SweepOptions::Kind kind) { return kind == SweepOptions::Kind::nodes ? "nodes" : "cache"; }
 
-// One series per topology: y(point) against the sweep's axis.
+// One series per kind of topology ("hypercube:3" and "hypercube:4" are one
+// line): y(point) against the sweep's axis.
 std::vector<viz::Series> series_of(const SweepTable& t, double (*y)(const ExperimentPoint&)) {
   std::map<std::string, std::size_t> index;
   std::vector<viz::Series> series;
   for (const ExperimentPoint& p : t.points) {
-    auto [it, fresh] = index.try_emplace(p.topology, series.size());
-    if (fresh) series.push_back(viz::Series{.name = p.topology});
+    const std::string kind = p.topology.substr(0, p.topology.find(':'));
+    auto [it, fresh] = index.try_emplace(kind, series.size());
+    if (fresh) series.push_back(viz::Series{.name = kind});
     const double x = t.kind == SweepOptions::Kind::nodes ? p.nodes : p.cache_pages;
     series[it->second].points.push_back({x, y(p)});
   }

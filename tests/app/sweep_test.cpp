@@ -92,8 +92,12 @@ TEST(Sweep, NodesSweepWritesWellFormedTablesAndPlots) {
   EXPECT_NE(json.find("\"efficiency\": 1,"), std::string::npos);
   EXPECT_EQ(json.find("nan"), std::string::npos);
 
-  const auto svg = viz::test::check_xml(read(dir / "nodes.svg"));
+  const std::string svg_text = read(dir / "nodes.svg");
+  const auto svg = viz::test::check_xml(svg_text);
   EXPECT_TRUE(svg.ok) << svg.error;
+  // One line per kind of topology, whatever the node count.
+  EXPECT_NE(svg_text.find(">ring<"), std::string::npos);
+  EXPECT_EQ(svg_text.find("ring:4"), std::string::npos);
   for (const auto& f : files) EXPECT_TRUE(fs::exists(f)) << f;
 }
 
