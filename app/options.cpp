@@ -185,7 +185,8 @@ std::string usage_text() {
          "Ray traces SCENE (an NFF file, '-' for stdin, or a built-in scene; default teapot)\n"
          "on a simulated distributed-memory machine (default: a 16-node hypercube) whose\n"
          "processors share the scene database as object pages in a virtual memory, and\n"
-         "writes an image and a report of rays, page traffic, network and per-node work.\n\n"
+         "writes an image and a report of rays, page traffic, network and per-node work.\n"
+         "The paper's experiments: vmpray sweep nodes|cache [options] (see vmpray sweep --help).\n\n"
       << describe_render(o, raw) << "\n" << describe_machine(o, raw) << "\nBuilt-in scenes (NAME[:SIZE][:tRES]):\n";
   for (const auto& s : tracer::builtin_scenes()) out << "  " << s.name << "  " << s.description << "\n";
   return out.str();
