@@ -40,6 +40,8 @@ std::size_t Alt::select_from(std::size_t first) {
   if (channels_.empty() && timeout_guard_ == none && !has_skip_) {
     throw std::logic_error("Alt::select: every guard is disabled (occam STOP)");
   }
+  const std::size_t hinted = poll_hints(first);
+  if (hinted != none) return hinted;
   const Clock::time_point start = timeout_guard_ == none ? Clock::time_point() : Clock::now();
   lock_channels();
   const std::size_t ready = poll_locked(first);
@@ -54,22 +56,51 @@ std::size_t Alt::select_from(std::size_t first) {
 
 // Derives from the enabled guards what every select needs: the distinct
 // channels in address order (the locking order), the earliest timeout, SKIP.
+// The address order of all input guards is sorted once, when guards change.
 void Alt::prepare() {
+  if (by_address_.size() != guards_.size()) sort_by_address();
   channels_.clear();
   timeout_guard_ = none;
   has_skip_ = false;
-  for (std::size_t i = 0; i < guards_.size(); ++i) {
+  for (std::size_t i : by_address_) {
     const Guard& g = guards_[i];
     if (!g.enabled) continue;
-    if (g.kind == Kind::input) channels_.push_back(g.channel.get());
+    if (on_channel(g.kind) && (channels_.empty() || channels_.back() != g.channel.get()))
+      channels_.push_back(g.channel.get());
     if (g.kind == Kind::skip) has_skip_ = true;
     if (g.kind == Kind::timeout && (timeout_guard_ == none || g.after < guards_[timeout_guard_].after)) {
       timeout_guard_ = i;
     }
   }
-  std::sort(channels_.begin(), channels_.end(), std::less<>());
-  channels_.erase(std::unique(channels_.begin(), channels_.end()), channels_.end());
   dirty_ = false;
+}
+
+void Alt::sort_by_address() {
+  by_address_.resize(guards_.size());
+  for (std::size_t i = 0; i < guards_.size(); ++i) by_address_[i] = i;
+  std::stable_sort(by_address_.begin(), by_address_.end(), [this](std::size_t a, std::size_t b) {
+    return std::less<>()(guards_[a].channel.get(), guards_[b].channel.get());
+  });
+}
+
+// Lock-free first pass: the first channel guard whose hint says ready,
+// confirmed under that channel's lock alone (a channel has one reader, and
+// a room guard's channel one writer, so it stays ready until this ALT's owner
+// acts on it). SKIP and timeouts are left to the locked poll. `none` sends
+// the caller to the full locked path, which decides for certain.
+std::size_t Alt::poll_hints(std::size_t first) const {
+  if (has_skip_ || timeout_guard_ != none) return none;
+  const std::size_t n = guards_.size();
+  for (std::size_t k = 0; k < n; ++k) {
+    const std::size_t i = (first + k) % n;
+    const Guard& g = guards_[i];
+    if (!g.enabled) continue;
+    const bool room = g.kind == Kind::room;
+    if (!(room ? g.channel->room_hint() : g.channel->ready_hint())) continue;
+    detail::ChannelLock lk(g.channel->lock_);
+    return (room ? g.channel->room_locked() : g.channel->ready_locked()) ? i : none;
+  }
+  return none;
 }
 
 std::size_t Alt::poll_locked(std::size_t first) const {
@@ -80,13 +111,14 @@ std::size_t Alt::poll_locked(std::size_t first) const {
     if (!g.enabled) continue;
     const bool ready = g.kind == Kind::skip ||
                        (g.kind == Kind::input && g.channel->ready_locked()) ||
+                       (g.kind == Kind::room && g.channel->room_locked()) ||
                        (g.kind == Kind::timeout && g.after <= Clock::duration::zero());
     if (ready) return i;
   }
   return none;
 }
 
-// Channels locked; nothing ready. Links a record per enabled input guard,
+// Channels locked; nothing ready. Links a record per enabled channel guard,
 // parks once, then unlinks whatever the winner left behind.
 std::size_t Alt::wait_locked(std::size_t timeout_guard, Clock::time_point deadline) {
   detail::Waiter w;
@@ -95,15 +127,15 @@ std::size_t Alt::wait_locked(std::size_t timeout_guard, Clock::time_point deadli
   records_.clear();
   records_.reserve(guards_.size());
   for (std::size_t i = 0; i < guards_.size(); ++i) {
-    if (guards_[i].enabled && guards_[i].kind == Kind::input) {
+    if (guards_[i].enabled && on_channel(guards_[i].kind)) {
       records_.emplace_back();
       records_.back().waiter = &w;
       records_.back().guard = i;
     }
   }
   auto record = records_.begin();
-  for (std::size_t i = 0; i < guards_.size(); ++i) {
-    if (guards_[i].enabled && guards_[i].kind == Kind::input) guards_[i].channel->readers_.push_back(*record++);
+  for (const Guard& g : guards_) {
+    if (g.enabled && on_channel(g.kind)) queue_of(g).push_back(*record++);
   }
 
   // Armed under every lock, since a waker may claim w as soon as one is
@@ -138,8 +170,12 @@ std::size_t Alt::wait_locked(std::size_t timeout_guard, Clock::time_point deadli
 void Alt::unlink_records() {
   auto record = records_.begin();
   for (const Guard& g : guards_) {
-    if (g.enabled && g.kind == Kind::input) g.channel->readers_.erase(*record++);
+    if (g.enabled && on_channel(g.kind)) queue_of(g).erase(*record++);
   }
+}
+
+detail::RecordQueue& Alt::queue_of(const Guard& g) {
+  return g.kind == Kind::room ? g.channel->room_waiters_ : g.channel->readers_;
 }
 
 void Alt::lock_channels() {

@@ -1,6 +1,7 @@
 // Occam ALT: waits until one of several guards is ready and says which.
 //
-// Guards: channel inputs, a timeout (ready `after` from the start of each
+// Guards: channel inputs, room in a buffered channel's output (ready when a
+// write would not block), a timeout (ready `after` from the start of each
 // select), SKIP (always ready); each may be switched off with enable().
 // select() is a fair ALT — polling starts at a rotating favourite, one past
 // the last guard chosen, so among guards that stay ready each is chosen within
@@ -10,14 +11,18 @@
 // poll; if nothing is ready, link one waiter record on every enabled channel
 // and park once. The first writer (or poison, or the timer) to claim the
 // waiter wins; on wake-up the ALT relocks its channels and unlinks the losing
-// records. After select() returns i for an input guard, the caller reads that
-// input: since a channel has a single reader, the read does not block.
-// A poisoned input counts as ready; its read throws Poisoned.
+// records. Before locking, a lock-free pass over the channels' ready hints
+// usually finds a ready guard at the cost of one lock. After select() returns
+// i for an input guard, the caller reads that input: since a channel has a
+// single reader, the read does not block. Likewise a room guard is for the
+// channel's only writer, whose next write then does not block.
+// A poisoned channel counts as ready; the read or write throws Poisoned.
 #pragma once
 
 #include <chrono>
 #include <cstddef>
 #include <memory>
+#include <stdexcept>
 #include <vector>
 
 #include "csp/channel.hpp"
@@ -30,6 +35,12 @@ class Alt {
   std::size_t add_input(In<T> in) {
     return add(Guard{Kind::input, std::move(in.state_), {}, true});
   }
+  // For a buffered channel written only by this ALT's owner.
+  template <class T>
+  std::size_t add_room(Out<T> out) {
+    if (out.state_->capacity() == 0) throw std::logic_error("Alt::add_room: '" + out.name() + "' is unbuffered");
+    return add(Guard{Kind::room, std::move(out.state_), {}, true});
+  }
   std::size_t add_timeout(std::chrono::steady_clock::duration after) {
     return add(Guard{Kind::timeout, nullptr, after, true});
   }
@@ -41,10 +52,11 @@ class Alt {
   std::size_t pri_select();
 
  private:
-  enum class Kind { input, timeout, skip };
+  enum class Kind { input, room, timeout, skip };
+  static bool on_channel(Kind k) { return k == Kind::input || k == Kind::room; }
   struct Guard {
     Kind kind = Kind::input;
-    std::shared_ptr<detail::ChannelBase> channel;  // input guards only
+    std::shared_ptr<detail::ChannelBase> channel;  // input and room guards only
     std::chrono::steady_clock::duration after{};   // timeout guards only
     bool enabled = true;
   };
@@ -52,9 +64,12 @@ class Alt {
   std::size_t add(Guard g);
   std::size_t select_from(std::size_t first);
   void prepare();
+  void sort_by_address();
+  std::size_t poll_hints(std::size_t first) const;
   std::size_t poll_locked(std::size_t first) const;
   std::size_t wait_locked(std::size_t timeout_guard, detail::Clock::time_point deadline);
   void unlink_records();
+  static detail::RecordQueue& queue_of(const Guard& g);
   void lock_channels();
   void unlock_channels();
 
@@ -64,7 +79,8 @@ class Alt {
   std::size_t favourite_ = 0;
   // Derived from the enabled guards by prepare(), again only after a change.
   bool dirty_ = true;
-  std::vector<detail::ChannelBase*> channels_;  // distinct, in address order
+  std::vector<std::size_t> by_address_;         // all guards, by channel address
+  std::vector<detail::ChannelBase*> channels_;  // enabled, distinct, in address order
   std::size_t timeout_guard_ = none;            // earliest enabled timeout
   bool has_skip_ = false;
   std::vector<detail::Record> records_;         // scratch: one per enabled input

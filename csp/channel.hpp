@@ -7,6 +7,13 @@
 //   writer fills directly (so the writer returns without parking: the reader
 //   has taken the value). A writer that finds only an ALT reader fires the
 //   ALT, then parks until the ALT's read takes the value.
+// - An ALT may wait for room in a buffered channel (Alt::add_room): its
+//   record waits in room_waiters_, and the reader that frees a slot (with no
+//   parked writer to refill it) fires it. Poison fires it too.
+// - ready_hint()/room_hint() mirror ready_locked()/room_locked() for
+//   lock-free polling by an ALT: republished under the lock after every
+//   change of the buffer or the parked writers, so they may be stale to
+//   another thread; an ALT confirms a hint under the lock.
 // - capacity k: a bounded buffer of exactly k values. Readers park only when
 //   it is empty, writers only when it is full; a reader that frees a slot
 //   moves the first parked writer's value in and wakes that writer.
@@ -41,11 +48,14 @@ template <class T>
 class ChannelState final : public ChannelBase {
  public:
   ChannelState(std::string name, std::size_t capacity)
-      : ChannelBase(std::move(name), capacity), ring_(capacity) {}
+      : ChannelBase(std::move(name), capacity), ring_(capacity) {
+    publish_hints(false, capacity > 0);
+  }
 
   bool ready_locked() const override {
     return poisoned() || count_ > 0 || !writers_.empty();
   }
+  bool room_locked() const override { return poisoned() || count_ < capacity_; }
 
   T read() {
     ChannelLock lk(lock_);
@@ -100,6 +110,7 @@ class ChannelState final : public ChannelBase {
     rec.waiter = &w;
     rec.slot = &value;
     writers_.push_back(rec);
+    note_ready_locked();
     finish_wait(park(w, lk.get()), rec, writers_);
   }
 
@@ -124,12 +135,16 @@ class ChannelState final : public ChannelBase {
       if (Record* r = claim_front_locked(writers_)) {
         push_locked(std::move(*static_cast<T*>(r->slot)));
         complete(*r->waiter, WaitState::data, r->guard);
+      } else if (Record* alt = claim_front_locked(room_waiters_)) {
+        complete(*alt->waiter, WaitState::data, alt->guard);
       }
+      note_ready_locked();
       return v;
     }
     if (Record* r = claim_front_locked(writers_)) {
       std::optional<T> v(std::move(*static_cast<T*>(r->slot)));
       complete(*r->waiter, WaitState::data, r->guard);
+      note_ready_locked();
       return v;
     }
     return std::nullopt;
@@ -164,7 +179,10 @@ class ChannelState final : public ChannelBase {
   void push_locked(T&& value) {
     ring_[(head_ + count_) % capacity_].emplace(std::move(value));
     ++count_;
+    note_ready_locked();
   }
+
+  void note_ready_locked() { publish_hints(count_ > 0 || !writers_.empty(), count_ < capacity_); }
 
   // After park(): throws for poison and deadlock; data needs nothing more.
   void finish_wait(WaitState s, Record& rec, RecordQueue& q) {
@@ -172,6 +190,7 @@ class ChannelState final : public ChannelBase {
     if (s == WaitState::poisoned) throw Poisoned(name_);
     ChannelLock lk(lock_);
     q.erase(rec);
+    note_ready_locked();
     lk.unlock();
     unwind_deadlock();
   }
@@ -230,6 +249,7 @@ class Out {
 
  private:
   friend class Channel<T>;
+  friend class Alt;
   explicit Out(std::shared_ptr<detail::ChannelState<T>> s) : state_(std::move(s)) {}
   std::shared_ptr<detail::ChannelState<T>> state_;
 };

@@ -53,6 +53,7 @@ void ChannelBase::poison() {
   poisoned_.store(true, std::memory_order_release);
   wake_all_locked(readers_, WaitState::poisoned);
   wake_all_locked(writers_, WaitState::poisoned);
+  wake_all_locked(room_waiters_, WaitState::poisoned);
 }
 
 Record* ChannelBase::claim_front_locked(RecordQueue& q) {

@@ -93,20 +93,35 @@ class ChannelBase {
 
   // Lock must be held. True if a read would not block (data, or poison).
   virtual bool ready_locked() const = 0;
+  // Lock must be held. True if a write would not block: a buffered channel
+  // with a free slot (or poison, which makes the write throw at once).
+  virtual bool room_locked() const = 0;
+  // No lock: ready_locked() and room_locked() as last published (see
+  // channel.hpp).
+  bool ready_hint() const { return poisoned() || ready_hint_.load(std::memory_order_relaxed); }
+  bool room_hint() const { return poisoned() || room_hint_.load(std::memory_order_relaxed); }
+  std::size_t capacity() const { return capacity_; }
 
   Spinlock lock_;
   RecordQueue readers_;  // guarded by lock_
   RecordQueue writers_;  // guarded by lock_
+  RecordQueue room_waiters_;  // ALTs waiting for a free slot; guarded by lock_
 
  protected:
   // Lock must be held. Claims and completes the first live record of q with
   // the given outcome; returns it (slot still valid) or null if none is live.
   Record* claim_front_locked(RecordQueue& q);
+  void publish_hints(bool ready, bool room) {
+    ready_hint_.store(ready, std::memory_order_relaxed);
+    room_hint_.store(room, std::memory_order_relaxed);
+  }
   void wake_all_locked(RecordQueue& q, WaitState outcome);
 
   std::string name_;
   std::size_t capacity_;
   std::atomic<bool> poisoned_{false};
+  std::atomic<bool> ready_hint_{false};
+  std::atomic<bool> room_hint_{false};
 };
 
 // Claiming: try_claim() wins the waiter or reports a lost race; complete()

@@ -1,7 +1,9 @@
-// ALT: fairness, priority, boolean guards, timeout, SKIP, poisoned inputs.
+// ALT: fairness, priority, boolean guards, timeout, SKIP, poisoned inputs,
+// room guards on buffered outputs.
 #include <gtest/gtest.h>
 
 #include <array>
+#include <string>
 #include <stdexcept>
 #include <vector>
 
@@ -237,6 +239,103 @@ TEST(Alt, CrossThreadStressLosesNothing) {
   });
   rt.run();
   EXPECT_EQ(sum, long{writers} * per_writer * (per_writer + 1) / 2);
+}
+
+TEST(Alt, RoomGuardFiresOnlyOnceAReaderFreesASlot) {
+  csp::Channel<int> full("full", 2);
+  std::vector<std::string> events;
+  csp::Runtime rt(1);
+  rt.spawn("alt", 0, [&, out = full.writer()]() mutable {
+    out.write(1);
+    out.write(2);
+    int three = 3;
+    EXPECT_FALSE(out.try_write(three));
+    csp::Alt alt;
+    alt.add_room(out);
+    events.push_back("alt waits");
+    EXPECT_EQ(alt.select(), 0u);
+    events.push_back("alt woken");
+    EXPECT_TRUE(out.try_write(three));
+  });
+  rt.spawn("reader", 0, [&, in = full.reader()]() mutable {
+    csp::sleep_for(1ms);
+    events.push_back("reader reads " + std::to_string(in.read()));
+    EXPECT_EQ(in.read(), 2);
+    EXPECT_EQ(in.read(), 3);
+  });
+  rt.run();
+  ASSERT_EQ(events.size(), 3u);
+  EXPECT_EQ(events[0], "alt waits");
+  EXPECT_EQ(events[1], "reader reads 1");
+  EXPECT_EQ(events[2], "alt woken");
+}
+
+TEST(Alt, RoomGuardOnAnUnbufferedChannelIsAnError) {
+  csp::Channel<int> rendezvous("rendezvous");
+  csp::Alt alt;
+  EXPECT_THROW(alt.add_room(rendezvous.writer()), std::logic_error);
+}
+
+TEST(Alt, PoisonedRoomGuardIsReadyAndTheWriteThrows) {
+  csp::Channel<int> full("full", 1);
+  csp::Runtime rt(1);
+  rt.spawn("alt", 0, [&, out = full.writer()]() mutable {
+    out.write(1);
+    csp::Alt alt;
+    alt.add_room(out);
+    EXPECT_EQ(alt.select(), 0u);
+    EXPECT_THROW(out.write(2), csp::Poisoned);
+  });
+  rt.spawn("poisoner", 0, [&] {
+    csp::sleep_for(1ms);
+    full.poison();
+  });
+  rt.run();
+}
+
+// A forwarder that never blocks on output, as a router does: it holds back
+// at most one value, reading no input until room for it appears. Across two
+// threads every value arrives once and in order.
+TEST(Alt, ForwarderWithRoomGuardLosesNothingAcrossThreads) {
+  constexpr int count = 20000;
+  csp::Channel<int> in("in", 1), out("out", 2);
+  long sum = 0;
+  int last = 0;
+  bool ordered = true;
+  csp::Runtime rt(2);
+  rt.spawn("source", 0, [w = in.writer()]() mutable {
+    for (int k = 1; k <= count; ++k) w.write(k);
+  });
+  rt.spawn("forwarder", 0, [r = in.reader(), w = out.writer()]() mutable {
+    csp::Alt alt;
+    const std::size_t input = alt.add_input(r);
+    const std::size_t room = alt.add_room(w);
+    int held = 0;
+    bool holding = false;
+    for (int moved = 0; moved < count;) {
+      alt.enable(input, !holding);
+      alt.enable(room, holding);
+      if (alt.select() == input) {
+        held = r.read();
+        holding = true;
+      }
+      if (w.try_write(held)) {
+        holding = false;
+        ++moved;
+      }
+    }
+  });
+  rt.spawn("sink", 1, [&, r = out.reader()]() mutable {
+    for (int k = 1; k <= count; ++k) {
+      const int v = r.read();
+      ordered = ordered && v == last + 1;
+      last = v;
+      sum += v;
+    }
+  });
+  rt.run();
+  EXPECT_TRUE(ordered);
+  EXPECT_EQ(sum, long{count} * (count + 1) / 2);
 }
 
 }  // namespace
