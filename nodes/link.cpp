@@ -1,4 +1,4 @@
-// Link process: pull a packet from the router, carry it, hand it on.
+// Link process: take a packet from the router's queue, carry it, hand it on.
 #include "nodes/link.hpp"
 
 #include <utility>
@@ -15,21 +15,13 @@ std::chrono::nanoseconds LinkModel::delay(std::size_t bytes) const {
   return d;
 }
 
-Link::Link(csp::Out<Ready> request, csp::In<Packet> reply, csp::Out<Packet> next, LinkModel model,
-           LinkCounters& counters)
-    : request_(std::move(request)),
-      reply_(std::move(reply)),
-      next_(std::move(next)),
-      model_(model),
-      counters_(counters) {}
+Link::Link(csp::In<Packet> queue, csp::Out<Packet> next, LinkModel model)
+    : queue_(std::move(queue)), next_(std::move(next)), model_(model) {}
 
 void Link::run() {
   for (;;) {
-    request_.write(Ready{});
-    Packet packet = reply_.read();
-    ++counters_.packets;
-    counters_.bytes += packet.payload.size();
-    if (model_.enabled()) csp::this_process::delay(model_.delay(packet.payload.size()));
+    Packet packet = queue_.read();
+    csp::this_process::delay(model_.delay(packet.payload.size()));
     next_.write(std::move(packet));
   }
 }

@@ -1,18 +1,15 @@
-// A link process: the output stage of one buffer class of one link (or of a
-// local delivery port). It owns no queue of its own beyond the packet it
-// carries; the bounded queue lives in the router it pulls from.
+// A link process: the wire of one buffer class of one link (or the delivery
+// stage into a local port) when the network models link costs. It takes the
+// next packet from the output queue its router writes (a bounded buffer
+// channel), holds it for latency + bytes / bandwidth — a real sleep, or
+// virtual time under csp's virtual-time scheduler (csp::this_process::delay)
+// — and hands it on to the neighbour router's input channel (or the local
+// port). One packet at a time: the link is busy while it carries one.
 //
-// Protocol (who wakes whom):
-//   link   -> router   request.write(Ready{})   "I can take a packet"
-//   router -> link     reply.write(packet)      only in answer to a request,
-//                                               so it never blocks for long
-//   link   -> next     next.write(packet)       the neighbour router's input
-//                                               channel (or the local port);
-//                                               may block: only this process
-//                                               waits, never the router.
-// With a link model the packet is delayed (latency + bytes / bandwidth)
-// between reply and next, modelling the wire: a real sleep, or virtual time
-// under csp's virtual-time scheduler (csp::this_process::delay).
+// Who wakes whom: the router's write wakes the link; the link's write wakes
+// the neighbour's router (its ALT) and may block: only this process waits,
+// never the router. Without a link model there is no link process: the
+// router's output queue is the neighbour's input channel itself.
 // Ends: the process stops when any of its channels is poisoned.
 #pragma once
 
@@ -24,8 +21,6 @@
 
 namespace nodes {
 
-struct Ready {};
-
 // Optional cost of crossing one link: e.g. iPSC/2 Direct-Connect links carry
 // about 2.8 MB/s. Zero bandwidth means infinitely fast.
 struct LinkModel {
@@ -36,7 +31,7 @@ struct LinkModel {
   std::chrono::nanoseconds delay(std::size_t bytes) const;
 };
 
-// Owned by one link process; read only after the runtime has stopped.
+// Traffic of one output queue, counted by the router that writes it.
 struct LinkCounters {
   std::uint64_t packets = 0;
   std::uint64_t bytes = 0;  // payload bytes
@@ -44,16 +39,13 @@ struct LinkCounters {
 
 class Link {
  public:
-  Link(csp::Out<Ready> request, csp::In<Packet> reply, csp::Out<Packet> next, LinkModel model,
-       LinkCounters& counters);
+  Link(csp::In<Packet> queue, csp::Out<Packet> next, LinkModel model);
   void run();
 
  private:
-  csp::Out<Ready> request_;
-  csp::In<Packet> reply_;
+  csp::In<Packet> queue_;
   csp::Out<Packet> next_;
   LinkModel model_;
-  LinkCounters& counters_;
 };
 
 }  // namespace nodes

@@ -31,17 +31,14 @@ Network::Network(csp::Runtime& runtime, topology::Topology topology, NetworkOpti
   if (options_.ports_per_node == 0) throw std::invalid_argument("network: each node needs at least one local port");
   const std::size_t n = topology_.size();
   link_in_.resize(n);
-  injections_.resize(n);
   ports_.resize(n);
-  link_counters_.resize(n);
   for (NodeId node = 0; node < n; ++node) {
     for (NodeId from : topology_.neighbours(node))
-      for (unsigned c = 0; c < classes_; ++c) link_in_[node].emplace_back(link_name(from, node, c));
-    for (unsigned j = 0; j < options_.ports_per_node; ++j) {
-      const std::string where = std::to_string(node) + "." + std::to_string(j);
-      injections_[node].emplace_back("inject " + where);
-      ports_[node].emplace_back("port " + where);
-    }
+      for (unsigned c = 0; c < classes_; ++c)
+        link_in_[node].emplace_back(link_name(from, node, c), queue_capacity());
+    injections_.emplace_back("inject " + std::to_string(node));
+    for (unsigned j = 0; j < options_.ports_per_node; ++j)
+      ports_[node].emplace_back("port " + std::to_string(node) + "." + std::to_string(j), queue_capacity());
     router_counters_.push_back(std::make_unique<RouterCounters>());
   }
   for (NodeId node = 0; node < n; ++node) wire_node(runtime, node);
@@ -52,46 +49,47 @@ unsigned Network::thread_of(NodeId node) const {
                             : block_placement(node, topology_.size(), threads_);
 }
 
+// Without a link model the channels into routers and ports are the routers'
+// output queues; with one, each is a rendezvous fed by a link process.
+std::size_t Network::queue_capacity() const { return options_.link.enabled() ? 0 : options_.buffer_capacity; }
+
 // Link inputs of `node` are numbered by the port on `node` the link comes in
-// by: the link process of (m, port_to(m, node), c) writes input
+// by: output queue (port_to(node, m), c) of m feeds input
 // port_to(node, m) * classes + c of node.
 void Network::wire_node(csp::Runtime& runtime, NodeId node) {
   RouterEnds ends;
   for (const auto& ch : link_in_[node]) ends.inputs.push_back(ch.reader());
-  for (const auto& ch : injections_[node]) ends.injections.push_back(ch.reader());
+  ends.injections.push_back(injections_[node].reader());
   const auto neighbours = topology_.neighbours(node);
   for (topology::Port p = 0; p < neighbours.size(); ++p) {
     const NodeId m = neighbours[p];
     const std::size_t back = topology_.port_to(m, node);
     for (unsigned c = 0; c < classes_; ++c)
-      spawn_link(runtime, node, ends, link_in_[m][back * classes_ + c].writer(),
-                 link_name(node, m, c));
+      ends.outputs.push_back(output_queue(runtime, node, link_in_[m][back * classes_ + c]));
   }
   for (unsigned j = 0; j < options_.ports_per_node; ++j)
-    spawn_link(runtime, node, ends, ports_[node][j].writer(),
-               "deliver " + std::to_string(node) + "." + std::to_string(j));
-  RouterConfig config{options_.buffer_capacity, options_.trace_routes};
+    ends.outputs.push_back(output_queue(runtime, node, ports_[node][j]));
+  RouterConfig config{options_.trace_routes};
   auto router = std::make_shared<Router>(topology_, node, std::move(ends), config,
                                          *router_counters_[node]);
   runtime.spawn("router " + std::to_string(node), thread_of(node), [router] { router->run(); });
 }
 
-void Network::spawn_link(csp::Runtime& runtime, NodeId node, RouterEnds& ends,
-                         csp::Out<Packet> next, const std::string& name) {
-  csp::Channel<Ready> request(name + " request");
-  csp::Channel<Packet> reply(name + " reply");
-  ends.requests.push_back(request.reader());
-  ends.replies.push_back(reply.writer());
-  link_counters_[node].push_back(std::make_unique<LinkCounters>());
-  auto link = std::make_shared<Link>(request.writer(), reply.reader(), std::move(next),
-                                     options_.link, *link_counters_[node].back());
-  requests_.push_back(std::move(request));
-  replies_.push_back(std::move(reply));
+// The channel a router of `node` writes to reach `next`: `next` itself, or
+// with a link model a queue that a new link process carries into `next`.
+csp::Out<Packet> Network::output_queue(csp::Runtime& runtime, NodeId node, const csp::Channel<Packet>& next) {
+  if (!options_.link.enabled()) return next.writer();
+  const std::string name = "wire into " + next.name();
+  wires_.emplace_back(name, options_.buffer_capacity);
+  auto link = std::make_shared<Link>(wires_.back().reader(), next.writer(), options_.link);
   runtime.spawn(name, thread_of(node), [link] { link->run(); });
+  return wires_.back().writer();
 }
 
 csp::Out<Packet> Network::injector(NodeId node, unsigned port) const {
-  return injections_.at(node).at(port).writer();
+  if (port >= options_.ports_per_node)
+    throw std::out_of_range("network: node " + std::to_string(node) + " has no port " + std::to_string(port));
+  return injections_.at(node).writer();
 }
 
 csp::In<Packet> Network::port(NodeId node, unsigned port) const {
@@ -99,10 +97,8 @@ csp::In<Packet> Network::port(NodeId node, unsigned port) const {
 }
 
 void Network::shutdown() {
-  for (auto& node : injections_)
-    for (auto& ch : node) ch.poison();
-  for (auto& ch : requests_) ch.poison();
-  for (auto& ch : replies_) ch.poison();
+  for (auto& ch : injections_) ch.poison();
+  for (auto& ch : wires_) ch.poison();
   for (auto& node : link_in_)
     for (auto& ch : node) ch.poison();
   for (auto& node : ports_)
@@ -122,7 +118,7 @@ NetworkStats Network::stats() const {
     for (topology::Port p = 0; p < neighbours.size(); ++p) {
       LinkStats link{node, neighbours[p], 0, 0};
       for (unsigned c = 0; c < classes_; ++c) {
-        const LinkCounters& lc = *link_counters_[node][p * classes_ + c];
+        const LinkCounters& lc = r.sent[p * classes_ + c];
         link.packets += lc.packets;
         link.bytes += lc.bytes;
       }
@@ -164,11 +160,11 @@ std::string format_summary(const NetworkStats& stats, const topology::Topology& 
   std::uint32_t peak = 0;
   std::uint64_t forwarded = 0;
   for (const auto& r : stats.routers) {
-    peak = std::max(peak, r.peak_queued);
+    peak = std::max(peak, r.peak_pending);
     forwarded += r.forwarded;
   }
-  out << "  packets forwarded by routers " << forwarded << ", peak packets held by one router "
-      << peak << "\n";
+  out << "  packets forwarded by routers " << forwarded
+      << ", most packets held back by one router (its output queues full) " << peak << "\n";
   return out.str();
 }
 

@@ -3,18 +3,22 @@
 //
 // Per node n (all placed on thread placement(n), block placement by default,
 // so most links join processes of the same thread):
-//   - one Router process (router.hpp),
-//   - one Link process per outgoing link and buffer class, carrying packets
-//     to the neighbour's router over a rendezvous channel,
-//   - one delivery Link process per local port, writing to that port's
-//     channel, which the application reads through port(n, p).
-// Every buffer is bounded (buffer_capacity packets per queue); deadlock
-// freedom rests on the acyclic channel dependencies of topology::next_hop
-// and on the consumption assumption documented in router.hpp.
+//   - one Router process (router.hpp), whose output queues are buffered
+//     channels of buffer_capacity packets: one per outgoing link and buffer
+//     class, read by the neighbour's router, and one per local port, which
+//     the application reads through port(n, p);
+//   - with a link model only: one Link process per output queue (link.hpp)
+//     that carries each packet across the modelled wire into the
+//     neighbour's router (or the port) over a rendezvous channel.
+// Every buffer is bounded; deadlock freedom rests on the acyclic channel
+// dependencies of topology::next_hop and on the consumption assumption
+// documented in router.hpp.
 //
 // Use: create the Network before Runtime::run(); local processes write to
-// injector(n, p) (one injection channel per local port: give each channel one
-// writing process) and read port(n, p). Once the application knows nothing
+// injector(n, p) and read port(n, p). The local processes of a node share
+// one injection channel into its router (a many-writer rendezvous, blocked
+// writers served in FIFO order), which keeps the router's ALT short; a
+// process blocked on it holds up no packet on its way to any port. Once the application knows nothing
 // is in flight, one of its processes calls shutdown(), which poisons every
 // network channel: routers, link processes and any reader of a port end with
 // csp::Poisoned, so run() returns with no fiber left blocked. Packets still
@@ -37,7 +41,7 @@ namespace nodes {
 
 struct NetworkOptions {
   std::size_t buffer_capacity = 4;  // packets per output queue, at least 1
-  unsigned ports_per_node = 1;      // local ports (and injection channels) per node
+  unsigned ports_per_node = 1;      // local ports per node
   std::uint64_t trace_routes = 0;   // record routes of packets whose id is below this
   LinkModel link;                   // optional per-hop latency and bandwidth
   std::function<unsigned(NodeId)> placement;  // thread of node n; default block
@@ -81,8 +85,8 @@ class Network {
 
  private:
   void wire_node(csp::Runtime& runtime, NodeId node);
-  void spawn_link(csp::Runtime& runtime, NodeId node, RouterEnds& ends, csp::Out<Packet> next,
-                  const std::string& name);
+  csp::Out<Packet> output_queue(csp::Runtime& runtime, NodeId node, const csp::Channel<Packet>& next);
+  std::size_t queue_capacity() const;
 
   topology::Topology topology_;
   NetworkOptions options_;
@@ -90,14 +94,12 @@ class Network {
   unsigned threads_;
   // Per node, per (port, class): the channel into that node's router.
   std::vector<std::vector<csp::Channel<Packet>>> link_in_;
-  std::vector<std::vector<csp::Channel<Packet>>> injections_;
+  std::vector<csp::Channel<Packet>> injections_;  // per node
   std::vector<std::vector<csp::Channel<Packet>>> ports_;
-  std::vector<csp::Channel<Ready>> requests_;
-  std::vector<csp::Channel<Packet>> replies_;
+  std::vector<csp::Channel<Packet>> wires_;  // link model only: router -> link process
   // Counters live here so they outlive the processes; each is written by
   // exactly one process and read only after run().
   std::vector<std::unique_ptr<RouterCounters>> router_counters_;
-  std::vector<std::vector<std::unique_ptr<LinkCounters>>> link_counters_;  // [node][queue]
 };
 
 // "page 17: 5 → 4 → 6 → 7 (3 hops)"

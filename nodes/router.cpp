@@ -1,5 +1,5 @@
-// Router process: ALT over link inputs, injections and link-process requests;
-// bounded output queues; pending slots that hold back a full route.
+// Router process: ALT over link inputs, injections and room in the outputs
+// that held-back packets wait for; pending slots that hold back a full route.
 #include "nodes/router.hpp"
 
 #include <algorithm>
@@ -29,19 +29,20 @@ Router::Router(topology::Topology topology, NodeId self, RouterEnds ends, Router
       config_(config),
       counters_(counters),
       link_queues_(ends_.inputs.size()),
-      queues_(ends_.requests.size()),
-      pending_(ends_.inputs.size() + ends_.injections.size()) {}
+      pending_(ends_.inputs.size() + ends_.injections.size()),
+      held_for_(ends_.outputs.size(), 0) {
+  counters_.sent.assign(ends_.outputs.size(), LinkCounters{});
+}
 
 void Router::run() {
   build_alt();
   for (;;) {
-    update_guards();
     const std::size_t guard = alt_.select();
-    if (guard < request_guard_.size()) {
-      send(guard);
+    if (guard < room_guard_.size()) {
+      admit_pending(guard);
       continue;
     }
-    const std::size_t source = guard - request_guard_.size();
+    const std::size_t source = guard - room_guard_.size();
     Packet packet = source < ends_.inputs.size()
                         ? ends_.inputs[source].read()
                         : ends_.injections[source - ends_.inputs.size()].read();
@@ -49,17 +50,15 @@ void Router::run() {
   }
 }
 
-// Requests first, then sources (inputs, injections): guard index = position.
+// Room guards first (one per output, enabled while a packet waits for it),
+// then sources (inputs, injections): guard index = position.
 void Router::build_alt() {
-  for (const auto& in : ends_.requests) request_guard_.push_back(alt_.add_input(in));
+  for (const auto& out : ends_.outputs) {
+    room_guard_.push_back(alt_.add_room(out));
+    alt_.enable(room_guard_.back(), false);
+  }
   for (const auto& in : ends_.inputs) source_guard_.push_back(alt_.add_input(in));
   for (const auto& in : ends_.injections) source_guard_.push_back(alt_.add_input(in));
-}
-
-void Router::update_guards() {
-  for (std::size_t o = 0; o < queues_.size(); ++o) alt_.enable(request_guard_[o], !queues_[o].empty());
-  for (std::size_t s = 0; s < pending_.size(); ++s)
-    alt_.enable(source_guard_[s], !pending_[s].has_value());
 }
 
 void Router::receive(std::size_t source, Packet packet) {
@@ -70,18 +69,12 @@ void Router::receive(std::size_t source, Packet packet) {
     if (packet.traced) packet.route.push_back(self_);
   }
   const std::size_t queue = output_queue(packet);
-  if (queues_[queue].size() < config_.buffer_capacity) {
-    if (queue >= link_queues_) note_delivery(packet); else ++counters_.forwarded;
-    queues_[queue].push_back(std::move(packet));
-  } else {
-    pending_[source] = Pending{std::move(packet), queue};
-    ++pending_count_;
-  }
-  note_occupancy();
+  // Packets already held back for this output go first.
+  if (held_for_[queue] > 0 || !try_send(queue, packet)) hold(source, std::move(packet), queue);
 }
 
 void Router::accept_injection(Packet& packet) const {
-  const std::size_t ports = queues_.size() - link_queues_;
+  const std::size_t ports = ends_.outputs.size() - link_queues_;
   if (packet.destination >= topology_.size() || packet.port >= ports)
     throw std::out_of_range("node " + std::to_string(self_) + ": packet " +
                             std::to_string(packet.id) + " sent to node " +
@@ -101,46 +94,49 @@ std::size_t Router::output_queue(const Packet& packet) const {
   return hop.port * topology_.buffer_classes() + hop.buffer_class;
 }
 
-// The link process of `queue` has asked (its request is ready): answer it.
-void Router::send(std::size_t queue) {
-  ends_.requests[queue].read();
-  Packet packet = std::move(queues_[queue].front());
-  queues_[queue].pop_front();
-  ends_.replies[queue].write(std::move(packet));
-  admit_pending(queue);
+// Writes the packet into its output queue if that has room; false (packet
+// untouched) if it is full.
+bool Router::try_send(std::size_t queue, Packet& packet) {
+  const std::size_t bytes = packet.payload.size();
+  const bool delivery = queue >= link_queues_;
+  const std::uint32_t hops = packet.hops;
+  const std::uint8_t kind = packet.kind;
+  std::optional<RouteRecord> route;
+  if (delivery && packet.traced) route = RouteRecord{packet.id, packet.kind, packet.route};
+  if (!ends_.outputs[queue].try_write(packet)) return false;
+  ++counters_.sent[queue].packets;
+  counters_.sent[queue].bytes += bytes;
+  if (!delivery) {
+    ++counters_.forwarded;
+    return true;
+  }
+  ++counters_.delivered;
+  counters_.hops.add(hops);
+  counters_.hops_by_kind[kind].add(hops);
+  if (route) counters_.routes.push_back(std::move(*route));
+  return true;
 }
 
-// A slot of `queue` is free: admit one pending packet waiting for it, taking
+void Router::hold(std::size_t source, Packet packet, std::size_t queue) {
+  pending_[source] = Pending{std::move(packet), queue};
+  alt_.enable(source_guard_[source], false);
+  if (held_for_[queue]++ == 0) alt_.enable(room_guard_[queue], true);
+  counters_.peak_pending = std::max(counters_.peak_pending, ++pending_count_);
+}
+
+// `queue` has room: write the packets held back for it while it has, taking
 // the pending slots in rotation so that no input starves.
 void Router::admit_pending(std::size_t queue) {
-  if (pending_count_ == 0) return;
-  for (std::size_t k = 0; k < pending_.size(); ++k) {
+  for (std::size_t k = 0; k < pending_.size() && held_for_[queue] > 0; ++k) {
     const std::size_t s = (next_admit_ + k) % pending_.size();
     if (!pending_[s] || pending_[s]->queue != queue) continue;
-    if (queue >= link_queues_) note_delivery(pending_[s]->packet); else ++counters_.forwarded;
-    queues_[queue].push_back(std::move(pending_[s]->packet));
+    if (!try_send(queue, pending_[s]->packet)) return;
     pending_[s].reset();
+    alt_.enable(source_guard_[s], true);
     --pending_count_;
+    if (--held_for_[queue] == 0) alt_.enable(room_guard_[queue], false);
     next_admit_ = s + 1;
-    return;
   }
-}
-
-void Router::note_delivery(const Packet& packet) {
-  ++counters_.delivered;
-  counters_.hops.add(packet.hops);
-  counters_.hops_by_kind[packet.kind].add(packet.hops);
-  if (packet.traced) counters_.routes.push_back(RouteRecord{packet.id, packet.kind, packet.route});
-}
-
-void Router::note_occupancy() {
-  std::size_t total = pending_count_, longest = 0;
-  for (const auto& q : queues_) {
-    total += q.size();
-    longest = std::max(longest, q.size());
-  }
-  counters_.peak_queued = std::max(counters_.peak_queued, static_cast<std::uint32_t>(total));
-  counters_.peak_queue = std::max(counters_.peak_queue, static_cast<std::uint32_t>(longest));
 }
 
 }  // namespace nodes

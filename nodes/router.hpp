@@ -1,25 +1,26 @@
 // The router of one processor: store-and-forward switching by the topology's
 // deadlock-free routing function.
 //
-// Ends (all read by the router alone):
-//   inputs[q]    packets arriving over link port p in buffer class c,
-//                q = p * classes + c (written by the neighbour's link process)
-//   injections[j] packets sent by local process j of this node
-//   requests[o]  Ready from the link process of output queue o; outputs are
-//                the link queues (same numbering as inputs) then one
-//                delivery queue per local port
-//   replies[o]   the packet answering requests[o]
+// Ends (all inputs read, all outputs written by the router alone):
+//   inputs[q]     packets arriving over link port p in buffer class c,
+//                 q = p * classes + c
+//   injections[j] packets sent by the local processes of this node
+//   outputs[o]    bounded buffers (capacity K): the link queues (same
+//                 numbering as inputs), then one delivery queue per local port
 //
-// Protocol: one ALT (fair select) over all of these. A request is enabled
-// only when its queue holds a packet, so the reply write meets a link process
-// that is already waiting: the router never blocks on output while a
-// neighbour blocks on it. A packet read from input i goes to its output queue
-// if that has room (capacity K); otherwise it waits in pending[i] and input i
-// is disabled until the queue drains. So each (link, class) owns at most
-// K queued + 1 carried + 1 pending packets, a packet in one channel's buffers
-// waits only for the next channel on its route, and the acyclic channel
-// dependency graph of topology::next_hop makes the whole network free of
-// deadlock with bounded buffers.
+// Protocol: one ALT (fair select) over the inputs and, for every output that
+// a held-back packet waits for, a room guard. A packet read from input i is
+// written to its output queue at once if that has room (try_write: the router
+// never blocks on output while a neighbour blocks on it); otherwise it waits
+// in pending[i], input i is disabled, and the output's room guard is enabled
+// until the packet can be written. Pending packets waiting for one output are
+// admitted in rotation, so no input starves, and an output with packets held
+// back for it takes no newcomers first. So each (link, class) owns at most
+// K queued + 1 pending packets (+ 1 carried by a link process when a link
+// model is on), a packet in one channel's buffers waits only for the next
+// channel on its route, and the acyclic channel dependency graph of
+// topology::next_hop makes the whole network free of deadlock with bounded
+// buffers.
 //
 // Consumption assumption: a delivery queue is a sink; it drains as long as the
 // local process reading that port keeps reading, even while its own writes
@@ -30,7 +31,6 @@
 #pragma once
 
 #include <cstdint>
-#include <deque>
 #include <map>
 #include <optional>
 #include <vector>
@@ -63,9 +63,9 @@ struct RouterCounters {
   std::uint64_t injected = 0;
   std::uint64_t forwarded = 0;  // packets sent on into a link queue
   std::uint64_t delivered = 0;
-  std::uint32_t peak_queued = 0;  // most packets held at once (queues + pending)
-  std::uint32_t peak_queue = 0;   // longest single output queue
-  HopSummary hops;                // of packets delivered here
+  std::uint32_t peak_pending = 0;  // most packets held back at once (outputs full)
+  std::vector<LinkCounters> sent;  // per output queue: packets and payload bytes
+  HopSummary hops;                 // of packets delivered here
   std::map<std::uint8_t, HopSummary> hops_by_kind;
   std::vector<RouteRecord> routes;  // traced packets delivered here
 };
@@ -73,12 +73,10 @@ struct RouterCounters {
 struct RouterEnds {
   std::vector<csp::In<Packet>> inputs;
   std::vector<csp::In<Packet>> injections;
-  std::vector<csp::In<Ready>> requests;
-  std::vector<csp::Out<Packet>> replies;
+  std::vector<csp::Out<Packet>> outputs;  // buffered channels
 };
 
 struct RouterConfig {
-  std::size_t buffer_capacity = 1;
   std::uint64_t trace_routes = 0;  // trace packets whose id is below this
 };
 
@@ -95,14 +93,12 @@ class Router {
   };
 
   void build_alt();
-  void update_guards();
   void receive(std::size_t source, Packet packet);
   void accept_injection(Packet& packet) const;
-  void send(std::size_t queue);
+  bool try_send(std::size_t queue, Packet& packet);
+  void hold(std::size_t source, Packet packet, std::size_t queue);
   void admit_pending(std::size_t queue);
   std::size_t output_queue(const Packet& packet) const;
-  void note_delivery(const Packet& packet);
-  void note_occupancy();
 
   topology::Topology topology_;
   NodeId self_;
@@ -110,12 +106,12 @@ class Router {
   RouterConfig config_;
   RouterCounters& counters_;
   std::size_t link_queues_;  // degree * classes; delivery queues follow
-  std::vector<std::deque<Packet>> queues_;
   std::vector<std::optional<Pending>> pending_;  // per input, then per injection
-  std::size_t pending_count_ = 0;
+  std::vector<std::uint32_t> held_for_;          // per output: pending packets waiting for it
+  std::uint32_t pending_count_ = 0;
   std::size_t next_admit_ = 0;  // rotates which pending packet is admitted first
   csp::Alt alt_;
-  std::vector<std::size_t> request_guard_, source_guard_;
+  std::vector<std::size_t> room_guard_, source_guard_;
 };
 
 }  // namespace nodes
