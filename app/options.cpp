@@ -58,7 +58,7 @@ po::options_description describe_machine(Options& o, Raw& raw) {
       ("cache-pages", po::value(&raw.cache_pages),
        "remote pages cached per node (default: 1/8 of the database)")
       ("cache-kb", po::value(&raw.cache_kb), "the cache per node in KB instead of pages")
-      ("grain", po::value(&raw.grain)->default_value(4), "pixels handed out per work request")
+      ("grain", po::value(&raw.grain)->default_value(16), "pixels handed out per work request (a run along a scanline)")
       ("schedule", po::value(&raw.schedule)->default_value("dynamic"),
        "dynamic (pixels to whoever asks) or static (fixed shares)")
       ("workers-per-node", po::value(&raw.workers)->default_value(1),

@@ -56,7 +56,7 @@ struct MachineOptions {
   unsigned threads = 0;                // 0: hardware cores; never more than the nodes
   std::optional<std::uint32_t> cache_pages;  // remote pages cached per node
   std::optional<std::uint64_t> cache_kb;     // the same in KB; default (neither): 1/8 of the database
-  std::uint32_t grain = 4;             // items per tile
+  std::uint32_t grain = 16;            // items per tile: balance vs farming traffic
   Schedule schedule = Schedule::dynamic;
   int workers_per_node = 1;
   Distribution distribution = Distribution::modulo;
