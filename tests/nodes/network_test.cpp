@@ -107,7 +107,7 @@ TEST(Network, RandomStormWithBuffersOfOneDeliversEveryPacketOnce) {
       "hypercube:0", "hypercube:3", "hypercube:6", "hypercube:8", "mesh:1x1",  "mesh:3x5",
       "mesh:16x16",  "torus:1x1",   "torus:2x2",   "torus:5x3",   "torus:8x8", "torus:16x16",
       "ring:1",      "ring:2",      "ring:5",      "ring:64",     "ring:256",  "complete:1",
-      "complete:2",  "complete:7",  "complete:32"};
+      "complete:2",  "complete:7",  "complete:32", "complete:256"};
   for (const auto& spec : specs) {
     SCOPED_TRACE(spec);
     const auto t = topology::parse_topology(spec);
