@@ -2,50 +2,25 @@
 // output on failure, image and JSON on success.
 #include <gtest/gtest.h>
 
-#include <sys/wait.h>
-
 #include <algorithm>
-#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
 #include <string>
 
-#include "sanitizer_noise.hpp"
+#include "tests/support/scratch.hpp"
 
 namespace {
 
 namespace fs = std::filesystem;
 
-struct Outcome {
-  int exit_code;
-  std::string err;
-};
+using test::Outcome;
 
-class Cli : public ::testing::Test {
+class Cli : public test::ScratchTest {
  protected:
-  void SetUp() override {
-    dir_ = fs::temp_directory_path() /
-           ("vmpray_cli_" + std::string(::testing::UnitTest::GetInstance()->current_test_info()->name()));
-    fs::remove_all(dir_);
-    fs::create_directories(dir_);
-  }
-  void TearDown() override { fs::remove_all(dir_); }
-
-  Outcome run(const std::string& args) {
-    const std::string err_file = (dir_ / "stderr.txt").string();
-    const std::string cmd = "cd '" + dir_.string() + "' && " + VMPRAY_BINARY + " " + args +
-                            " >/dev/null 2>'" + err_file + "' </dev/null";
-    const int status = std::system(cmd.c_str());
-    std::ifstream in(err_file);
-    std::stringstream ss;
-    ss << in.rdbuf();
-    return {WEXITSTATUS(status), without_sanitizer_noise(ss.str())};
-  }
-
+  Cli() : ScratchTest("vmpray_cli_") {}
+  Outcome run(const std::string& args) { return run_vmpray(args); }
   std::size_t lines(const std::string& s) { return std::count(s.begin(), s.end(), '\n'); }
-
-  fs::path dir_;
 };
 
 TEST_F(Cli, MissingSceneFileIsARuntimeErrorWithNoOutput) {

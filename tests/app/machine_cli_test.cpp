@@ -4,11 +4,8 @@
 // and one-line errors with no output file for each kind of bad input.
 #include <gtest/gtest.h>
 
-#include <sys/wait.h>
-
 #include <algorithm>
 #include <cctype>
-#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <map>
@@ -18,6 +15,7 @@
 #include <vector>
 
 #include "app/options.hpp"
+#include "tests/support/scratch.hpp"
 
 namespace {
 
@@ -144,39 +142,14 @@ class JsonReader {
   std::size_t i_ = 0;
 };
 
-std::string read_file(const fs::path& p) {
-  std::ifstream in(p, std::ios::binary);
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
-}
+using test::Outcome;
+using test::read_file;
 
-struct Outcome {
-  int exit_code;
-  std::string out, err;
-};
-
-class MachineCli : public ::testing::Test {
+class MachineCli : public test::ScratchTest {
  protected:
-  void SetUp() override {
-    dir_ = fs::temp_directory_path() /
-           ("vmpray_mcli_" + std::string(::testing::UnitTest::GetInstance()->current_test_info()->name()));
-    fs::remove_all(dir_);
-    fs::create_directories(dir_);
-  }
-  void TearDown() override { fs::remove_all(dir_); }
-
-  // Two threads at most: the suite shares the machine with other work.
-  Outcome run(const std::string& args) {
-    const std::string cmd = "cd '" + dir_.string() + "' && " + VMPRAY_BINARY + " " + args +
-                            " >stdout.txt 2>stderr.txt </dev/null";
-    const int status = std::system(cmd.c_str());
-    return {WEXITSTATUS(status), read_file(dir_ / "stdout.txt"), read_file(dir_ / "stderr.txt")};
-  }
-
+  MachineCli() : ScratchTest("vmpray_mcli_") {}
+  Outcome run(const std::string& args) { return run_vmpray(args); }
   static std::size_t lines(const std::string& s) { return std::count(s.begin(), s.end(), '\n'); }
-
-  fs::path dir_;
 };
 
 constexpr const char* kSmall = "tetra:3 --width 32 --height 32 --threads 2";

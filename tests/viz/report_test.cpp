@@ -11,6 +11,7 @@
 #include "app/viz/ownership.hpp"
 #include "app/viz/plot.hpp"
 #include "app/viz/report.hpp"
+#include "tests/support/scratch.hpp"
 #include "xml_check.hpp"
 
 namespace viz {
@@ -18,24 +19,10 @@ namespace {
 
 namespace fs = std::filesystem;
 
-class ReportTest : public ::testing::Test {
+class ReportTest : public ::test::ScratchTest {
  protected:
-  void SetUp() override {
-    dir_ = fs::temp_directory_path() /
-           ("viz-report-" + std::string(::testing::UnitTest::GetInstance()->current_test_info()->name()));
-    fs::remove_all(dir_);
-    fs::create_directories(dir_);
-  }
-  void TearDown() override { fs::remove_all(dir_); }
-
-  static std::string read(const fs::path& p) {
-    std::ifstream f(p);
-    std::stringstream s;
-    s << f.rdbuf();
-    return s.str();
-  }
-
-  fs::path dir_;
+  ReportTest() : ScratchTest("viz-report-") {}
+  static std::string read(const fs::path& p) { return ::test::read_file(p); }
 };
 
 Report sample_report() {
