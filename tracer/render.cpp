@@ -98,26 +98,37 @@ bool Tracer::test_prim(std::uint32_t index, const Ray& ray, float t_min, float& 
 }
 
 namespace {
-// Slab tests of the ray against a node's four boxes, lane by lane (the loop
-// vectorises). near/far pick each axis's entry plane by the ray's direction
-// sign, so an empty box (lo > hi) is never entered. Returns a hit-lane mask.
 // Four floats or lane masks, as GCC/Clang vector types: the four slab tests
 // of a node run as one SIMD operation on every target these compilers support.
 using Float4 = float __attribute__((vector_size(16)));
 using Mask4 = int __attribute__((vector_size(16)));
 
-// `node` points at a BvhNode in a page (or the header); its planes are loaded
-// with memcpy. near/far pick each axis's entry plane by the ray's direction
-// sign, so an empty box (lo > hi) is never entered. Returns a hit-lane mask.
+// Byte offsets in a BvhNode of each axis's entry (near) and exit (far) planes
+// for one ray, chosen once per ray rather than per node.
+struct PlaneOffsets {
+  std::size_t near[3], far[3];
+  explicit PlaneOffsets(const RayInverse& inv) {
+    for (int a = 0; a < 3; ++a) {
+      const std::size_t lo = offsetof(BvhNode, lo) + a * sizeof(Float4);
+      const std::size_t hi = offsetof(BvhNode, hi) + a * sizeof(Float4);
+      near[a] = inv.inv_dir[a] < 0 ? hi : lo;
+      far[a] = inv.inv_dir[a] < 0 ? lo : hi;
+    }
+  }
+};
+
+// Slab tests of the ray against a node's four boxes at once. `node` points at
+// a BvhNode in a page (or the header); its planes are loaded with memcpy.
+// Entering by the near planes means an empty box (lo > hi) is never entered.
+// Returns a hit-lane mask.
 inline unsigned slab_test4(const std::byte* node, const Ray& ray, const RayInverse& inv,
-                           const bool negative[3], float t_min, float t_max, float t_entry[4]) {
+                           const PlaneOffsets& planes, float t_min, float t_max,
+                           float t_entry[4]) {
   Float4 tn = {t_min, t_min, t_min, t_min}, tf = {t_max, t_max, t_max, t_max};
   for (int a = 0; a < 3; ++a) {
     Float4 near, far;
-    const std::size_t lo = offsetof(BvhNode, lo) + a * sizeof(Float4);
-    const std::size_t hi = offsetof(BvhNode, hi) + a * sizeof(Float4);
-    std::memcpy(&near, node + (negative[a] ? hi : lo), sizeof near);
-    std::memcpy(&far, node + (negative[a] ? lo : hi), sizeof far);
+    std::memcpy(&near, node + planes.near[a], sizeof near);
+    std::memcpy(&far, node + planes.far[a], sizeof far);
     const float o = ray.origin[a], id = inv.inv_dir[a];
     const Float4 n = (near - o) * id, f = (far - o) * id;
     tn = n > tn ? n : tn;  // a NaN plane distance keeps the running bound
@@ -128,6 +139,47 @@ inline unsigned slab_test4(const std::byte* node, const Ray& ray, const RayInver
   return unsigned(hit[0] & 1) | unsigned(hit[1] & 2) | unsigned(hit[2] & 4) | unsigned(hit[3] & 8);
 }
 
+inline Float4 splat(float x) { return Float4{x, x, x, x}; }
+inline float load_float(const std::byte* p) {
+  float f;
+  std::memcpy(&f, p, sizeof f);
+  return f;
+}
+
+// Moeller-Trumbore on four triangles side by side, each lane the same float
+// operations in the same order as intersect_triangle, so t, u and v are
+// bit-identical to the scalar test (no FMA on baseline x86-64, and GCC does not
+// reassociate without -ffast-math). `recs` points at `count` (1..4) packed
+// triangle PrimRecords in a page. Returns the mask of lanes hit in (t_min, t_max).
+inline unsigned triangles4(const std::byte* recs, std::uint32_t count, const Ray& ray,
+                           float t_min, float t_max, Float4& t, Float4& u, Float4& v) {
+  // Lanes past `count` repeat the last triangle; the count mask drops them.
+  const std::byte* lane[4];
+  for (std::uint32_t k = 0; k < 4; ++k)
+    lane[k] = recs + (k < count ? k : count - 1) * sizeof(PrimRecord) + offsetof(PrimRecord, p0);
+  // c[j]: float j of v0, e1, e2 in each lane, loaded straight into the vector
+  // (going through a stack array stalls store-to-load forwarding).
+  Float4 c[9];
+  for (int j = 0; j < 9; ++j)
+    c[j] = Float4{load_float(lane[0] + 4 * j), load_float(lane[1] + 4 * j),
+                  load_float(lane[2] + 4 * j), load_float(lane[3] + 4 * j)};
+  const Float4 dx = splat(ray.dir.x), dy = splat(ray.dir.y), dz = splat(ray.dir.z);
+  const Float4 px = dy * c[8] - dz * c[7], py = dz * c[6] - dx * c[8], pz = dx * c[7] - dy * c[6];
+  const Float4 det = c[3] * px + c[4] * py + c[5] * pz;
+  const Float4 inv_det = 1.0f / det;
+  const Float4 sx = ray.origin.x - c[0], sy = ray.origin.y - c[1], sz = ray.origin.z - c[2];
+  u = (sx * px + sy * py + sz * pz) * inv_det;
+  const Float4 qx = sy * c[5] - sz * c[4], qy = sz * c[3] - sx * c[5], qz = sx * c[4] - sy * c[3];
+  v = (dx * qx + dy * qy + dz * qz) * inv_det;
+  t = (c[6] * qx + c[7] * qy + c[8] * qz) * inv_det;
+  // The scalar test's rejections, negated as written there (a NaN u or v passes them).
+  const Mask4 miss = (det == 0.0f) | (u < 0.0f) | (u > 1.0f) | (v < 0.0f) | (u + v > 1.0f);
+  const Mask4 hit = ~miss & (t > t_min) & (t < t_max);
+  const unsigned bits = unsigned(hit[0] & 1) | unsigned(hit[1] & 2) | unsigned(hit[2] & 4) |
+                        unsigned(hit[3] & 8);
+  return bits & ((1u << count) - 1);
+}
+
 // Lane references of a node in a page: child index and primitive count.
 inline void lane_refs(const std::byte* node, std::uint32_t child[4], std::uint32_t count[4]) {
   std::memcpy(child, node + offsetof(BvhNode, child), 4 * sizeof(std::uint32_t));
@@ -135,11 +187,67 @@ inline void lane_refs(const std::byte* node, std::uint32_t child[4], std::uint32
 }
 }  // namespace
 
+// A BVH leaf: primitives first..first+count-1 in order, as test_prim one by
+// one would. When they are all triangles in one page, the four-wide test
+// replaces the loop with the same outcome: the nearest hit, the first of equal
+// ones (the loop's strict t < t_max), or for any-hit rays the first hit in
+// order, with the statistics of the records the loop would have read.
+template <bool Any>
+bool Tracer::test_leaf(std::uint32_t first, std::uint32_t count, const Ray& ray, float t_min,
+                       float& t_max, Hit* hit, RayStats& stats) {
+  const std::uint64_t last_byte = (std::uint64_t{first} + count) * sizeof(PrimRecord) - 1;
+  const std::uint64_t first_byte = std::uint64_t{first} * sizeof(PrimRecord);
+  bool batch = count <= 4 && (first_byte >> header_.page_shift) == (last_byte >> header_.page_shift);
+  const std::byte* recs = nullptr;
+  if (batch) {
+    // Records are counted below, as many as the loop would read.
+    const PageId page = header_.section(Section::prims).first_page +
+                        static_cast<PageId>(first_byte >> header_.page_shift);
+    recs = fetch(page, stats) + (first_byte & (header_.page_size - 1));
+    for (std::uint32_t k = 0; k < count && batch; ++k) {
+      PrimKind kind;
+      std::memcpy(&kind, recs + k * sizeof(PrimRecord) + offsetof(PrimRecord, kind), sizeof kind);
+      batch = kind == PrimKind::flat_triangle || kind == PrimKind::smooth_triangle;
+    }
+  }
+  if (!batch) {
+    bool found = false;
+    for (std::uint32_t k = 0; k < count; ++k) {
+      if (!test_prim<Any>(first + k, ray, t_min, t_max, hit, stats)) continue;
+      if (Any) return true;
+      found = true;
+    }
+    return found;
+  }
+  Float4 t, u, v;
+  const unsigned mask = triangles4(recs, count, ray, t_min, t_max, t, u, v);
+  if (Any) {
+    const std::uint32_t tested = mask ? std::countr_zero(mask) + 1 : count;
+    stats.prim_tests += tested;
+    stats.record_reads += tested;
+    if (mask) t_max = t[std::countr_zero(mask)];
+    return mask != 0;
+  }
+  stats.prim_tests += count;
+  stats.record_reads += count;
+  if (!mask) return false;
+  int best = std::countr_zero(mask);
+  for (unsigned m = mask & (mask - 1); m; m &= m - 1) {
+    const int lane = std::countr_zero(m);
+    if (t[lane] < t[best]) best = lane;
+  }
+  t_max = t[best];
+  hit->t = t[best], hit->u = u[best], hit->v = v[best];
+  hit->prim_index = first + best;
+  std::memcpy(&hit->prim, recs + best * sizeof(PrimRecord), sizeof(PrimRecord));
+  return true;
+}
+
 template <bool Any>
 bool Tracer::traverse_bvh(const Ray& ray, float t_min, float& t_max_io, Hit* hit, RayStats& stats) {
   float t_max = t_max_io;  // a local, so stores to the stack or the hit need not reload it
   const RayInverse inv(ray);
-  const bool negative[3] = {inv.inv_dir.x < 0, inv.inv_dir.y < 0, inv.inv_dir.z < 0};
+  const PlaneOffsets planes(inv);
   bool found = false;
   std::size_t sp = 0;
   std::uint64_t box_tests = 0;
@@ -148,7 +256,7 @@ bool Tracer::traverse_bvh(const Ray& ray, float t_min, float& t_max_io, Hit* hit
   for (;;) {
     box_tests += 4;
     float t[4];
-    unsigned mask = slab_test4(node, ray, inv, negative, t_min, t_max, t);
+    unsigned mask = slab_test4(node, ray, inv, planes, t_min, t_max, t);
     std::uint32_t child[4], count[4];
     lane_refs(node, child, count);
     // Stack the lanes met, farthest first, so the nearest is popped next
@@ -176,15 +284,13 @@ bool Tracer::traverse_bvh(const Ray& ray, float t_min, float& t_max_io, Hit* hit
         node = locate(Section::bvh_nodes, e.child, sizeof(BvhNode), stats);
         break;
       }
-      for (std::uint32_t k = 0; k < e.count; ++k) {
-        if (test_prim<Any>(e.child + k, ray, t_min, t_max, hit, stats)) {
-          if (Any) {
-            stats.box_tests += box_tests;
-            t_max_io = t_max;
-            return true;
-          }
-          found = true;
+      if (test_leaf<Any>(e.child, e.count, ray, t_min, t_max, hit, stats)) {
+        if (Any) {
+          stats.box_tests += box_tests;
+          t_max_io = t_max;
+          return true;
         }
+        found = true;
       }
     }
   }

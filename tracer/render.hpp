@@ -75,6 +75,7 @@ class Tracer {
   // Traversal; Any = stop at the first hit (shadow rays).
   template <bool Any> bool traverse_bvh(const Ray& ray, float t_min, float& t_max, Hit* hit, RayStats& stats);
   template <bool Any> bool traverse_grid(const Ray& ray, float t_min, float& t_max, Hit* hit, RayStats& stats);
+  template <bool Any> bool test_leaf(std::uint32_t first, std::uint32_t count, const Ray& ray, float t_min, float& t_max, Hit* hit, RayStats& stats);
   template <bool Any> bool test_prim(std::uint32_t index, const Ray& ray, float t_min, float& t_max, Hit* hit, RayStats& stats);
 
   // Shading (shading.cpp).
