@@ -193,7 +193,7 @@ inline void lane_refs(const std::byte* node, std::uint32_t child[4], std::uint32
 // ones (the loop's strict t < t_max), or for any-hit rays the first hit in
 // order, with the statistics of the records the loop would have read.
 template <bool Any>
-bool Tracer::test_leaf(std::uint32_t first, std::uint32_t count, const Ray& ray, float t_min,
+[[gnu::always_inline]] inline bool Tracer::test_leaf(std::uint32_t first, std::uint32_t count, const Ray& ray, float t_min,
                        float& t_max, Hit* hit, RayStats& stats) {
   const std::uint64_t last_byte = (std::uint64_t{first} + count) * sizeof(PrimRecord) - 1;
   const std::uint64_t first_byte = std::uint64_t{first} * sizeof(PrimRecord);
@@ -250,6 +250,7 @@ bool Tracer::traverse_bvh(const Ray& ray, float t_min, float& t_max_io, Hit* hit
   const PlaneOffsets planes(inv);
   bool found = false;
   std::size_t sp = 0;
+  StackEntry* const stack = stack_.data();  // a local: stores through it cannot move it
   std::uint64_t box_tests = 0;
   // The node being tested, in place: valid until the next page read.
   const std::byte* node = reinterpret_cast<const std::byte*>(&header_.bvh_root);
@@ -266,8 +267,8 @@ bool Tracer::traverse_bvh(const Ray& ray, float t_min, float& t_max_io, Hit* hit
       const int lane = std::countr_zero(mask);
       std::size_t k = sp++;
       if constexpr (!Any)
-        for (; k > base && stack_[k - 1].t < t[lane]; --k) stack_[k] = stack_[k - 1];
-      stack_[k] = {child[lane], count[lane], t[lane]};
+        for (; k > base && stack[k - 1].t < t[lane]; --k) stack[k] = stack[k - 1];
+      stack[k] = {child[lane], count[lane], t[lane]};
     }
     // Run leaves and pop until the next inner node.
     for (;;) {
@@ -278,8 +279,8 @@ bool Tracer::traverse_bvh(const Ray& ray, float t_min, float& t_max_io, Hit* hit
           t_max_io = t_max;
           return found;
         }
-        e = stack_[--sp];
-      } while (e.t > t_max);  // beyond the closest hit so far
+        e = stack[--sp];
+      } while (!Any && e.t > t_max);  // beyond the closest hit so far
       if (e.count == 0) {
         node = locate(Section::bvh_nodes, e.child, sizeof(BvhNode), stats);
         break;

@@ -59,6 +59,33 @@ void expect_same_hits_as_brute_force(Accel accel) {
 TEST(Bvh, ClosestHitsMatchBruteForce) { expect_same_hits_as_brute_force(Accel::bvh); }
 TEST(Grid, ClosestHitsMatchBruteForce) { expect_same_hits_as_brute_force(Accel::grid); }
 
+// The four-wide leaf test must give the scalar test's barycentrics bit for
+// bit (shading interpolates normals with them), at every page size.
+TEST(Bvh, LeafHitsCarryTheScalarTriangleResult) {
+  const Scene scene = testing::random_scene(5, 400, 60);
+  for (std::uint32_t page_size : {256u, 4096u}) {
+    const Database db = build_database(scene, {.page_size = page_size});
+    InMemoryPageSource pages(db);
+    Tracer tracer(db.header, pages);
+    std::mt19937 rng(23);
+    std::uniform_real_distribution<float> u(-1.5f, 1.5f);
+    int triangle_hits = 0;
+    for (int i = 0; i < 2000; ++i) {
+      const Ray ray{{u(rng), u(rng), u(rng)}, {u(rng), u(rng), u(rng)}};
+      RayStats stats;
+      const auto got = tracer.closest_hit(ray, 0.0f, 1e30f, stats);
+      if (!got || got->prim.kind == PrimKind::sphere) continue;
+      ++triangle_hits;
+      const auto h = intersect_triangle(ray, got->prim.p0, got->prim.p1, got->prim.p2, 0.0f, 1e30f);
+      ASSERT_TRUE(h) << "ray " << i;
+      EXPECT_EQ(h->t, got->t) << "ray " << i;
+      EXPECT_EQ(h->u, got->u) << "ray " << i;
+      EXPECT_EQ(h->v, got->v) << "ray " << i;
+    }
+    EXPECT_GT(triangle_hits, 100);
+  }
+}
+
 TEST(Bvh, SinglePrimitiveSceneIsTraversable) {
   Scene s;
   s.materials.push_back({});
