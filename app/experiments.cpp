@@ -14,6 +14,7 @@ ExperimentPoint run_point(const tracer::Database& db, const ExperimentSetup& set
   options.cache_pages = setup.cache_pages;
   options.grain = setup.grain;
   options.timing = setup.model;
+  options.trace = setup.trace;
   const nodes::MachineResult result = nodes::run_machine(db, options);
   const nodes::MachineReport& r = result.report;
   ExperimentPoint p;
@@ -34,19 +35,17 @@ ExperimentPoint run_point(const tracer::Database& db, const ExperimentSetup& set
   return p;
 }
 
-double fit_unit(const tracer::Database& db, const nodes::CostModel& model, double seconds) {
+double fit_unit(const tracer::Database& db, const ExperimentSetup& setup, double seconds) {
   if (!(seconds > 0)) throw std::invalid_argument("--fit-seconds must be positive");
   // A small probe unit keeps the probe run well inside the virtual clock's range.
   constexpr double probe_unit = 1e-6;
-  nodes::CostModel probe = model;
-  probe.unit = probe_unit;
-  ExperimentSetup setup;
-  setup.nodes = 1;
-  setup.model = probe;
-  const double compute = run_point(db, setup).predicted_seconds;
-  probe.unit = 0.0;  // what remains is message time (work requests, results)
-  setup.model = probe;
-  const double messages = run_point(db, setup).predicted_seconds;
+  ExperimentSetup probe = setup;
+  probe.topology = "hypercube";
+  probe.nodes = 1;
+  probe.model.unit = probe_unit;
+  const double compute = run_point(db, probe).predicted_seconds;
+  probe.model.unit = 0.0;  // what remains is message time (work requests, results)
+  const double messages = run_point(db, probe).predicted_seconds;
   if (compute - messages <= 0) throw std::runtime_error("fit: the one-node run did no counted work");
   return probe_unit * (seconds - messages) / (compute - messages);
 }

@@ -15,6 +15,7 @@
 #include "nodes/machine.hpp"
 #include "nodes/timing.hpp"
 #include "tracer/database.hpp"
+#include "tracer/render.hpp"
 
 namespace app {
 
@@ -24,6 +25,7 @@ struct ExperimentSetup {
   std::optional<std::uint32_t> cache_pages;  // default: the machine's (1/8 of the database)
   std::uint32_t grain = 4;
   nodes::CostModel model = nodes::ipsc2_profile();
+  tracer::TraceOptions trace;
 };
 
 struct ExperimentPoint {
@@ -48,10 +50,11 @@ struct ExperimentPoint {
 // One run of db's frame under setup; db is copied (the machine consumes its copy).
 ExperimentPoint run_point(const tracer::Database& db, const ExperimentSetup& setup);
 
-// The unit that makes db's one-node run take `seconds` under model: compute
-// time is proportional to unit and the one-node run has no remote pages, so
-// two runs (a probe unit, and unit 0 for the message time) fix it.
-double fit_unit(const tracer::Database& db, const nodes::CostModel& model, double seconds);
+// The unit that makes db's one-node run under `setup` (its model, tracing
+// and grain; its node count is ignored) take `seconds`: compute time is
+// proportional to unit and the one-node run has no remote pages, so two runs
+// (a probe unit, and unit 0 for the message time) fix it.
+double fit_unit(const tracer::Database& db, const ExperimentSetup& setup, double seconds);
 
 // "3h12mn2s" as in the paper's Table 2 (also "51mn32s", "4.2s" below a minute).
 std::string paper_duration(double seconds);

@@ -36,7 +36,9 @@ RenderResult render_machine(const Options& o, const tracer::Scene& scene) {
   tracer::Database db = build_database(scene, {.accel = o.accel, .page_size = o.page_size});
   RenderResult out{tracer::Image(scene.camera.width, scene.camera.height), describe_run(o, db)};
   nodes::MachineOptions machine = o.machine;
-  machine.trace = {.max_depth = o.max_depth, .spd_procedure = o.spd_procedure};
+  machine.trace = {.max_depth = o.max_depth,
+                   .spd_procedure = o.spd_procedure,
+                   .shadow_rays_to_all_lights = o.shadow_rays_all};
   std::optional<SerialComparison> serial;
   // In virtual time T1 is cheap and deterministic: always there for speedup and efficiency.
   if (o.compare_serial || machine.timing) serial = run_serial(db, machine, o);

@@ -15,7 +15,7 @@ namespace {
 
 // Values that need checking or converting before they reach Options.
 struct Raw {
-  std::string accel;
+  std::string accel, shadow_rays;
   std::int64_t page_size = 0;
   std::string topology, schedule, distribution;
   std::int64_t nodes = 0, threads = 0, cache_pages = 0, cache_kb = 0, grain = 0, workers = 0,
@@ -33,6 +33,9 @@ po::options_description describe_render(Options& o, Raw& raw) {
       ("spd-procedure", po::bool_switch(&o.spd_procedure),
        "SPD testing procedure: pixel-corner eye rays, depth 5, no adaptive cut-off")
       ("accel", po::value(&raw.accel)->default_value("bvh"), "acceleration structure: bvh or grid")
+      ("shadow-rays", po::value(&raw.shadow_rays)->default_value("facing"),
+       "facing: a shadow ray only to lights in front of the surface (SPD); all: one to every "
+       "light at every hit, as VM_pRAY counted them (same image, more rays)")
       ("page-size", po::value(&raw.page_size)->default_value(1024),
        "database page size in bytes, a power of two from 256 to 65536")
       ("max-depth", po::value(&o.max_depth)->default_value(5), "maximum ray depth (eye ray = 1)")
@@ -85,6 +88,7 @@ void check_render(Options& o, const Raw& raw) {
   if (raw.accel == "bvh") o.accel = tracer::Accel::bvh;
   else if (raw.accel == "grid") o.accel = tracer::Accel::grid;
   else throw UsageError("--accel: expected bvh or grid, got '" + raw.accel + "'");
+  o.shadow_rays_all = parse_shadow_rays(raw.shadow_rays);
   try {
     tracer::validate_page_size(static_cast<std::uint64_t>(std::max<std::int64_t>(raw.page_size, 0)));
   } catch (const tracer::DatabaseError& e) {
@@ -142,6 +146,12 @@ void check_machine(Options& o, const Raw& raw, const po::variables_map& vm) {
 }
 
 }  // namespace
+
+bool parse_shadow_rays(const std::string& policy) {
+  if (policy == "facing") return false;
+  if (policy == "all") return true;
+  throw UsageError("--shadow-rays: expected facing or all, got '" + policy + "'");
+}
 
 std::string default_output(const std::string& scene) {
   if (scene == "-") return "stdin.png";

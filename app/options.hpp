@@ -27,6 +27,7 @@ struct Options {
   std::string output;             // .png or .ppm; derived from the scene when empty
   std::string stats_path;         // JSON report, none when empty
   bool spd_procedure = false;
+  bool shadow_rays_all = false;  // --shadow-rays all: one per light at every hit
   tracer::Accel accel = tracer::Accel::bvh;
   std::uint32_t page_size = 1024;
   int max_depth = 5;
@@ -45,6 +46,9 @@ struct Options {
 
 // Throws UsageError. argv[0] is the program name.
 Options parse_options(int argc, const char* const argv[]);
+
+// --shadow-rays: "facing" -> false, "all" -> true; UsageError otherwise.
+bool parse_shadow_rays(const std::string& policy);
 
 // The --help text (options and built-in scenes).
 std::string usage_text();

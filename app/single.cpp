@@ -31,7 +31,9 @@ RenderResult render_single(const Options& o, const tracer::Scene& scene) {
   const tracer::Database db = build_database(scene, {.accel = o.accel, .page_size = o.page_size});
   RenderResult out{tracer::Image(scene.camera.width, scene.camera.height), describe_run(o, db)};
   tracer::InMemoryPageSource pages(db);
-  const tracer::TraceOptions trace{.max_depth = o.max_depth, .spd_procedure = o.spd_procedure};
+  const tracer::TraceOptions trace{.max_depth = o.max_depth,
+                                   .spd_procedure = o.spd_procedure,
+                                   .shadow_rays_to_all_lights = o.shadow_rays_all};
   const int w = scene.camera.width, h = scene.camera.height;
   ProgressBar bar(std::uint64_t(w) * h, "pixels", !o.quiet && stderr_is_terminal());
   const auto t0 = std::chrono::steady_clock::now();

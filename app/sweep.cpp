@@ -46,6 +46,7 @@ std::vector<std::string> split(const std::string& text) {
 
 struct RawSweep {
   std::string kind, topologies = "hypercube", nodes, cache, profile = "ipsc2", costs, out;
+  std::string accel = "bvh", shadow_rays = "facing";
 };
 
 po::options_description describe(SweepOptions& o, RawSweep& raw) {
@@ -59,6 +60,9 @@ po::options_description describe(SweepOptions& o, RawSweep& raw) {
       ("nodes", po::value(&raw.nodes), "processor counts, comma-separated (nodes: default 1,2,...,64; cache: 16)")
       ("cache-pages", po::value(&raw.cache), "cache sizes in pages, comma-separated (cache: the axis)")
       ("grain", po::value(&o.grain), "pixels per work item (default 4)")
+      ("accel", po::value(&raw.accel), "acceleration structure: bvh (default) or grid")
+      ("shadow-rays", po::value(&raw.shadow_rays),
+       "facing (default): shadow rays only to lights in front of the surface; all: to every light")
       ("profile", po::value(&raw.profile), "machine profile: ipsc2, native, or a key = value file")
       ("cost", po::value(&raw.costs), "costs over the profile: box=..,prim=..,shade=..,page=..,serve=..,hop=..,bw=..")
       ("fit-seconds", po::value(&o.fit_seconds), "fit the compute unit so the one-node run takes this long")
@@ -81,6 +85,10 @@ void check_sweep(SweepOptions& o, const RawSweep& raw) {
   if (!raw.cache.empty()) o.cache_pages = parse_list<std::uint32_t>(raw.cache, "--cache-pages");
   else if (o.kind == SweepOptions::Kind::cache) o.cache_pages = {8, 16, 32, 64, 128, 256, 512};
   o.out_dir = raw.out.empty() ? "sweep-" + raw.kind : raw.out;
+  if (raw.accel == "bvh") o.accel = tracer::Accel::bvh;
+  else if (raw.accel == "grid") o.accel = tracer::Accel::grid;
+  else throw UsageError("--accel: expected bvh or grid, got '" + raw.accel + "'");
+  o.trace.shadow_rays_to_all_lights = parse_shadow_rays(raw.shadow_rays);
 }
 
 tracer::Database load_database(const SweepOptions& o) {
@@ -89,7 +97,7 @@ tracer::Database load_database(const SweepOptions& o) {
   render.width = o.size;
   render.height = o.size;
   render.page_size = o.page_size;
-  return tracer::build_database(load_scene(render), {.accel = tracer::Accel::bvh, .page_size = o.page_size});
+  return tracer::build_database(load_scene(render), {.accel = o.accel, .page_size = o.page_size});
 }
 
 std::string fixed(double v, int digits) {
@@ -140,12 +148,13 @@ SweepTable run_sweep(const SweepOptions& o, std::ostream* progress) {
   table.width = db.header.camera.width;
   table.height = db.header.camera.height;
   table.page_count = db.header.page_count;
-  table.model = o.model;
-  if (o.fit_seconds > 0) table.model.unit = fit_unit(db, o.model, o.fit_seconds);
   ExperimentSetup setup;
   setup.grain = o.grain;
-  setup.model = table.model;
+  setup.model = o.model;
+  setup.trace = o.trace;
   setup.nodes = 1;
+  if (o.fit_seconds > 0) setup.model.unit = fit_unit(db, setup, o.fit_seconds);
+  table.model = setup.model;
   if (!o.cache_pages.empty()) setup.cache_pages = o.cache_pages.front();
   table.serial_seconds = run_point(db, setup).predicted_seconds;
   const bool by_nodes = o.kind == SweepOptions::Kind::nodes;

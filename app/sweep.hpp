@@ -30,6 +30,8 @@ struct SweepOptions {
   std::vector<std::uint32_t> cache_pages;  // sweep cache: the axis; nodes: the first (empty: default)
   std::uint32_t grain = 4;
   nodes::CostModel model = nodes::ipsc2_profile();
+  tracer::Accel accel = tracer::Accel::bvh;
+  tracer::TraceOptions trace;             // --shadow-rays
   double fit_seconds = 0;                 // > 0: fit model.unit so T1 takes this long
   std::filesystem::path out_dir;          // default: sweep-<kind>
   bool quiet = false;

@@ -36,6 +36,7 @@ struct TraceOptions {
   int max_depth = 5;                     // the eye ray is depth 1
   float min_contribution = 1.0f / 256;   // adaptive depth cut-off (not in SPD mode)
   bool spd_procedure = false;            // SPD testing procedure (see NFF.md)
+  bool shadow_rays_to_all_lights = false;  // also cast the shadow rays N.L <= 0 makes useless
 };
 
 // The closest hit of a ray: distance, barycentrics and the primitive record.

@@ -125,9 +125,11 @@ Color Tracer::direct_light(const Vec3f& p, const Vec3f& n_geo, const Vec3f& n,
     const float dist = length(l);
     l = l * (1.0f / dist);
     const float n_dot_l = dot(n, l);
-    if (n_dot_l <= 0.0f) continue;  // facing away: no shadow ray (SPD rule)
+    // A light behind the surface adds nothing either way; SPD casts no ray
+    // to it, VM_pRAY's counts (Table 1) show one cast anyway.
+    if (n_dot_l <= 0.0f && !options_.shadow_rays_to_all_lights) continue;
     ++stats.shadow;
-    if (occluded({origin, l}, 0.0f, dist, stats)) continue;
+    if (occluded({origin, l}, 0.0f, dist, stats) || n_dot_l <= 0.0f) continue;
     c += m.color * light.color * (m.kd * n_dot_l);
     if (m.ks > 0.0f) {
       const float r_dot_v = dot(reflect(-l, n), view);

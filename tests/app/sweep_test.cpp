@@ -54,6 +54,8 @@ TEST(SweepOptions, BadValuesNameTheOption) {
       {{"cache", "--cache-pages", "0"}, "--cache-pages"},
       {{"nodes", "--cost", "box=slow"}, "--cost"},
       {{"nodes", "--size", "0"}, "--size"},
+      {{"nodes", "--shadow-rays", "some"}, "--shadow-rays"},
+      {{"nodes", "--accel", "kd"}, "--accel"},
   };
   for (const auto& [args, option] : cases) {
     try {
@@ -63,6 +65,13 @@ TEST(SweepOptions, BadValuesNameTheOption) {
       EXPECT_NE(std::string(e.what()).find(option), std::string::npos) << e.what();
     }
   }
+}
+
+TEST(SweepOptions, ShadowRaysAndAccelReachTheRuns) {
+  EXPECT_FALSE(parse({"nodes"}).trace.shadow_rays_to_all_lights);
+  const auto o = parse({"nodes", "--shadow-rays", "all", "--accel", "grid"});
+  EXPECT_TRUE(o.trace.shadow_rays_to_all_lights);
+  EXPECT_EQ(o.accel, tracer::Accel::grid);
 }
 
 TEST(SweepOptions, CacheSweepDefaultsToSixteenNodes) {

@@ -74,4 +74,24 @@ TEST_F(TimingCli, BadTimingOptionsNameTheOptionOnOneLine) {
   EXPECT_EQ(std::count(err_.begin(), err_.end(), '\n'), 1) << err_;
 }
 
+TEST_F(TimingCli, ShadowRaysToAllLightsCountMoreRaysForTheSameImage) {
+  const std::string common = "teapot:2 --width 24 --height 24 --nodes 4 --timing virtual -q";
+  ASSERT_EQ(run(common + " --stats facing.json -o facing.ppm"), 0) << err_;
+  ASSERT_EQ(run(common + " --shadow-rays all --stats all.json -o all.ppm"), 0) << err_;
+  EXPECT_EQ(read(dir_ / "all.ppm"), read(dir_ / "facing.ppm"));
+  const std::regex shadow(R"re("shadow": ([0-9]+))re"), predicted(R"re("predicted_seconds": ([0-9.e+-]+))re");
+  std::smatch a, f;
+  const std::string all = read(dir_ / "all.json"), facing = read(dir_ / "facing.json");
+  ASSERT_TRUE(std::regex_search(all, a, shadow) && std::regex_search(facing, f, shadow)) << all;
+  EXPECT_GT(std::stoull(a[1].str()), std::stoull(f[1].str()));
+  ASSERT_TRUE(std::regex_search(all, a, predicted) && std::regex_search(facing, f, predicted)) << all;
+  EXPECT_GT(std::stod(a[1].str()), std::stod(f[1].str()));  // more rays, more work
+}
+
+TEST_F(TimingCli, BadShadowRaysNamesTheOptionOnOneLine) {
+  EXPECT_EQ(run("teapot:2 --width 8 --height 8 --shadow-rays some"), 2);
+  EXPECT_NE(err_.find("--shadow-rays: expected facing or all, got 'some'"), std::string::npos) << err_;
+  EXPECT_EQ(std::count(err_.begin(), err_.end(), '\n'), 1) << err_;
+}
+
 }  // namespace
