@@ -25,7 +25,7 @@ using Seconds = std::chrono::duration<double>;
 constexpr double ipsc2_box = 1.0, ipsc2_prim = 2.0, ipsc2_shade = 5.0, ipsc2_page = 0.2;
 // Fitted by `vmpray sweep nodes teapot --size 512 --nodes 1 --cache-pages 3072
 // --fit-seconds 11522` (Teapot, 3h12mn2s on one node; see app/experiments.hpp).
-constexpr double ipsc2_unit = 377.935e-6;
+constexpr double ipsc2_unit = 380.648e-6;
 // The virtual clock counts picoseconds in 64 bits: about 106 days.
 constexpr double max_virtual_seconds = 9e6;
 
@@ -75,9 +75,10 @@ void set_cost(CostModel& m, const std::string& key, const std::string& value) {
   else if (key == "shade") m.shade = v;
   else if (key == "page") m.page = v;
   else if (key == "serve") m.serve = v;
+  else if (key == "msg") m.msg = v;
   else if (key == "hop") m.hop = v;
   else if (key == "bw" || key == "bandwidth") m.bandwidth = v;
-  else throw std::invalid_argument("unknown cost '" + key + "' (box, prim, shade, page, serve, hop, bw, unit)");
+  else throw std::invalid_argument("unknown cost '" + key + "' (box, prim, shade, page, serve, msg, hop, bw, unit)");
 }
 
 // Seconds per weighted operation of this machine's tracer: a small scene
@@ -145,7 +146,7 @@ LinkModel CostModel::link_model() const {
 std::string CostModel::describe() const {
   std::ostringstream out;
   out << name << ": unit=" << unit << " box=" << box << " prim=" << prim << " shade=" << shade << " page=" << page
-      << " serve=" << serve << "s hop=" << hop << "s bw=" << bandwidth << "B/s";
+      << " serve=" << serve << "s msg=" << msg << "s hop=" << hop << "s bw=" << bandwidth << "B/s";
   return out.str();
 }
 
@@ -158,6 +159,7 @@ CostModel ipsc2_profile() {
   m.shade = ipsc2_shade;
   m.page = ipsc2_page;
   m.serve = 150e-6;
+  m.msg = 175e-6;
   m.hop = 175e-6;
   m.bandwidth = 2.8e6;
   return m;
@@ -169,6 +171,7 @@ CostModel native_profile() {
   m.unit = calibrate_compute();
   m.hop = calibrate_hop();
   m.serve = m.hop;
+  m.msg = 0;  // a channel hand-over costs the sender and receiver nothing beyond the hop
   m.bandwidth = calibrate_bandwidth();
   return m;
 }
@@ -224,10 +227,25 @@ CostModel read_profile_file(const std::string& path) {
 ComputeMeter::ComputeMeter(const CostModel& model, const tracer::RayStats& rays, std::shared_ptr<NodeCpu> cpu)
     : model_(model), rays_(rays), cpu_(std::move(cpu)) {}
 
+// Messages of one tile: the result, the next work request and its answer.
+constexpr std::uint64_t tile_messages = 3;
+// Messages of one page request on the requesting side: the request and the page.
+constexpr std::uint64_t request_messages = 2;
+
 void ComputeMeter::charge() {
+  messages_ += tile_messages;
+  advance_clock();
+}
+
+void ComputeMeter::charge_page_request() {
+  messages_ += request_messages;
+  advance_clock();
+}
+
+void ComputeMeter::advance_clock() {
   // Work is cumulative in the counters: price the totals, then give the clock
   // the difference, so rounding to picoseconds never accumulates.
-  charged_ = model_.compute_seconds(rays_) + cpu_->stolen / cpu_->workers;
+  charged_ = model_.compute_seconds(rays_) + model_.msg * double(messages_) + cpu_->stolen / cpu_->workers;
   if (!(charged_ < max_virtual_seconds))
     throw std::overflow_error("virtual time beyond " + std::to_string(max_virtual_seconds) +
                               " s: the cost model is far too slow");
@@ -259,16 +277,17 @@ ComputeMeter& MachineTiming::add_meter(int node, const tracer::RayStats& rays) {
 
 PageFetch MachineTiming::charging_fetch(ComputeMeter& meter, PageFetch fetch) {
   return [&meter, fetch = std::move(fetch)](std::uint32_t page) {
-    meter.charge();
+    meter.charge_page_request();
     return fetch(page);
   };
 }
 
 std::function<void()> MachineTiming::serve_hook(int node) {
-  return [this, cpu = cpus_[static_cast<std::size_t>(node)]] {
-    cpu->stolen += model_.serve;
-    csp::this_process::advance(
-        csp::VirtualDuration(static_cast<std::int64_t>(std::llround(model_.serve * 1e12))));
+  // The handler, and the request it receives and the page it sends.
+  const double busy = model_.serve + double(request_messages) * model_.msg;
+  return [busy, cpu = cpus_[static_cast<std::size_t>(node)]] {
+    cpu->stolen += busy;
+    csp::this_process::advance(csp::VirtualDuration(static_cast<std::int64_t>(std::llround(busy * 1e12))));
   };
 }
 

@@ -9,6 +9,10 @@
 // forward), hop + bytes / bandwidth; a link carries one message at a time.
 // A page server spends `serve` per request, and that time is taken from its
 // node's pixel computers too (on the iPSC/2 the handler interrupts them).
+// Every message sent or received by a pixel computer or a page server also
+// costs its processor `msg` (the message-passing kernel's software): three
+// per tile for a pixel computer (its result, its next work request, the work
+// that answers it), two per page request on each side (request and page).
 //
 // MachineTiming: the hooks that make a nodes::run_machine run charge those
 // costs under csp's virtual-time scheduler (csp/virtual_time.hpp): the whole
@@ -41,6 +45,7 @@ struct CostModel {
   double shade = 0;          // seconds per ray: set-up, shading, spawning
   double page = 0;           // seconds per page-table operation
   double serve = 0;          // seconds per page request handled by a page server
+  double msg = 0;            // processor seconds per message sent or received
   double hop = 0;            // seconds per link crossed (and per delivery)
   double bandwidth = 0;      // link bytes per second; 0: infinitely fast
 
@@ -52,7 +57,9 @@ struct CostModel {
 
 // The Intel iPSC/2 of the paper: 80386/80387 nodes, Direct-Connect links of
 // about 2.8 MB/s, ~350 µs for a zero-byte message to a neighbour (two stages
-// of 175 µs here: link and delivery), compute unit fitted to Teapot.
+// of 175 µs here: link and delivery). The Direct-Connect modules route in
+// hardware, so that latency is NX/2 software on the two processors: each
+// spends msg = 175 µs per message. Compute unit fitted to Teapot.
 CostModel ipsc2_profile();
 
 // This desktop: compute costs timed on the tracer (a small scene, divided by
@@ -83,15 +90,21 @@ struct NodeCpu {
 class ComputeMeter {
  public:
   ComputeMeter(const CostModel& model, const tracer::RayStats& rays, std::shared_ptr<NodeCpu> cpu);
-  // Advances the calling process's clock by the work done since the last
-  // charge plus the handler time stolen from this node meanwhile.
+  // At the end of a tile: advances the calling process's clock by the work
+  // done since the last charge, the tile's three messages and the handler
+  // time stolen from this node meanwhile.
   void charge();
+  // The same before a page request, with its two messages instead.
+  void charge_page_request();
   double charged_seconds() const { return charged_; }
 
  private:
+  void advance_clock();
+
   const CostModel& model_;
   const tracer::RayStats& rays_;
   std::shared_ptr<NodeCpu> cpu_;     // shared with the node's page server
+  std::uint64_t messages_ = 0;      // sent or received so far
   double charged_ = 0;              // seconds, exact sum
   std::int64_t charged_ps_ = 0;     // what the clock has received: rounding never drifts
 };

@@ -1,5 +1,5 @@
 // Virtual timing of the machine: the cost formula on a hand-computable page
-// request, more hops cost more, determinism across runs and thread counts,
+// request, message software per page request and per tile, more hops cost more, determinism across runs and thread counts,
 // and the cost/profile parsers' errors.
 #include <gtest/gtest.h>
 
@@ -29,8 +29,9 @@ tracer::Database make_db(const std::string& spec, int size) {
   return tracer::build_database(scene, {});
 }
 
-// Node 0 fetches page 1 from node 1's page server over the one link of a
-// two-node machine; returns the virtual time at which the page arrived.
+// Node 0's pixel computer, having counted no work, fetches page 1 from node
+// 1's page server over the one link of a two-node machine; returns the
+// virtual time at which the page arrived.
 double one_page_request(const CostModel& model) {
   constexpr std::uint32_t page_size = 256;
   const nodes::PagePlacement placement(nodes::Distribution::modulo, 2, 2);
@@ -52,7 +53,10 @@ double one_page_request(const CostModel& model) {
   double arrived = -1;
   runtime.spawn("worker", 0, [&] {
     nodes::Outbox out(net.injector(0, Ports::first_worker), 1, 4);
-    const auto fetch = nodes::make_page_fetch(placement, Ports::first_worker, net.port(0, Ports::first_worker), out);
+    const tracer::RayStats no_work;
+    const auto fetch = nodes::MachineTiming::charging_fetch(
+        timing.add_meter(0, no_work),
+        nodes::make_page_fetch(placement, Ports::first_worker, net.port(0, Ports::first_worker), out));
     const auto reply = fetch(1);
     arrived = double(csp::this_process::now().count()) * 1e-12;
     EXPECT_EQ(nodes::page_reply_id(reply), 1u);
@@ -77,6 +81,17 @@ TEST(Timing, OnePageRequestCostsExactlyTheModel) {
   // forward), and the server spends `serve` in between.
   const double expected = 2 * (model.hop + request * 1e-9) + model.serve + 2 * (model.hop + reply * 1e-9);
   EXPECT_NEAR(one_page_request(model), expected, 1e-12);
+}
+
+TEST(Timing, MessageSoftwareCostsBothProcessorsTwoMessagesPerPageRequest) {
+  CostModel model;
+  model.hop = 1e-6;
+  model.serve = 3e-6;
+  const double free_software = one_page_request(model);
+  model.msg = 5e-6;
+  // The requester sends the request and receives the page; the owner
+  // receives the request and sends the page.
+  EXPECT_NEAR(one_page_request(model), free_software + 2 * model.msg + 2 * model.msg, 1e-12);
 }
 
 nodes::MachineResult run_timed(const std::string& topology, std::size_t n, unsigned threads,
@@ -130,14 +145,28 @@ TEST(Timing, ComputeTimeFollowsCountedWork) {
   EXPECT_NEAR(r.report.predicted_seconds, expected, 1e-9);
 }
 
+TEST(Timing, EveryTileCostsThreeMessagesOfSoftware) {
+  CostModel model;
+  model.box = 1e-6;
+  model.msg = 7e-6;
+  const auto r = run_timed("hypercube", 1, 1, model);
+  const std::uint64_t tiles = r.report.per_node[0].work.tiles;
+  ASSERT_GT(tiles, 1u);
+  // Result, next work request and the work that answers it.
+  const double expected = 1e-6 * double(r.report.rays().box_tests) + 7e-6 * 3.0 * double(tiles);
+  EXPECT_NEAR(r.report.compute_seconds, expected, 1e-9);
+  EXPECT_NEAR(r.report.predicted_seconds, expected, 1e-9);
+}
+
 TEST(CostModel, ParsesUnitsAndNamesBadItems) {
   CostModel m;
-  nodes::apply_costs(m, "box=2us,prim=1.5e-6,hop=350us,bw=2.8MB/s,serve=0.1ms", "--cost");
+  nodes::apply_costs(m, "box=2us,prim=1.5e-6,hop=350us,bw=2.8MB/s,serve=0.1ms,msg=175us", "--cost");
   EXPECT_DOUBLE_EQ(m.box, 2e-6);
   EXPECT_DOUBLE_EQ(m.prim, 1.5e-6);
   EXPECT_DOUBLE_EQ(m.hop, 350e-6);
   EXPECT_DOUBLE_EQ(m.bandwidth, 2.8e6);
   EXPECT_DOUBLE_EQ(m.serve, 1e-4);
+  EXPECT_DOUBLE_EQ(m.msg, 175e-6);
   for (const char* bad : {"box", "box=fast", "colour=1", "hop=3 parsecs", "box=-1"}) {
     try {
       nodes::apply_costs(m, bad, "--cost");
