@@ -64,7 +64,7 @@ po::options_description describe(SweepOptions& o, RawSweep& raw) {
       ("shadow-rays", po::value(&raw.shadow_rays),
        "facing (default): shadow rays only to lights in front of the surface; all: to every light")
       ("profile", po::value(&raw.profile), "machine profile: ipsc2, native, or a key = value file")
-      ("cost", po::value(&raw.costs), "costs over the profile: box=..,prim=..,shade=..,page=..,serve=..,hop=..,bw=..")
+      ("cost", po::value(&raw.costs), "costs over the profile: box=..,prim=..,shade=..,page=..,serve=..,msg=..,hop=..,bw=..")
       ("fit-seconds", po::value(&o.fit_seconds), "fit the compute unit so the one-node run takes this long")
       ("out", po::value(&raw.out), "output directory (default sweep-KIND)")
       ("quiet,q", po::bool_switch(&o.quiet), "print nothing but errors");
@@ -148,6 +148,8 @@ SweepTable run_sweep(const SweepOptions& o, std::ostream* progress) {
   table.width = db.header.camera.width;
   table.height = db.header.camera.height;
   table.page_count = db.header.page_count;
+  table.tracing = std::string(o.accel == tracer::Accel::grid ? "grid" : "bvh") + ", shadow rays " +
+                  (o.trace.shadow_rays_to_all_lights ? "all" : "facing");
   ExperimentSetup setup;
   setup.grain = o.grain;
   setup.model = o.model;

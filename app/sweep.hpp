@@ -42,6 +42,7 @@ struct SweepTable {
   std::string scene;
   int width = 0, height = 0;
   std::uint32_t page_count = 0;
+  std::string tracing;        // "bvh, shadow rays facing": what the counted work was
   nodes::CostModel model;
   double serial_seconds = 0;  // T1
   std::vector<ExperimentPoint> points;

@@ -17,7 +17,7 @@ void add_timing_options(po::options_description& d, TimingChoice& timing, Pictur
       ("profile", po::value(&timing.profile)->default_value("ipsc2"),
        "machine model for virtual time: ipsc2, native (calibrated here), or a 'key = value' file")
       ("cost", po::value(&timing.costs),
-       "costs over the profile: box=,prim=,shade=,page=,serve=,hop= (s, ms, us, ns), bw= (B/s, KB/s, MB/s)")
+       "costs over the profile: box=,prim=,shade=,page=,serve=,msg=,hop= (s, ms, us, ns), bw= (B/s, KB/s, MB/s)")
       ("machine-svg", po::value(&pictures.machine_svg), "after a machine render: the machine with its traffic, SVG")
       ("ownership", po::value(&pictures.ownership_png), "after a machine render: which node computed each pixel, PNG")
       ("report", po::value(&pictures.report_html),

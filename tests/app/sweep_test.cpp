@@ -99,6 +99,7 @@ TEST(Sweep, NodesSweepWritesWellFormedTablesAndPlots) {
   EXPECT_EQ(std::count(json.begin(), json.end(), '{'), std::count(json.begin(), json.end(), '}'));
   EXPECT_EQ(std::count(json.begin(), json.end(), '['), std::count(json.begin(), json.end(), ']'));
   EXPECT_NE(json.find("\"efficiency\": 1,"), std::string::npos);
+  EXPECT_NE(json.find("\"tracing\": \"bvh, shadow rays facing\""), std::string::npos);
   EXPECT_EQ(json.find("nan"), std::string::npos);
 
   const std::string svg_text = read(dir / "nodes.svg");
@@ -108,6 +109,17 @@ TEST(Sweep, NodesSweepWritesWellFormedTablesAndPlots) {
   EXPECT_NE(svg_text.find(">ring<"), std::string::npos);
   EXPECT_EQ(svg_text.find("ring:4"), std::string::npos);
   for (const auto& f : files) EXPECT_TRUE(fs::exists(f)) << f;
+}
+
+TEST(Sweep, ShadowRaysToAllLightsCountMoreRaysAndTakeLonger) {
+  auto o = parse({"nodes", "teapot:2", "--size", "12", "--nodes", "2"});
+  const app::SweepTable facing = app::run_sweep(o, nullptr);
+  o.trace.shadow_rays_to_all_lights = true;
+  const app::SweepTable all = app::run_sweep(o, nullptr);
+  ASSERT_EQ(all.points.size(), 1u);
+  EXPECT_GT(all.points[0].rays, facing.points[0].rays);
+  EXPECT_GT(all.serial_seconds, facing.serial_seconds);
+  EXPECT_EQ(all.tracing, "bvh, shadow rays all");
 }
 
 TEST(Sweep, CacheSweepCountsFewerMissesWithMoreCache) {
