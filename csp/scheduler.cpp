@@ -26,21 +26,34 @@ boost::fibers::context* FifoScheduler::pick_next() noexcept {
 
 bool FifoScheduler::has_ready_fibers() const noexcept { return dispatcher_ || !ready_.empty(); }
 
+// Spins until notified (true), the spin limit or `when`, whichever first.
+bool FifoScheduler::spin_until_notified(std::chrono::steady_clock::time_point when) noexcept {
+  const auto end = std::min(when, std::chrono::steady_clock::now() + spin_limit);
+  do {
+    for (int i = 0; i < 64; ++i) {
+      if (notified_.exchange(false, std::memory_order_acq_rel)) return true;
+      __builtin_ia32_pause();
+    }
+  } while (std::chrono::steady_clock::now() < end);
+  return false;
+}
+
 void FifoScheduler::suspend_until(std::chrono::steady_clock::time_point const& when) noexcept {
+  if (spin_until_notified(when)) return;
   std::unique_lock<std::mutex> lk(mutex_);
-  const auto woken = [this] { return notified_; };
+  const auto woken = [this] { return notified_.load(std::memory_order_acquire); };
   if (when == std::chrono::steady_clock::time_point::max()) {
     wakeup_.wait(lk, woken);
   } else {
     wakeup_.wait_until(lk, when, woken);
   }
-  notified_ = false;
+  notified_.store(false, std::memory_order_relaxed);
 }
 
 void FifoScheduler::notify() noexcept {
   {
     std::lock_guard<std::mutex> lk(mutex_);
-    notified_ = true;
+    notified_.store(true, std::memory_order_release);
   }
   wakeup_.notify_one();
 }

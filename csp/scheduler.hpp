@@ -5,8 +5,10 @@
 // properties are ProcessProps, so the runtime can find the process a fiber
 // belongs to (and a virtual-time scheduler can keep a clock per process).
 // FifoScheduler is the default: ready fibers run in FIFO order; when none is
-// ready the thread sleeps on a condition variable until notify() (a wake from
-// another thread) or the next timer deadline — it never spins. Boost's
+// ready the thread first spins for a few microseconds watching for notify()
+// (a wake from another thread: waking a sleeping thread costs a system call
+// on both sides, several times a message's own cost), then sleeps on a
+// condition variable until notify() or the next timer deadline. Boost's
 // dispatcher fiber (which moves timed-out and remotely woken fibers to the
 // ready queue, and reads the clock to do so) is kept aside and run when
 // nothing else is ready or after every `dispatch_period` picks, not once per
@@ -14,6 +16,7 @@
 // while taking the clock read off most context switches.
 #pragma once
 
+#include <atomic>
 #include <chrono>
 #include <condition_variable>
 #include <functional>
@@ -51,13 +54,16 @@ class FifoScheduler final : public Scheduler {
 
  private:
   static constexpr unsigned dispatch_period = 32;
+  static constexpr std::chrono::microseconds spin_limit{50};
+
+  bool spin_until_notified(std::chrono::steady_clock::time_point when) noexcept;
 
   boost::fibers::scheduler::ready_queue_type ready_;
   boost::fibers::context* dispatcher_ = nullptr;  // set while it is ready
   unsigned picks_since_dispatch_ = 0;
-  std::mutex mutex_;                 // guards notified_ for the sleeping thread
+  std::mutex mutex_;  // orders notify() against the check before sleeping
   std::condition_variable wakeup_;
-  bool notified_ = false;
+  std::atomic<bool> notified_{false};
 };
 
 }  // namespace csp
