@@ -38,7 +38,7 @@ void print_report(std::ostream& out, const RunReport& r) {
       << r.build.accel_seconds << " s)\n"
       << "rays           " << s.rays() << ": primary " << s.primary << " (hit " << s.primary_hits
       << "), shadow " << s.shadow << ", reflected " << s.reflected << ", refracted "
-      << s.refracted << "\n"
+      << s.refracted << (r.shadow_rays_all ? " (shadow rays to every light)" : "") << "\n"
       << "tests          " << s.box_tests << (r.accel == tracer::Accel::bvh ? " box" : " cell")
       << ", " << s.prim_tests << " primitive\n"
       << "page accesses  " << s.record_reads << " record reads, " << s.page_calls
@@ -59,6 +59,7 @@ void write_stats_json(const std::string& path, const RunReport& r) {
     << "  \"output\": " << json_string(r.output) << ",\n"
     << "  \"width\": " << r.width << ", \"height\": " << r.height << ",\n"
     << "  \"spd_procedure\": " << (r.spd_procedure ? "true" : "false") << ",\n"
+    << "  \"shadow_rays\": \"" << (r.shadow_rays_all ? "all" : "facing") << "\",\n"
     << "  \"polygons\": " << r.polygons << ", \"objects\": " << r.objects
     << ", \"primitives\": " << r.primitives << ",\n"
     << "  \"database\": {\"accel\": \"" << accel_name(r.accel) << "\", \"page_size\": "

@@ -19,6 +19,7 @@ struct RunReport {
   std::string output;
   int width = 0, height = 0;
   bool spd_procedure = false;
+  bool shadow_rays_all = false;  // one shadow ray per light at every hit
   std::uint64_t polygons = 0;    // "p" + "pp" entities
   std::uint64_t objects = 0;
   std::uint64_t primitives = 0;  // after triangulation

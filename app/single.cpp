@@ -16,6 +16,7 @@ RunReport describe_run(const Options& o, const tracer::Database& db) {
   r.width = h.camera.width;
   r.height = h.camera.height;
   r.spd_procedure = o.spd_procedure;
+  r.shadow_rays_all = o.shadow_rays_all;
   r.polygons = h.polygon_count;
   r.objects = h.object_count;
   r.primitives = h.primitive_count;

@@ -14,8 +14,9 @@
 // Shading (NFF): per positional light, Kd * colour * (N.L) + Ks * (R.V)^Shine,
 // no ambient term; light intensity 1/sqrt(#lights) (SPD's convention).
 // Shadow rays: every object, transmitting ones included, blocks light fully
-// (as SPD-style renderers do); no shadow ray where N.L <= 0. Reflection
-// (weight Ks) when Ks > 0; refraction (weight T, Snell's law, IOR of the
+// (as SPD-style renderers do); no shadow ray where N.L <= 0 unless
+// shadow_rays_to_all_lights (which changes the counts, never the image).
+// Reflection (weight Ks) when Ks > 0; refraction (weight T, Snell's law, IOR of the
 // material inside, 1 outside) when T > 0; under total internal reflection the
 // T weight goes to the reflection ray. Surfaces are two-sided: the shading
 // normal is turned to face the incoming ray. Outside SPD mode a secondary ray

@@ -69,6 +69,14 @@ TEST_F(Cli, RendersImageAndJsonStats) {
   ss << in.rdbuf();
   EXPECT_NE(ss.str().find("\"primary\": 384"), std::string::npos) << ss.str();
   EXPECT_NE(ss.str().find("\"page_size\": 1024"), std::string::npos);
+  EXPECT_NE(ss.str().find("\"shadow_rays\": \"facing\""), std::string::npos);
+}
+
+TEST_F(Cli, ReportNamesTheShadowRayPolicyInTextAndJson) {
+  const Outcome r = run_vmpray("tetra:1 --single --width 16 --height 16 -o out.ppm --shadow-rays all --stats s.json");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_NE(r.out.find("(shadow rays to every light)"), std::string::npos) << r.out;
+  EXPECT_NE(test::read_file(dir_ / "s.json").find("\"shadow_rays\": \"all\""), std::string::npos);
 }
 
 }  // namespace
