@@ -2,44 +2,31 @@
 // not depend on --threads, and bad timing options fail with one line naming
 // the option (or the profile file and line).
 #include <gtest/gtest.h>
-#include <sys/wait.h>
 
-#include <cstdlib>
+#include <algorithm>
 #include <filesystem>
 #include <fstream>
 #include <regex>
 #include <sstream>
 
+#include "tests/support/scratch.hpp"
+
 namespace {
 
 namespace fs = std::filesystem;
 
-class TimingCli : public ::testing::Test {
+class TimingCli : public test::ScratchTest {
  protected:
-  void SetUp() override {
-    dir_ = fs::temp_directory_path() /
-           ("vmpray_timing_" + std::string(::testing::UnitTest::GetInstance()->current_test_info()->name()));
-    fs::remove_all(dir_);
-    fs::create_directories(dir_);
-  }
-  void TearDown() override { fs::remove_all(dir_); }
+  TimingCli() : ScratchTest("vmpray_timing_") {}
 
   // Exit code; stderr in err_.
   int run(const std::string& args) {
-    const std::string err_file = (dir_ / "stderr.txt").string();
-    const std::string cmd = "cd '" + dir_.string() + "' && " + VMPRAY_BINARY + " " + args + " >/dev/null 2>'" +
-                            err_file + "' </dev/null";
-    const int status = std::system(cmd.c_str());
-    err_ = read(err_file);
-    return WEXITSTATUS(status);
+    const test::Outcome r = run_vmpray(args);
+    err_ = r.err;
+    return r.exit_code;
   }
 
-  static std::string read(const fs::path& p) {
-    std::ifstream in(p);
-    std::stringstream s;
-    s << in.rdbuf();
-    return s.str();
-  }
+  static std::string read(const fs::path& p) { return test::read_file(p); }
 
   // The JSON fields that must not depend on the thread count.
   std::string deterministic_fields(const std::string& json) {
@@ -50,7 +37,6 @@ class TimingCli : public ::testing::Test {
     return out;
   }
 
-  fs::path dir_;
   std::string err_;
 };
 
