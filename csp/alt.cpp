@@ -40,8 +40,8 @@ std::size_t Alt::select_from(std::size_t first) {
   if (channels_.empty() && timeout_guard_ == none && !has_skip_) {
     throw std::logic_error("Alt::select: every guard is disabled (occam STOP)");
   }
-  const std::size_t hinted = poll_hints(first);
-  if (hinted != none) return hinted;
+  const std::size_t by_hint = poll_hints(first);
+  if (by_hint != none) return by_hint;
   const Clock::time_point start = timeout_guard_ == none ? Clock::time_point() : Clock::now();
   lock_channels();
   const std::size_t ready = poll_locked(first);
@@ -94,11 +94,9 @@ std::size_t Alt::poll_hints(std::size_t first) const {
   for (std::size_t k = 0; k < n; ++k) {
     const std::size_t i = (first + k) % n;
     const Guard& g = guards_[i];
-    if (!g.enabled) continue;
-    const bool room = g.kind == Kind::room;
-    if (!(room ? g.channel->room_hint() : g.channel->ready_hint())) continue;
+    if (!g.enabled || !on_channel(g.kind) || !hinted(g)) continue;
     detail::ChannelLock lk(g.channel->lock_);
-    return (room ? g.channel->room_locked() : g.channel->ready_locked()) ? i : none;
+    return ready_locked(g) ? i : none;
   }
   return none;
 }
@@ -109,9 +107,7 @@ std::size_t Alt::poll_locked(std::size_t first) const {
     const std::size_t i = (first + k) % n;
     const Guard& g = guards_[i];
     if (!g.enabled) continue;
-    const bool ready = g.kind == Kind::skip ||
-                       (g.kind == Kind::input && g.channel->ready_locked()) ||
-                       (g.kind == Kind::room && g.channel->room_locked()) ||
+    const bool ready = g.kind == Kind::skip || (on_channel(g.kind) && ready_locked(g)) ||
                        (g.kind == Kind::timeout && g.after <= Clock::duration::zero());
     if (ready) return i;
   }
@@ -172,6 +168,16 @@ void Alt::unlink_records() {
   for (const Guard& g : guards_) {
     if (g.enabled && on_channel(g.kind)) queue_of(g).erase(*record++);
   }
+}
+
+// A channel guard's readiness: data (or poison) for an input, a free slot
+// (or poison) for a room guard; hinted() without the lock, the other under it.
+bool Alt::hinted(const Guard& g) {
+  return g.kind == Kind::room ? g.channel->room_hint() : g.channel->ready_hint();
+}
+
+bool Alt::ready_locked(const Guard& g) {
+  return g.kind == Kind::room ? g.channel->room_locked() : g.channel->ready_locked();
 }
 
 detail::RecordQueue& Alt::queue_of(const Guard& g) {

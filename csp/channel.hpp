@@ -7,6 +7,9 @@
 //   writer fills directly (so the writer returns without parking: the reader
 //   has taken the value). A writer that finds only an ALT reader fires the
 //   ALT, then parks until the ALT's read takes the value.
+// - capacity k: a bounded buffer of exactly k values. Readers park only when
+//   it is empty, writers only when it is full; a reader that frees a slot
+//   moves the first parked writer's value in and wakes that writer.
 // - An ALT may wait for room in a buffered channel (Alt::add_room): its
 //   record waits in room_waiters_, and the reader that frees a slot (with no
 //   parked writer to refill it) fires it. Poison fires it too.
@@ -14,16 +17,13 @@
 //   lock-free polling by an ALT: republished under the lock after every
 //   change of the buffer or the parked writers, so they may be stale to
 //   another thread; an ALT confirms a hint under the lock.
-// - capacity k: a bounded buffer of exactly k values. Readers park only when
-//   it is empty, writers only when it is full; a reader that frees a slot
-//   moves the first parked writer's value in and wakes that writer.
 // - At most one of (parked readers, parked writers with data) is non-empty.
 // - Poison is permanent and wakes every waiter; every later operation on
 //   either end throws Poisoned, even with values still buffered.
 // - try_write on a rendezvous channel succeeds only if a reader is parked in
 //   read(); a parked ALT would still have to run before taking the value.
-// Who wakes whom: writers wake readers (and fire ALTs), readers wake writers,
-// poison wakes both; see detail/wait.hpp for the claiming rules.
+// Who wakes whom: writers wake readers (and fire ALTs), readers wake writers
+// (and fire room guards), poison wakes all; see detail/wait.hpp for the claiming rules.
 #pragma once
 
 #include <cstddef>
@@ -110,7 +110,7 @@ class ChannelState final : public ChannelBase {
     rec.waiter = &w;
     rec.slot = &value;
     writers_.push_back(rec);
-    note_ready_locked();
+    publish_hints_locked();
     finish_wait(park(w, lk.get()), rec, writers_);
   }
 
@@ -138,13 +138,13 @@ class ChannelState final : public ChannelBase {
       } else if (Record* alt = claim_front_locked(room_waiters_)) {
         complete(*alt->waiter, WaitState::data, alt->guard);
       }
-      note_ready_locked();
+      publish_hints_locked();
       return v;
     }
     if (Record* r = claim_front_locked(writers_)) {
       std::optional<T> v(std::move(*static_cast<T*>(r->slot)));
       complete(*r->waiter, WaitState::data, r->guard);
-      note_ready_locked();
+      publish_hints_locked();
       return v;
     }
     return std::nullopt;
@@ -179,10 +179,11 @@ class ChannelState final : public ChannelBase {
   void push_locked(T&& value) {
     ring_[(head_ + count_) % capacity_].emplace(std::move(value));
     ++count_;
-    note_ready_locked();
+    publish_hints_locked();
   }
 
-  void note_ready_locked() { publish_hints(count_ > 0 || !writers_.empty(), count_ < capacity_); }
+  // The hints ready_hint()/room_hint() read without the lock.
+  void publish_hints_locked() { publish_hints(count_ > 0 || !writers_.empty(), count_ < capacity_); }
 
   // After park(): throws for poison and deadlock; data needs nothing more.
   void finish_wait(WaitState s, Record& rec, RecordQueue& q) {
@@ -190,7 +191,7 @@ class ChannelState final : public ChannelBase {
     if (s == WaitState::poisoned) throw Poisoned(name_);
     ChannelLock lk(lock_);
     q.erase(rec);
-    note_ready_locked();
+    publish_hints_locked();
     lk.unlock();
     unwind_deadlock();
   }
