@@ -85,9 +85,7 @@ T in_range(std::int64_t v, std::int64_t lo, std::int64_t hi, const char* option)
 }
 
 void check_render(Options& o, const Raw& raw) {
-  if (raw.accel == "bvh") o.accel = tracer::Accel::bvh;
-  else if (raw.accel == "grid") o.accel = tracer::Accel::grid;
-  else throw UsageError("--accel: expected bvh or grid, got '" + raw.accel + "'");
+  o.accel = parse_accel(raw.accel);
   o.shadow_rays_all = parse_shadow_rays(raw.shadow_rays);
   try {
     tracer::validate_page_size(static_cast<std::uint64_t>(std::max<std::int64_t>(raw.page_size, 0)));
@@ -152,6 +150,14 @@ bool parse_shadow_rays(const std::string& policy) {
   if (policy == "all") return true;
   throw UsageError("--shadow-rays: expected facing or all, got '" + policy + "'");
 }
+
+tracer::Accel parse_accel(const std::string& name) {
+  if (name == "bvh") return tracer::Accel::bvh;
+  if (name == "grid") return tracer::Accel::grid;
+  throw UsageError("--accel: expected bvh or grid, got '" + name + "'");
+}
+
+const char* accel_name(tracer::Accel accel) { return accel == tracer::Accel::bvh ? "bvh" : "grid"; }
 
 std::string default_output(const std::string& scene) {
   if (scene == "-") return "stdin.png";

@@ -49,6 +49,9 @@ Options parse_options(int argc, const char* const argv[]);
 
 // --shadow-rays: "facing" -> false, "all" -> true; UsageError otherwise.
 bool parse_shadow_rays(const std::string& policy);
+// --accel: "bvh" or "grid"; UsageError otherwise. accel_name() is the inverse.
+tracer::Accel parse_accel(const std::string& name);
+const char* accel_name(tracer::Accel accel);
 
 // The --help text (options and built-in scenes).
 std::string usage_text();

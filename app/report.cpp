@@ -6,12 +6,9 @@
 #include <iomanip>
 #include <stdexcept>
 
+#include "app/options.hpp"
+
 namespace app {
-namespace {
-
-const char* accel_name(tracer::Accel a) { return a == tracer::Accel::bvh ? "bvh" : "grid"; }
-
-}  // namespace
 
 std::string json_string(const std::string& s) {
   std::string out = "\"";

@@ -85,9 +85,7 @@ void check_sweep(SweepOptions& o, const RawSweep& raw) {
   if (!raw.cache.empty()) o.cache_pages = parse_list<std::uint32_t>(raw.cache, "--cache-pages");
   else if (o.kind == SweepOptions::Kind::cache) o.cache_pages = {8, 16, 32, 64, 128, 256, 512};
   o.out_dir = raw.out.empty() ? "sweep-" + raw.kind : raw.out;
-  if (raw.accel == "bvh") o.accel = tracer::Accel::bvh;
-  else if (raw.accel == "grid") o.accel = tracer::Accel::grid;
-  else throw UsageError("--accel: expected bvh or grid, got '" + raw.accel + "'");
+  o.accel = parse_accel(raw.accel);
   o.trace.shadow_rays_to_all_lights = parse_shadow_rays(raw.shadow_rays);
 }
 
@@ -148,7 +146,7 @@ SweepTable run_sweep(const SweepOptions& o, std::ostream* progress) {
   table.width = db.header.camera.width;
   table.height = db.header.camera.height;
   table.page_count = db.header.page_count;
-  table.tracing = std::string(o.accel == tracer::Accel::grid ? "grid" : "bvh") + ", shadow rays " +
+  table.tracing = std::string(accel_name(o.accel)) + ", shadow rays " +
                   (o.trace.shadow_rays_to_all_lights ? "all" : "facing");
   ExperimentSetup setup;
   setup.grain = o.grain;
