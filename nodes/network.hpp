@@ -18,11 +18,12 @@
 // injector(n, p) and read port(n, p). The local processes of a node share
 // one injection channel into its router (a many-writer rendezvous, blocked
 // writers served in FIFO order), which keeps the router's ALT short; a
-// process blocked on it holds up no packet on its way to any port. Once the application knows nothing
-// is in flight, one of its processes calls shutdown(), which poisons every
-// network channel: routers, link processes and any reader of a port end with
-// csp::Poisoned, so run() returns with no fiber left blocked. Packets still
-// in the network at shutdown are dropped. stats() is valid after run().
+// process blocked on it holds up no packet on its way to any port. Once the
+// application knows nothing is in flight, one of its processes calls
+// shutdown(), which poisons every network channel: routers, link processes
+// and any reader of a port end with csp::Poisoned, so run() returns with no
+// fiber left blocked. Packets still in the network at shutdown are dropped.
+// stats() is valid after run().
 #pragma once
 
 #include <functional>

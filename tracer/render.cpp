@@ -193,8 +193,8 @@ inline void lane_refs(const std::byte* node, std::uint32_t child[4], std::uint32
 // ones (the loop's strict t < t_max), or for any-hit rays the first hit in
 // order, with the statistics of the records the loop would have read.
 template <bool Any>
-[[gnu::always_inline]] inline bool Tracer::test_leaf(std::uint32_t first, std::uint32_t count, const Ray& ray, float t_min,
-                       float& t_max, Hit* hit, RayStats& stats) {
+[[gnu::always_inline]] inline bool Tracer::test_leaf(std::uint32_t first, std::uint32_t count, const Ray& ray,
+                                                     float t_min, float& t_max, Hit* hit, RayStats& stats) {
   const std::uint64_t last_byte = (std::uint64_t{first} + count) * sizeof(PrimRecord) - 1;
   const std::uint64_t first_byte = std::uint64_t{first} * sizeof(PrimRecord);
   bool batch = count <= 4 && (first_byte >> header_.page_shift) == (last_byte >> header_.page_shift);

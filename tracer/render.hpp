@@ -16,11 +16,12 @@
 // Shadow rays: every object, transmitting ones included, blocks light fully
 // (as SPD-style renderers do); no shadow ray where N.L <= 0 unless
 // shadow_rays_to_all_lights (which changes the counts, never the image).
-// Reflection (weight Ks) when Ks > 0; refraction (weight T, Snell's law, IOR of the
-// material inside, 1 outside) when T > 0; under total internal reflection the
-// T weight goes to the reflection ray. Surfaces are two-sided: the shading
-// normal is turned to face the incoming ray. Outside SPD mode a secondary ray
-// is skipped when its weight along the path falls below min_contribution.
+// Reflection (weight Ks) when Ks > 0; refraction (weight T, Snell's law, IOR
+// of the material inside, 1 outside) when T > 0; under total internal
+// reflection the T weight goes to the reflection ray. Surfaces are two-sided:
+// the shading normal is turned to face the incoming ray. Outside SPD mode a
+// secondary ray is skipped when its weight along the path falls below
+// min_contribution.
 #pragma once
 
 #include <functional>
@@ -77,7 +78,8 @@ class Tracer {
   // Traversal; Any = stop at the first hit (shadow rays).
   template <bool Any> bool traverse_bvh(const Ray& ray, float t_min, float& t_max, Hit* hit, RayStats& stats);
   template <bool Any> bool traverse_grid(const Ray& ray, float t_min, float& t_max, Hit* hit, RayStats& stats);
-  template <bool Any> bool test_leaf(std::uint32_t first, std::uint32_t count, const Ray& ray, float t_min, float& t_max, Hit* hit, RayStats& stats);
+  template <bool Any> bool test_leaf(std::uint32_t first, std::uint32_t count, const Ray& ray, float t_min,
+                                      float& t_max, Hit* hit, RayStats& stats);
   template <bool Any> bool test_prim(std::uint32_t index, const Ray& ray, float t_min, float& t_max, Hit* hit, RayStats& stats);
 
   // Shading (shading.cpp).

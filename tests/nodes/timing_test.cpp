@@ -1,6 +1,7 @@
 // Virtual timing of the machine: the cost formula on a hand-computable page
-// request, message software per page request and per tile, more hops cost more, determinism across runs and thread counts,
-// and the cost/profile parsers' errors.
+// request, message software per page request and per tile, more hops cost
+// more, determinism across runs and thread counts, and the cost/profile
+// parsers' errors.
 #include <gtest/gtest.h>
 
 #include <cstdio>
