@@ -32,16 +32,27 @@ std::optional<std::pair<float, std::uint32_t>> brute_force(const Database& db, c
   return best;
 }
 
+// Rays from random points in random directions, over the cube the random
+// test scenes fill; the same seed gives the same rays.
+class RandomRays {
+ public:
+  explicit RandomRays(unsigned seed) : rng_(seed) {}
+  Ray next() { return {{u_(rng_), u_(rng_), u_(rng_)}, {u_(rng_), u_(rng_), u_(rng_)}}; }
+
+ private:
+  std::mt19937 rng_;
+  std::uniform_real_distribution<float> u_{-1.5f, 1.5f};
+};
+
 void expect_same_hits_as_brute_force(Accel accel) {
   const Scene scene = testing::random_scene(7, 400, 60);
   const Database db = build_database(scene, {.accel = accel, .page_size = 512});
   InMemoryPageSource pages(db);
   Tracer tracer(db.header, pages);
-  std::mt19937 rng(11);
-  std::uniform_real_distribution<float> u(-1.5f, 1.5f);
+  RandomRays rays(11);
   int hits = 0;
   for (int i = 0; i < 3000; ++i) {
-    const Ray ray{{u(rng), u(rng), u(rng)}, {u(rng), u(rng), u(rng)}};
+    const Ray ray = rays.next();
     RayStats stats;
     const auto expected = brute_force(db, ray);
     const auto got = tracer.closest_hit(ray, 0.0f, 1e30f, stats);
@@ -67,11 +78,10 @@ TEST(Bvh, LeafHitsCarryTheScalarTriangleResult) {
     const Database db = build_database(scene, {.page_size = page_size});
     InMemoryPageSource pages(db);
     Tracer tracer(db.header, pages);
-    std::mt19937 rng(23);
-    std::uniform_real_distribution<float> u(-1.5f, 1.5f);
+    RandomRays rays(23);
     int triangle_hits = 0;
     for (int i = 0; i < 2000; ++i) {
-      const Ray ray{{u(rng), u(rng), u(rng)}, {u(rng), u(rng), u(rng)}};
+      const Ray ray = rays.next();
       RayStats stats;
       const auto got = tracer.closest_hit(ray, 0.0f, 1e30f, stats);
       if (!got || got->prim.kind == PrimKind::sphere) continue;
