@@ -13,6 +13,7 @@ ExperimentPoint run_point(const tracer::Database& db, const ExperimentSetup& set
   options.nodes = setup.nodes;
   options.cache_pages = setup.cache_pages;
   options.grain = setup.grain;
+  options.prefetch = setup.prefetch;
   options.timing = setup.model;
   options.trace = setup.trace;
   const nodes::MachineResult result = nodes::run_machine(db, options);

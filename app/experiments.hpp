@@ -24,6 +24,7 @@ struct ExperimentSetup {
   std::size_t nodes = 1;
   std::optional<std::uint32_t> cache_pages;  // default: the machine's (1/8 of the database)
   std::uint32_t grain = 4;
+  std::uint16_t prefetch = 0;  // the paper's protocol: a processor asks for work when idle
   nodes::CostModel model = nodes::ipsc2_profile();
   tracer::TraceOptions trace;
 };

@@ -19,7 +19,7 @@ struct Raw {
   std::int64_t page_size = 0;
   std::string topology, schedule, distribution;
   std::int64_t nodes = 0, threads = 0, cache_pages = 0, cache_kb = 0, grain = 0, workers = 0,
-               trace_routes = 0;
+               prefetch = 0, trace_routes = 0;
   TimingChoice timing;
 };
 
@@ -66,6 +66,8 @@ po::options_description describe_machine(Options& o, Raw& raw) {
        "dynamic (pixels to whoever asks) or static (fixed shares)")
       ("workers-per-node", po::value(&raw.workers)->default_value(1),
        "pixel computers per processor")
+      ("prefetch", po::value(&raw.prefetch)->default_value(1),
+       "work requests a pixel computer keeps ahead of its tracing, 0..3 (0: ask only when idle, as the paper)")
       ("distribution", po::value(&raw.distribution)->default_value("modulo"),
        "page p on node p mod N (modulo), or consecutive runs of pages (block)")
       ("trace-routes", po::value(&raw.trace_routes)->default_value(0),
@@ -133,6 +135,7 @@ void check_machine(Options& o, const Raw& raw, const po::variables_map& vm) {
   m.threads = in_range<unsigned>(raw.threads, 0, 4096, "--threads");
   m.grain = in_range<std::uint32_t>(raw.grain, 1, 1 << 20, "--grain");
   m.workers_per_node = in_range<int>(raw.workers, 1, 64, "--workers-per-node");
+  m.prefetch = in_range<std::uint16_t>(raw.prefetch, 0, 3, "--prefetch");
   m.trace_routes = in_range<std::uint64_t>(raw.trace_routes, 0, 1 << 20, "--trace-routes");
   if (raw.schedule == "dynamic") m.schedule = nodes::Schedule::dynamic;
   else if (raw.schedule == "static") m.schedule = nodes::Schedule::static_split;

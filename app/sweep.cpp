@@ -60,6 +60,7 @@ po::options_description describe(SweepOptions& o, RawSweep& raw) {
       ("nodes", po::value(&raw.nodes), "processor counts, comma-separated (nodes: default 1,2,...,64; cache: 16)")
       ("cache-pages", po::value(&raw.cache), "cache sizes in pages, comma-separated (cache: the axis)")
       ("grain", po::value(&o.grain), "pixels per work item (default 4)")
+      ("prefetch", po::value(&o.prefetch), "work requests kept ahead, 0..3 (default 0: ask when idle, as the paper)")
       ("accel", po::value(&raw.accel), "acceleration structure: bvh (default) or grid")
       ("shadow-rays", po::value(&raw.shadow_rays),
        "facing (default): shadow rays only to lights in front of the surface; all: to every light")
@@ -77,6 +78,7 @@ void check_sweep(SweepOptions& o, const RawSweep& raw) {
   else throw UsageError("sweep: expected 'nodes' or 'cache', got '" + raw.kind + "'");
   if (o.size < 1 || o.size > 4096) throw UsageError("--size: expected 1..4096");
   if (o.grain < 1) throw UsageError("--grain: expected at least 1");
+  if (o.prefetch > 3) throw UsageError("--prefetch: expected 0..3");
   if (o.fit_seconds < 0) throw UsageError("--fit-seconds: expected a positive time");
   o.topologies = split(raw.topologies);
   if (o.topologies.empty()) throw UsageError("--topology: empty list");
@@ -150,6 +152,7 @@ SweepTable run_sweep(const SweepOptions& o, std::ostream* progress) {
                   (o.trace.shadow_rays_to_all_lights ? "all" : "facing");
   ExperimentSetup setup;
   setup.grain = o.grain;
+  setup.prefetch = o.prefetch;
   setup.model = o.model;
   setup.trace = o.trace;
   setup.nodes = 1;

@@ -7,9 +7,8 @@
 
 namespace nodes {
 
-Collector::Collector(FrameAssembler& frame, csp::In<Packet> in, Outbox out, Progress progress,
-                     std::vector<std::uint16_t>* owners)
-    : frame_(frame), in_(std::move(in)), out_(std::move(out)), progress_(std::move(progress)), owners_(owners) {}
+Collector::Collector(FrameAssembler& frame, csp::In<Packet> in, Progress progress, std::vector<std::uint16_t>* owners)
+    : frame_(frame), in_(std::move(in)), progress_(std::move(progress)), owners_(owners) {}
 
 void Collector::run() {
   while (!frame_.complete()) {
@@ -22,7 +21,6 @@ void Collector::run() {
       std::fill_n(owners_->begin() + result.tile.first, result.tile.count, static_cast<std::uint16_t>(packet.source));
     if (progress_) progress_(frame_.received(), frame_.items());
   }
-  out_.send(make_packet(0, Ports::farmer, MessageKind::frame_done));
 }
 
 }  // namespace nodes

@@ -22,6 +22,7 @@ struct NodeState {
   std::unique_ptr<NodeSvm> svm;
   ServerCounters served;
   std::vector<std::unique_ptr<Outbox>> worker_out;
+  std::vector<std::unique_ptr<WorkerPort>> worker_in;
   std::vector<WorkerCounters> work;
   std::unique_ptr<Mailbox> mailbox;
 };
@@ -31,6 +32,7 @@ struct Host {
   std::unique_ptr<WorkPlan> plan;
   std::unique_ptr<FrameAssembler> frame;
   std::unique_ptr<Mailbox> mailbox;
+  std::unique_ptr<csp::Channel<Packet>> results;  // farmer -> collector
   FarmerCounters farmer;
   std::vector<std::uint16_t> owners;  // per item, filled by the collector
 };
@@ -39,6 +41,12 @@ void validate(const MachineOptions& options) {
   if (options.workers_per_node < 1) throw std::invalid_argument("--workers-per-node must be at least 1");
   if (options.grain < 1) throw std::invalid_argument("--grain must be at least 1");
   if (options.buffer_capacity < 1) throw std::invalid_argument("network buffer capacity must be at least 1");
+  // While a worker traces, P answers and a page reply may come to its port:
+  // they must fit the network's delivery buffer.
+  if (options.prefetch + 1u > options.buffer_capacity)
+    throw std::invalid_argument("--prefetch must be at most " + std::to_string(options.buffer_capacity - 1) +
+                                " (a worker's answers and a page reply must fit the network buffer of " +
+                                std::to_string(options.buffer_capacity) + " packets)");
 }
 
 unsigned thread_count(const MachineOptions& options, std::size_t nodes) {
@@ -62,6 +70,9 @@ std::vector<std::unique_ptr<NodeState>> distribute(tracer::Database& db, const P
   db.pages.shrink_to_fit();  // the host keeps no copy
   return nodes;
 }
+
+// Results the farmer may pass on before the collector runs.
+constexpr std::size_t results_buffer = 16;
 
 struct Wiring {
   csp::Runtime& runtime;
@@ -94,9 +105,11 @@ void spawn_node(const Wiring& w, NodeId n, NodeState& node) {
   for (int i = 0; i < k; ++i) {
     const auto port = static_cast<std::uint16_t>(Ports::first_worker + i);
     node.worker_out.push_back(std::make_unique<Outbox>(w.outbox(n, port)));
+    node.worker_in.push_back(std::make_unique<WorkerPort>(w.net.port(n, port)));
     Outbox& out = *node.worker_out.back();
+    WorkerPort& in = *node.worker_in.back();
     auto& counters = node.work[static_cast<std::size_t>(i)];
-    PageFetch fetch = make_page_fetch(w.placement, port, w.net.port(n, port), out);
+    PageFetch fetch = make_page_fetch(w.placement, port, in, out);
     std::function<void()> charge;
     if (w.timing) {
       ComputeMeter& meter = w.timing->add_meter(static_cast<int>(n), counters.rays);
@@ -105,8 +118,9 @@ void spawn_node(const Wiring& w, NodeId n, NodeState& node) {
     }
     SvmSource& source = node.svm->add_worker(std::move(fetch));
     w.runtime.spawn(name + " pixel computer " + std::to_string(i), thread,
-                    [&w, port, &source, &out, in = w.net.port(n, port), &counters, charge] {
-                      PixelComputer(port, source, w.header, w.options.trace, w.grid, in, out, counters, charge)
+                    [&w, port, &source, &in, &out, &counters, charge] {
+                      PixelComputer(port, w.options.prefetch, source, w.header, w.options.trace, w.grid, in, out,
+                                    counters, charge)
                           .run();
                     });
   }
@@ -114,19 +128,21 @@ void spawn_node(const Wiring& w, NodeId n, NodeState& node) {
 
 void spawn_host(const Wiring& w, Host& host) {
   const unsigned thread = w.net.thread_of(0);
-  // Outstanding for the farmer: one per worker, one per page server, frame_done.
-  host.mailbox = std::make_unique<Mailbox>("farmer requests", static_cast<std::size_t>(w.processes) + 1);
+  const auto nodes = static_cast<std::size_t>(w.net.topology().size());
+  const auto workers = nodes * static_cast<std::size_t>(w.options.workers_per_node);
+  // Outstanding for the farmer: P + 1 per worker, one per page server.
+  host.mailbox = std::make_unique<Mailbox>("farmer requests", workers * (w.options.prefetch + 1u) + nodes);
   w.runtime.spawn("farmer mailbox", thread, [mb = host.mailbox.get(), in = w.net.port(0, Ports::farmer)] {
     mb->forward(in);
   });
-  const int nodes = static_cast<int>(w.net.topology().size());
+  host.results = std::make_unique<csp::Channel<Packet>>("results", results_buffer);
   w.runtime.spawn("farmer", thread, [&w, &host, nodes, out = w.outbox(0, Ports::farmer)] {
-    Farmer(*host.plan, nodes, w.options.workers_per_node, host.mailbox->reader(), out,
-           [&net = w.net] { net.shutdown(); }, host.farmer)
+    Farmer(*host.plan, static_cast<int>(nodes), w.options.workers_per_node, host.mailbox->reader(), out,
+           host.results->writer(), [&net = w.net] { net.shutdown(); }, host.farmer)
         .run();
   });
-  w.runtime.spawn("collector", thread, [&w, &host, out = w.outbox(0, Ports::collector)] {
-    Collector(*host.frame, w.net.port(0, Ports::collector), out, w.options.progress, &host.owners).run();
+  w.runtime.spawn("collector", thread, [&w, &host] {
+    Collector(*host.frame, host.results->reader(), w.options.progress, &host.owners).run();
   });
 }
 
@@ -238,6 +254,7 @@ MachineResult run_machine(tracer::Database db, const MachineOptions& options) {
   report.nodes = static_cast<int>(topology.size());
   report.threads = runtime.threads();
   report.workers_per_node = options.workers_per_node;
+  report.prefetch = options.prefetch;
   report.cache_pages = cache_pages;
   report.page_size = header.page_size;
   report.page_count = header.page_count;

@@ -7,27 +7,36 @@
 //   pixel computers w = 0..k-1       Ports::first_worker + w
 // and on node 0 only:
 //   farmer (+ its mailbox)           Ports::farmer
-//   frame collector                  Ports::collector
+//   frame collector                  fed by the farmer over a local channel
 // The host's copy of the database is moved into the owners before the run:
 // page p lives only on its owner and in caches.
 //
+// Work (pixel_computer.hpp): a worker asks for P + 1 tiles at start (P =
+// prefetch) and each result it sends asks for one more, so it always has the
+// next tile coming while it traces: two messages per tile, plus one request
+// per worker.
+//
 // Orderly end (no message lost, none left in flight, no fiber blocked):
-//  1. The farmer answers every work request with a tile until the plan is
-//     exhausted, then with stop.
-//  2. A worker sends its result before asking for more work, so when it
-//     reads stop all its results are sent and all its page requests have
-//     been answered; it sends worker_done and ends.
+//  1. The farmer answers every tile asked for with work until the plan is
+//     exhausted, then with stop, and passes each result to the collector.
+//  2. A worker ends once all P + 1 answers it is owed are in; by then its
+//     results are sent and all its page requests answered. It sends
+//     worker_done, which reaches the farmer after its results (packets
+//     between two processes keep their order).
 //  3. After the last worker_done no page request exists anywhere, so the
 //     farmer sends server_stop to every page server; each answers
 //     server_done and ends.
-//  4. The collector sends frame_done once the last item arrived.
-//  5. With N*k worker_done, N server_done and frame_done received, every
-//     packet sent has been read: the farmer calls Network::shutdown(), which
-//     ends routers, links and the mailboxes, and Runtime::run() returns.
-// Buffer bounds: at most one packet per worker, one per page server and
-// the collector's one are outstanding for the farmer (N*k + N + 1), and at
-// most N*k page requests for a page server (one per worker, plus its
-// server_stop), which sizes their mailboxes.
+//  4. With N*k worker_done and N server_done received, every packet sent
+//     has been read and every result passed on: the farmer checks that the
+//     results cover the frame and calls Network::shutdown(), which ends
+//     routers, links and the mailboxes; the collector ends with the frame.
+// Buffer bounds: each packet of a worker not yet read by the farmer carries
+// a tile still owed to it, so at most P + 1 per worker and one per page
+// server are outstanding for the farmer (N*k*(P+1) + N); at most N*k page
+// requests for a page server (one per worker, plus its server_stop), which
+// sizes their mailboxes. Whenever a worker does not read its port (it traces,
+// or sends), at most P answers and one page reply are on their way to it,
+// which must fit the network's delivery buffer (so P < buffer capacity).
 #pragma once
 
 #include <cstdint>
@@ -59,6 +68,7 @@ struct MachineOptions {
   std::uint32_t grain = 16;            // items per tile: balance vs farming traffic
   Schedule schedule = Schedule::dynamic;
   int workers_per_node = 1;
+  std::uint16_t prefetch = 1;          // tiles a worker has asked for beyond the one it traces
   Distribution distribution = Distribution::modulo;
   std::uint64_t trace_routes = 0;      // record the routes of the first N packets
   std::size_t buffer_capacity = 4;     // packets per network queue
@@ -82,6 +92,7 @@ struct MachineReport {
   int nodes = 0;
   unsigned threads = 0;
   int workers_per_node = 0;
+  std::uint16_t prefetch = 0;
   std::uint32_t cache_pages = 0;  // requested per node (before capping at remote pages)
   std::uint32_t page_size = 0;
   std::uint32_t page_count = 0;

@@ -27,6 +27,7 @@ T get(std::span<const std::byte> in, std::size_t at, const char* what) {
 }
 
 constexpr std::size_t tile_bytes = 2 * sizeof(std::uint32_t);
+constexpr std::size_t result_header_bytes = sizeof(std::uint16_t) + tile_bytes;
 constexpr std::size_t color_bytes = 3 * sizeof(float);
 
 }  // namespace
@@ -34,7 +35,7 @@ constexpr std::size_t color_bytes = 3 * sizeof(float);
 std::string_view message_kind_name(std::uint8_t kind) {
   static constexpr std::array<std::string_view, message_kind_count> names{
       "unknown",     "work_request", "work",        "stop",        "result",    "page_request",
-      "page_reply",  "worker_done",  "server_stop", "server_done", "frame_done"};
+      "page_reply",  "worker_done",  "server_stop", "server_done"};
   return kind < names.size() ? names[kind] : names[0];
 }
 
@@ -55,14 +56,15 @@ Packet make_packet(NodeId destination, std::uint16_t port, MessageKind kind, std
   return p;
 }
 
-std::vector<std::byte> encode_port(std::uint16_t port) {
+std::vector<std::byte> encode_work_request(WorkRequest request) {
   std::vector<std::byte> out;
-  put(out, port);
+  put(out, request.reply_port);
+  put(out, request.tiles);
   return out;
 }
 
-std::uint16_t decode_port(std::span<const std::byte> payload) {
-  return get<std::uint16_t>(payload, 0, "work_request");
+WorkRequest decode_work_request(std::span<const std::byte> payload) {
+  return {get<std::uint16_t>(payload, 0, "work_request"), get<std::uint16_t>(payload, 2, "work_request")};
 }
 
 std::vector<std::byte> encode_tile(Tile tile) {
@@ -77,10 +79,11 @@ Tile decode_tile(std::span<const std::byte> payload) {
   return {get<std::uint32_t>(payload, 0, "work"), get<std::uint32_t>(payload, 4, "work")};
 }
 
-std::vector<std::byte> encode_result(Tile tile, std::span<const tracer::Color> colors) {
+std::vector<std::byte> encode_result(std::uint16_t reply_port, Tile tile, std::span<const tracer::Color> colors) {
   if (colors.size() != tile.count) throw std::logic_error("result: colour count differs from tile size");
   std::vector<std::byte> out;
-  out.reserve(tile_bytes + colors.size() * color_bytes);
+  out.reserve(result_header_bytes + colors.size() * color_bytes);
+  put(out, reply_port);
   put(out, tile.first);
   put(out, tile.count);
   for (const auto& c : colors) {
@@ -92,10 +95,11 @@ std::vector<std::byte> encode_result(Tile tile, std::span<const tracer::Color> c
 }
 
 ResultView decode_result(std::span<const std::byte> payload) {
-  const Tile tile{get<std::uint32_t>(payload, 0, "result"), get<std::uint32_t>(payload, 4, "result")};
-  if (payload.size() != tile_bytes + std::size_t{tile.count} * color_bytes)
+  const auto reply_port = get<std::uint16_t>(payload, 0, "result");
+  const Tile tile{get<std::uint32_t>(payload, 2, "result"), get<std::uint32_t>(payload, 6, "result")};
+  if (payload.size() != result_header_bytes + std::size_t{tile.count} * color_bytes)
     throw std::runtime_error("malformed result message: size does not match its pixel count");
-  return {tile, payload.subspan(tile_bytes)};
+  return {reply_port, tile, payload.subspan(result_header_bytes)};
 }
 
 std::vector<std::byte> encode_page_request(PageRequest request) {

@@ -8,15 +8,17 @@
 // rather than reading out of bounds.
 //
 // Who sends what (see machine.hpp for the whole protocol):
-//   worker    -> farmer     work_request {reply port}
-//   farmer    -> worker     work {first, count} | stop {}
-//   worker    -> collector  result {first, count, count x RGB floats}
+//   worker    -> farmer     work_request {reply port, tiles}   (once, at start)
+//   farmer    -> worker     work {first, count} | stop {}      (one per tile asked)
+//   worker    -> farmer     result {reply port, first, count, count x RGB
+//                           floats}: the colours, and a request for one tile
 //   worker    -> owner's page server  page_request {page, reply port}
 //   page srv  -> worker     page_reply {page, page bytes}
 //   worker    -> farmer     worker_done {}
 //   farmer    -> page srv   server_stop {}
 //   page srv  -> farmer     server_done {}
-//   collector -> farmer     frame_done {}
+// The farmer hands each result on to the frame collector over a local
+// channel of node 0 (not the network).
 #pragma once
 
 #include <cstddef>
@@ -42,20 +44,18 @@ enum class MessageKind : std::uint8_t {
   worker_done,
   server_stop,
   server_done,
-  frame_done,
 };
-inline constexpr int message_kind_count = 11;  // one past the last kind
+inline constexpr int message_kind_count = 10;  // one past the last kind
 
 // Name for reports and route traces ("page_reply" etc.).
 std::string_view message_kind_name(std::uint8_t kind);
 
-// Local ports of a processor. The farmer and collector exist on node 0
-// only; worker w of a node listens on first_worker + w.
+// Local ports of a processor. The farmer exists on node 0 only; worker w of
+// a node listens on first_worker + w.
 struct Ports {
   static constexpr std::uint16_t page_server = 0;
   static constexpr std::uint16_t farmer = 1;
-  static constexpr std::uint16_t collector = 2;
-  static constexpr std::uint16_t first_worker = 3;
+  static constexpr std::uint16_t first_worker = 2;
   static constexpr std::uint16_t count(int workers_per_node) {
     return static_cast<std::uint16_t>(first_worker + workers_per_node);
   }
@@ -74,19 +74,26 @@ struct PageRequest {
   std::uint16_t reply_port = 0;
 };
 
+// A worker's first message: send `tiles` answers (work or stop) to reply_port.
+struct WorkRequest {
+  std::uint16_t reply_port = 0;
+  std::uint16_t tiles = 0;
+};
+
 struct ResultView {
+  std::uint16_t reply_port = 0;  // where the answer to the request it carries goes
   Tile tile;
   std::span<const std::byte> rgb;  // tile.count x 3 floats, bit-exact
   tracer::Color color(std::uint32_t i) const;
 };
 
-std::vector<std::byte> encode_port(std::uint16_t port);
-std::uint16_t decode_port(std::span<const std::byte> payload);
+std::vector<std::byte> encode_work_request(WorkRequest request);
+WorkRequest decode_work_request(std::span<const std::byte> payload);
 
 std::vector<std::byte> encode_tile(Tile tile);
 Tile decode_tile(std::span<const std::byte> payload);
 
-std::vector<std::byte> encode_result(Tile tile, std::span<const tracer::Color> colors);
+std::vector<std::byte> encode_result(std::uint16_t reply_port, Tile tile, std::span<const tracer::Color> colors);
 ResultView decode_result(std::span<const std::byte> payload);
 
 std::vector<std::byte> encode_page_request(PageRequest request);

@@ -8,39 +8,65 @@ namespace nodes {
 
 namespace {
 
-Packet expect(csp::In<Packet>& in, MessageKind a, MessageKind b) {
-  Packet p = in.read();
+bool is_answer(const Packet& p) {
   const auto kind = static_cast<MessageKind>(p.kind);
-  if (kind != a && kind != b)
-    throw std::logic_error("pixel computer got an unexpected " + std::string(message_kind_name(p.kind)) + " message");
-  return p;
+  return kind == MessageKind::work || kind == MessageKind::stop;
+}
+
+[[noreturn]] void unexpected(const Packet& p) {
+  throw std::logic_error("pixel computer got an unexpected " + std::string(message_kind_name(p.kind)) + " message");
 }
 
 }  // namespace
 
-PixelComputer::PixelComputer(std::uint16_t port, SvmSource& source, const tracer::DatabaseHeader& header,
-                             tracer::TraceOptions options, ItemGrid grid, csp::In<Packet> in, Outbox& out,
-                             WorkerCounters& counters, std::function<void()> after_tile)
+Packet WorkerPort::next_answer() {
+  if (!answers_.empty()) {
+    Packet p = std::move(answers_.front());
+    answers_.pop_front();
+    return p;
+  }
+  Packet p = in_.read();
+  if (!is_answer(p)) unexpected(p);
+  return p;
+}
+
+Packet WorkerPort::page_reply() {
+  for (;;) {
+    Packet p = in_.read();
+    if (static_cast<MessageKind>(p.kind) == MessageKind::page_reply) return p;
+    if (!is_answer(p)) unexpected(p);
+    answers_.push_back(std::move(p));
+  }
+}
+
+PixelComputer::PixelComputer(std::uint16_t port, std::uint16_t prefetch, SvmSource& source,
+                             const tracer::DatabaseHeader& header, tracer::TraceOptions options, ItemGrid grid,
+                             WorkerPort& in, Outbox& out, WorkerCounters& counters, std::function<void()> after_tile)
     : port_(port),
+      prefetch_(prefetch),
       source_(source),
       tracer_(header, source, options),
       grid_(grid),
-      in_(std::move(in)),
+      in_(in),
       out_(out),
       counters_(counters),
       after_tile_(std::move(after_tile)) {}
 
 void PixelComputer::run() {
-  for (;;) {
+  std::uint32_t owed = prefetch_ + 1u;  // answers the farmer still has to send
+  out_.send(make_packet(0, Ports::farmer, MessageKind::work_request,
+                        encode_work_request({port_, static_cast<std::uint16_t>(owed)})));
+  while (owed > 0) {
     source_.release();  // about to block: another worker may evict our page
-    out_.send(make_packet(0, Ports::farmer, MessageKind::work_request, encode_port(port_)));
-    const Packet answer = expect(in_, MessageKind::work, MessageKind::stop);
-    if (static_cast<MessageKind>(answer.kind) == MessageKind::stop) break;
+    const Packet answer = in_.next_answer();
+    --owed;
+    if (static_cast<MessageKind>(answer.kind) == MessageKind::stop) continue;
     const Tile tile = decode_tile(answer.payload);
     compute(tile);
     source_.release();  // before the hook too: it may suspend this fiber
     if (after_tile_) after_tile_();
-    out_.send(make_packet(0, Ports::collector, MessageKind::result, encode_result(tile, colors_)));
+    out_.send(make_packet(0, Ports::farmer, MessageKind::result, encode_result(port_, tile, colors_)));
+    ++owed;
   }
   out_.send(make_packet(0, Ports::farmer, MessageKind::worker_done));
 }
@@ -57,12 +83,11 @@ void PixelComputer::compute(Tile tile) {
   ++counters_.tiles;
 }
 
-PageFetch make_page_fetch(const PagePlacement& placement, std::uint16_t port, csp::In<Packet> in,
-                          Outbox& out) {
-  return [&placement, port, in, &out](std::uint32_t page) mutable {
+PageFetch make_page_fetch(const PagePlacement& placement, std::uint16_t port, WorkerPort& in, Outbox& out) {
+  return [&placement, port, &in, &out](std::uint32_t page) {
     const auto owner = static_cast<NodeId>(placement.owner(page));
     out.send(make_packet(owner, Ports::page_server, MessageKind::page_request, encode_page_request({page, port})));
-    return expect(in, MessageKind::page_reply, MessageKind::page_reply).payload;
+    return in.page_reply().payload;
   };
 }
 

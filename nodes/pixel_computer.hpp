@@ -1,20 +1,29 @@
 // A pixel computer: one fiber that asks the farmer for work, traces it
-// through its node's shared virtual memory and sends the colours to the
-// frame collector. A processor runs one or more (--workers-per-node), so page
-// waits of one overlap with tracing by another.
+// through its node's shared virtual memory and sends the colours back. A
+// processor runs one or more (--workers-per-node), so page waits of one
+// overlap with tracing by another.
 //
-// Protocol, on its own local port (Ports::first_worker + w):
-//   -> farmer     work_request {my port}
-//   <- farmer     work {first, count}  |  stop
-//   -> collector  result {first, count, colours}      (after work)
-//   -> farmer     worker_done                         (after stop; then ends)
+// Protocol, on its own local port (Ports::first_worker + w), with prefetch P:
+//   -> farmer     work_request {my port, P + 1 tiles}       (once)
+//   <- farmer     work {first, count}  |  stop              (one per tile asked)
+//   -> farmer     result {my port, first, count, colours}   (after each work;
+//                 it also asks for one more tile)
+//   -> farmer     worker_done                               (once every answer
+//                 is in; then ends)
+// So P + 1 answers are always owed to the worker: with P >= 1 the next tile
+// is already on its way while it traces the current one. The farmer answers
+// in order and never sends work after a stop, so after the first stop only
+// stops follow and every result is sent before worker_done.
 // While tracing, a cache miss sends page_request to the page's owner and
-// reads this same port for the page_reply (make_page_fetch): the worker has
-// at most one request outstanding, so its port never holds more than one
-// packet and the next packet is always the awaited answer.
+// reads this same port for the page_reply (make_page_fetch); answers of the
+// farmer that arrive meanwhile are kept, in order, for later. While the
+// worker traces or sends, at most P answers and one page reply are on their
+// way to the port; the machine keeps that within the network's delivery
+// buffer, so the port drains whenever the worker blocks.
 #pragma once
 
 #include <cstdint>
+#include <deque>
 #include <functional>
 
 #include "csp/csp.hpp"
@@ -37,21 +46,35 @@ struct ItemGrid {
   bool corners = false;
 };
 
+// A worker's network port, shared by its two readers: the work loop (work
+// and stop answers) and the miss path (page replies). One fiber uses it.
+class WorkerPort {
+ public:
+  explicit WorkerPort(csp::In<Packet> in) : in_(std::move(in)) {}
+  Packet next_answer();  // work or stop
+  Packet page_reply();   // keeps any answers that arrive first
+
+ private:
+  csp::In<Packet> in_;
+  std::deque<Packet> answers_;  // arrived while waiting for a page
+};
+
 class PixelComputer {
  public:
-  PixelComputer(std::uint16_t port, SvmSource& source, const tracer::DatabaseHeader& header,
-                tracer::TraceOptions options, ItemGrid grid, csp::In<Packet> in, Outbox& out,
-                WorkerCounters& counters, std::function<void()> after_tile = {});
+  PixelComputer(std::uint16_t port, std::uint16_t prefetch, SvmSource& source, const tracer::DatabaseHeader& header,
+                tracer::TraceOptions options, ItemGrid grid, WorkerPort& in, Outbox& out, WorkerCounters& counters,
+                std::function<void()> after_tile = {});
   void run();
 
  private:
   void compute(Tile tile);
 
   std::uint16_t port_;
+  std::uint16_t prefetch_;
   SvmSource& source_;
   tracer::Tracer tracer_;
   ItemGrid grid_;
-  csp::In<Packet> in_;
+  WorkerPort& in_;
   Outbox& out_;
   WorkerCounters& counters_;
   std::vector<tracer::Color> colors_;
@@ -59,8 +82,7 @@ class PixelComputer {
 };
 
 // The miss path of a worker's SvmSource: page_request to the owner, then
-// block on the worker's port for the page_reply.
-PageFetch make_page_fetch(const PagePlacement& placement, std::uint16_t port, csp::In<Packet> in,
-                          Outbox& out);
+// wait on the worker's port for the page_reply.
+PageFetch make_page_fetch(const PagePlacement& placement, std::uint16_t port, WorkerPort& in, Outbox& out);
 
 }  // namespace nodes

@@ -227,8 +227,9 @@ CostModel read_profile_file(const std::string& path) {
 ComputeMeter::ComputeMeter(const CostModel& model, const tracer::RayStats& rays, std::shared_ptr<NodeCpu> cpu)
     : model_(model), rays_(rays), cpu_(std::move(cpu)) {}
 
-// Messages of one tile: the result, the next work request and its answer.
-constexpr std::uint64_t tile_messages = 3;
+// Messages of one tile: the work that brings it, and the result that also
+// asks for the next.
+constexpr std::uint64_t tile_messages = 2;
 // Messages of one page request on the requesting side: the request and the page.
 constexpr std::uint64_t request_messages = 2;
 

@@ -10,9 +10,9 @@
 // A page server spends `serve` per request, and that time is taken from its
 // node's pixel computers too (on the iPSC/2 the handler interrupts them).
 // Every message sent or received by a pixel computer or a page server also
-// costs its processor `msg` (the message-passing kernel's software): three
-// per tile for a pixel computer (its result, its next work request, the work
-// that answers it), two per page request on each side (request and page).
+// costs its processor `msg` (the message-passing kernel's software): two
+// per tile for a pixel computer (the work, and the result that asks for the
+// next), two per page request on each side (request and page).
 //
 // MachineTiming: the hooks that make a nodes::run_machine run charge those
 // costs under csp's virtual-time scheduler (csp/virtual_time.hpp): the whole
@@ -91,7 +91,7 @@ class ComputeMeter {
  public:
   ComputeMeter(const CostModel& model, const tracer::RayStats& rays, std::shared_ptr<NodeCpu> cpu);
   // At the end of a tile: advances the calling process's clock by the work
-  // done since the last charge, the tile's three messages and the handler
+  // done since the last charge, the tile's two messages and the handler
   // time stolen from this node meanwhile.
   void charge();
   // The same before a page request, with its two messages instead.

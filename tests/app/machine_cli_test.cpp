@@ -189,7 +189,8 @@ TEST_F(MachineCli, EveryMachineMakesTheSingleProcessImage) {
       "",
       "--topology mesh:3x3 --cache-pages 1 --grain 7 --schedule static --distribution block",
       "--topology ring --nodes 5 --workers-per-node 2 --page-size 256",
-      "--topology torus:4x2 --cache-kb 2 --grain 1",
+      "--topology torus:4x2 --cache-kb 2 --grain 1 --prefetch 0",
+      "--topology hypercube:3 --grain 3 --prefetch 3",
       "--topology complete:1",
   };
   for (const std::string& m : machines) {
@@ -212,6 +213,7 @@ TEST_F(MachineCli, EachBadInputIsOneLineWithNoOutputFile) {
       {"--schedule random", 2},
       {"--distribution stripes", 2},
       {"--grain 0", 2},
+      {"--prefetch 4", 2},
       {"no/such/scene.nff", 1},
   };
   for (const auto& [args, code] : cases) {
@@ -287,7 +289,7 @@ TEST(MachineOptions, AFullSpecNeedsNoNodeCount) {
 TEST(MachineOptions, ValuesReachTheMachine) {
   const app::Options o = parse({"--cache-kb", "8", "--grain", "9", "--schedule", "static",
                                 "--workers-per-node", "3", "--distribution", "block",
-                                "--trace-routes", "5", "--threads", "2", "--compare-serial"});
+                                "--trace-routes", "5", "--threads", "2", "--compare-serial", "--prefetch", "2"});
   EXPECT_EQ(o.machine.cache_kb, 8u);
   EXPECT_EQ(o.machine.grain, 9u);
   EXPECT_EQ(o.machine.schedule, nodes::Schedule::static_split);
@@ -295,6 +297,7 @@ TEST(MachineOptions, ValuesReachTheMachine) {
   EXPECT_EQ(o.machine.distribution, nodes::Distribution::block);
   EXPECT_EQ(o.machine.trace_routes, 5u);
   EXPECT_EQ(o.machine.threads, 2u);
+  EXPECT_EQ(o.machine.prefetch, 2);
   EXPECT_TRUE(o.compare_serial);
 }
 

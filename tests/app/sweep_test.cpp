@@ -56,6 +56,7 @@ TEST(SweepOptions, BadValuesNameTheOption) {
       {{"nodes", "--size", "0"}, "--size"},
       {{"nodes", "--shadow-rays", "some"}, "--shadow-rays"},
       {{"nodes", "--accel", "kd"}, "--accel"},
+      {{"nodes", "--prefetch", "4"}, "--prefetch"},
   };
   for (const auto& [args, option] : cases) {
     try {

@@ -61,6 +61,7 @@ struct Case {
   unsigned threads;
   std::string scene = "teapot:2";
   int size = 24;
+  std::uint16_t prefetch = 1;
 };
 
 nodes::MachineResult run_case(const Case& c) {
@@ -73,6 +74,7 @@ nodes::MachineResult run_case(const Case& c) {
   options.grain = c.grain;
   options.schedule = c.schedule;
   options.workers_per_node = c.workers;
+  options.prefetch = c.prefetch;
   return nodes::run_machine(std::move(db), options);
 }
 
@@ -80,7 +82,7 @@ std::string describe(const Case& c) {
   return c.topology + " n=" + std::to_string(c.nodes) + " cache=" + std::to_string(c.cache_pages) +
          " page=" + std::to_string(c.page_size) + " grain=" + std::to_string(c.grain) +
          (c.schedule == Schedule::dynamic ? " dynamic" : " static") + " k=" + std::to_string(c.workers) +
-         " threads=" + std::to_string(c.threads) + " " + c.scene;
+         " threads=" + std::to_string(c.threads) + " prefetch=" + std::to_string(c.prefetch) + " " + c.scene;
 }
 
 TEST(Machine, ImageIsBitIdenticalToSingleProcessRenderAcrossConfigurations) {
@@ -147,8 +149,34 @@ TEST(Machine, EveryPixelIsComputedExactlyOnce) {
   EXPECT_EQ(r.farmer.items, pixels);
   EXPECT_EQ(r.collected, pixels);
   EXPECT_EQ(r.items_computed(), pixels);
-  EXPECT_EQ(r.farmer.stops, 16u * 2u);
+  // Each worker is owed prefetch + 1 answers at the end, all of them stops.
+  EXPECT_EQ(r.farmer.stops, 16u * 2u * 2u);
+  EXPECT_EQ(r.farmer.results, r.farmer.tiles);
   EXPECT_EQ(r.rays().samples, pixels);
+}
+
+// Prefetch changes only when work arrives: the same image, every item once,
+// and one request per worker plus one result per tile on the network.
+TEST(Machine, PrefetchKeepsTheImageAndTheCounts) {
+  for (std::uint16_t prefetch = 0; prefetch <= 3; ++prefetch) {
+    for (Case c : {Case{"hypercube", 8, 2, 256, 3, Schedule::dynamic, 2, 1},
+                   Case{"ring", 5, 1, 1024, 7, Schedule::static_split, 1, 1},
+                   Case{"torus", 4, 1, 256, 4, Schedule::dynamic, 3, 2}}) {
+      c.prefetch = prefetch;
+      const auto result = run_case(c);
+      const auto& r = result.report;
+      EXPECT_TRUE(same_bits(result.image.pixels(), cached_reference(c.scene, c.size))) << describe(c);
+      EXPECT_EQ(r.items_computed(), r.items) << describe(c);
+      EXPECT_EQ(r.farmer.results, r.farmer.tiles) << describe(c);
+      const std::uint64_t workers = c.nodes * static_cast<std::uint64_t>(c.workers);
+      EXPECT_EQ(r.farmer.stops, workers * (prefetch + 1u)) << describe(c);
+      const auto& kinds = r.network.hops_by_kind;
+      EXPECT_EQ(kinds.at(static_cast<std::uint8_t>(nodes::MessageKind::work_request)).packets, workers)
+          << describe(c);
+      EXPECT_EQ(kinds.at(static_cast<std::uint8_t>(nodes::MessageKind::result)).packets, r.farmer.tiles)
+          << describe(c);
+    }
+  }
 }
 
 TEST(Machine, ResidentSceneBytesStayWithinOwnShareAndCache) {
@@ -236,6 +264,9 @@ TEST(Machine, BadOptionsFailWithOneLineNamingTheOption) {
   MachineOptions grain;
   grain.grain = 0;
   expect_error(c, grain, "--grain");
+  MachineOptions prefetch;
+  prefetch.prefetch = 4;  // the network buffers 4 packets per queue
+  expect_error(c, prefetch, "--prefetch");
   expect_error({"hypercube", 48, 1, 1024, 4, Schedule::dynamic, 1, 1}, MachineOptions{}, "48");
   expect_error({"mesh:8x8", 32, 1, 1024, 4, Schedule::dynamic, 1, 1}, MachineOptions{}, "32");
 }

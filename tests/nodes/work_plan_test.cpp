@@ -67,18 +67,26 @@ TEST(WorkPlan, ZeroGrainIsRejectedNamingTheOption) {
 TEST(FrameAssembler, StoresColoursBitExactAndRejectsDuplicates) {
   nodes::FrameAssembler frame(4);
   const std::vector<tracer::Color> colors{{0.1f, 0.2f, 0.3f}, {1e-30f, -0.0f, 7.0f}};
-  const auto payload = nodes::encode_result({1, 2}, colors);
+  const auto payload = nodes::encode_result(5, {1, 2}, colors);
   frame.add(nodes::decode_result(payload));
   EXPECT_EQ(frame.received(), 2u);
   EXPECT_FALSE(frame.complete());
   EXPECT_EQ(frame.colors()[2], colors[1]);
   EXPECT_THROW(frame.add(nodes::decode_result(payload)), std::logic_error);
-  const auto beyond = nodes::encode_result({3, 2}, colors);
+  const auto beyond = nodes::encode_result(5, {3, 2}, colors);
   EXPECT_THROW(frame.add(nodes::decode_result(beyond)), std::logic_error);
 }
 
 TEST(Messages, PayloadsRoundTrip) {
-  EXPECT_EQ(nodes::decode_port(nodes::encode_port(7)), 7);
+  const auto work_request = nodes::decode_work_request(nodes::encode_work_request({7, 3}));
+  EXPECT_EQ(work_request.reply_port, 7);
+  EXPECT_EQ(work_request.tiles, 3);
+  const std::vector<tracer::Color> colors{{0.5f, 0.25f, 1.0f}};
+  const auto result_payload = nodes::encode_result(9, {4, 1}, colors);
+  const auto result = nodes::decode_result(result_payload);
+  EXPECT_EQ(result.reply_port, 9);
+  EXPECT_EQ(result.tile, (Tile{4, 1}));
+  EXPECT_EQ(result.color(0), colors[0]);
   EXPECT_EQ(nodes::decode_tile(nodes::encode_tile({12, 34})), (Tile{12, 34}));
   const auto request = nodes::decode_page_request(nodes::encode_page_request({99, 5}));
   EXPECT_EQ(request.page, 99u);
@@ -91,7 +99,7 @@ TEST(Messages, PayloadsRoundTrip) {
 }
 
 TEST(Messages, TruncatedPayloadIsRejected) {
-  auto payload = nodes::encode_result({0, 2}, std::vector<tracer::Color>(2));
+  auto payload = nodes::encode_result(5, {0, 2}, std::vector<tracer::Color>(2));
   payload.pop_back();
   EXPECT_THROW(nodes::decode_result(payload), std::runtime_error);
   EXPECT_THROW(nodes::decode_tile(std::vector<std::byte>(3)), std::runtime_error);
