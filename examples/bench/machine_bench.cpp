@@ -2,6 +2,10 @@
 // dynamic farming, hypercube network) against the same renderer over one
 // shared in-memory database with plain std::threads pulling rows, measured
 // side by side on the same threads; and the speedup of T threads over 1.
+// Then where the machine's time goes, on 16 nodes and T threads: the same
+// run with the paper's ask-when-idle protocol (prefetch 0), with every cache
+// holding the whole database (no page traffic), and with tiles of 256
+// pixels (little farming traffic).
 //
 // usage: machine_bench [SCENE [SIZE [THREADS]]]   default: teapot 512 2
 #include <atomic>
@@ -9,6 +13,7 @@
 #include <cstdio>
 #include <cstring>
 #include <exception>
+#include <functional>
 #include <string>
 #include <thread>
 #include <vector>
@@ -53,8 +58,10 @@ struct MachineRun {
   std::string error;
 };
 
+using Variant = std::function<void(nodes::MachineOptions&, const tracer::DatabaseHeader&)>;
+
 MachineRun machine_seconds(const std::string& spec, int size, int nodes, unsigned threads,
-                           const std::vector<tracer::Color>& reference) {
+                           const std::vector<tracer::Color>& reference, const Variant& variant = {}) {
   MachineRun run;
   try {
     auto db = make_db(spec, size);
@@ -63,6 +70,7 @@ MachineRun machine_seconds(const std::string& spec, int size, int nodes, unsigne
     options.nodes = static_cast<std::size_t>(nodes);
     options.threads = threads;
     options.cache_pages = std::max<std::uint32_t>(1, db.header.page_count / 8);
+    if (variant) variant(options, db.header);
     const auto result = nodes::run_machine(std::move(db), options);
     run.seconds = result.report.wall_seconds;
     run.miss_ratio = result.report.svm().miss_ratio();
@@ -111,5 +119,18 @@ int main(int argc, char** argv) {
     if (one.seconds > 0 && many.seconds > 0)
       std::printf("  speedup of %u threads over 1: %.2fx\n", threads, one.seconds / many.seconds);
   }
+
+  std::printf("where the time goes: hypercube 16, %u threads, against shared memory on %u threads\n", threads,
+              threads);
+  const std::vector<std::pair<const char*, Variant>> variants{
+      {"  as above (prefetch 1, grain 16)", {}},
+      {"  prefetch 0 (ask when idle)",
+       [](nodes::MachineOptions& o, const tracer::DatabaseHeader&) { o.prefetch = 0; }},
+      {"  cache = whole database (first-touch misses only)",
+       [](nodes::MachineOptions& o, const tracer::DatabaseHeader& h) { o.cache_pages = h.page_count; }},
+      {"  grain 256", [](nodes::MachineOptions& o, const tracer::DatabaseHeader&) { o.grain = 256; }},
+  };
+  for (const auto& [label, variant] : variants)
+    print_run(label, machine_seconds(spec, size, 16, threads, image, variant), shared_t);
   return 0;
 }
