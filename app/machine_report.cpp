@@ -112,8 +112,8 @@ void print_machine_report(std::ostream& out, const MachineSummary& m) {
   const nodes::ServerCounters served = r.served();
   out << std::fixed << std::setprecision(1);
   out << "machine        " << r.topology << ": " << r.nodes << " nodes, " << r.workers_per_node
-      << " pixel computer(s) each (prefetch " << r.prefetch << "), " << r.threads << " thread(s), cache " << r.cache_pages
-      << " pages (" << double(r.cache_pages) * r.page_size / 1024.0 << " KB) per node\n"
+      << " pixel computer(s) each (prefetch " << r.prefetch << "), " << r.threads << " thread(s), cache "
+      << r.cache_pages << " pages (" << double(r.cache_pages) * r.page_size / 1024.0 << " KB) per node\n"
       << std::setprecision(4) << "svm            " << svm.accesses << " page accesses: "
       << svm.own_hits << " local, " << svm.cache_hits << " cache hits, " << svm.misses << " misses (" << svm.coalesced
       << " coalesced), miss ratio " << svm.miss_ratio() << "\n"
