@@ -67,7 +67,7 @@ po::options_description describe_machine(Options& o, Raw& raw) {
       ("workers-per-node", po::value(&raw.workers)->default_value(1),
        "pixel computers per processor")
       ("prefetch", po::value(&raw.prefetch)->default_value(1),
-       "work requests a pixel computer keeps ahead of its tracing, 0..3 (0: ask only when idle, as the paper)")
+       "tiles a pixel computer keeps asked for beyond the one it traces, 0..3 (0: ask when idle, as in the paper)")
       ("distribution", po::value(&raw.distribution)->default_value("modulo"),
        "page p on node p mod N (modulo), or consecutive runs of pages (block)")
       ("trace-routes", po::value(&raw.trace_routes)->default_value(0),

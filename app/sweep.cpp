@@ -60,7 +60,7 @@ po::options_description describe(SweepOptions& o, RawSweep& raw) {
       ("nodes", po::value(&raw.nodes), "processor counts, comma-separated (nodes: default 1,2,...,64; cache: 16)")
       ("cache-pages", po::value(&raw.cache), "cache sizes in pages, comma-separated (cache: the axis)")
       ("grain", po::value(&o.grain), "pixels per work item (default 4)")
-      ("prefetch", po::value(&o.prefetch), "work requests kept ahead, 0..3 (default 0: ask when idle, as the paper)")
+      ("prefetch", po::value(&o.prefetch), "tiles asked for ahead, 0..3 (default 0: ask when idle, as in the paper)")
       ("accel", po::value(&raw.accel), "acceleration structure: bvh (default) or grid")
       ("shadow-rays", po::value(&raw.shadow_rays),
        "facing (default): shadow rays only to lights in front of the surface; all: to every light")
