@@ -1,4 +1,6 @@
-// Binned SAH BVH builder (16 bins on each axis of the centroid box).
+// Binned SAH BVH builder (16 bins on each axis of the centroid box). A set of
+// at most four triangles always becomes one leaf: traversal tests such a leaf
+// in one four-wide step, so splitting it further only adds nodes to visit.
 #include "tracer/bvh.hpp"
 
 #include <algorithm>
@@ -10,6 +12,7 @@ namespace {
 
 constexpr int kBins = 16;
 constexpr float kTraversalCost = 1.0f;  // relative to one primitive test
+constexpr std::uint32_t kLeafLanes = 4;  // triangles a leaf test handles in one step
 
 // A node of the binary tree before it is collapsed to four-wide nodes.
 struct BinNode {
@@ -26,8 +29,8 @@ struct Split {
 
 class Builder {
  public:
-  Builder(const std::vector<Box3f>& bounds, int max_leaf)
-      : bounds_(bounds), max_leaf_(std::max(1, max_leaf)) {
+  Builder(const std::vector<Box3f>& bounds, const std::vector<bool>& triangle, int max_leaf)
+      : bounds_(bounds), triangle_(triangle), max_leaf_(std::max(1, max_leaf)) {
     out_.order.resize(bounds.size());
     for (std::uint32_t i = 0; i < bounds.size(); ++i) out_.order[i] = i;
   }
@@ -60,7 +63,7 @@ class Builder {
     const std::uint32_t n = end - begin;
     const Split split = find_split(begin, end, centroids, box);
     if (n <= static_cast<std::uint32_t>(max_leaf_) &&
-        (split.axis < 0 || split.cost >= static_cast<float>(n))) {
+        (split.axis < 0 || split.cost >= static_cast<float>(n) || one_step_leaf(begin, end))) {
       bin_[index].first = begin;
       bin_[index].count = n;
       return;
@@ -72,6 +75,14 @@ class Builder {
     bin_[index].right = left + 1;
     build(left, begin, mid);
     build(left + 1, mid, end);
+  }
+
+  // Whether primitives [begin, end) are triangles few enough for one four-wide leaf test.
+  bool one_step_leaf(std::uint32_t begin, std::uint32_t end) const {
+    if (end - begin > kLeafLanes) return false;
+    for (std::uint32_t k = begin; k < end; ++k)
+      if (!triangle_[out_.order[k]]) return false;
+    return true;
   }
 
   // The binary nodes that become the lanes of the four-wide node for `index`:
@@ -176,6 +187,7 @@ class Builder {
   }
 
   const std::vector<Box3f>& bounds_;
+  const std::vector<bool>& triangle_;
   int max_leaf_;
   std::vector<BinNode> bin_;
   BvhBuild out_;
@@ -191,8 +203,8 @@ void set_lane_box(BvhNode& node, int lane, const Box3f& b) {
   if (b.empty()) node.child[lane] = node.count[lane] = 0;
 }
 
-BvhBuild build_bvh(const std::vector<Box3f>& prim_bounds, int max_leaf) {
-  return Builder(prim_bounds, max_leaf).run();
+BvhBuild build_bvh(const BuildRefs& refs, int max_leaf) {
+  return Builder(refs.bounds, refs.triangle, max_leaf).run();
 }
 
 namespace {
@@ -235,6 +247,7 @@ void split_piece(const Piece& poly, const Box3f& box, float max_area, int depth,
   if (depth == 0 || box.half_area() <= max_area) {
     out.bounds.push_back(box);
     out.prim.push_back(prim);
+    out.triangle.push_back(true);
     return;
   }
   const Vec3f e = box.extent();
@@ -264,6 +277,7 @@ BuildRefs split_large_triangles(const std::vector<PrimRecord>& prims,
     if (!triangle || bounds[i].half_area() <= max_area) {
       out.bounds.push_back(bounds[i]);
       out.prim.push_back(i);
+      out.triangle.push_back(triangle);
       continue;
     }
     split_piece({p.p0, p.p0 + p.p1, p.p0 + p.p2}, bounds[i], max_area, max_depth, i, out);

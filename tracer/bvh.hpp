@@ -1,12 +1,14 @@
 // Bounding volume hierarchy: a binary tree built with the binned surface area
 // heuristic, then collapsed to four-wide nodes (each node adopts grandchildren
 // of its largest inner children until it has four). The builder sees only
-// primitive boxes, so the tree, and with it the order in which a ray meets
-// primitives, does not depend on how it is later packed into pages.
+// reference boxes and which references are triangles, so the tree, and with
+// it the order in which a ray meets primitives, does not depend on how it is
+// later packed into pages.
 // Output invariants: nodes[0] is the root; an inner lane's node index is
-// greater than its parent's, and a node's inner children are consecutive; leaves hold 1..max_leaf primitives, consecutive
-// in `order` (order[k] is the original index of the k-th primitive). With no
-// primitives, nodes[0] has four empty lanes.
+// greater than its parent's, and a node's inner children are consecutive;
+// leaves hold 1..max_leaf references, consecutive in `order` (order[k] is the
+// reference index of the k-th leaf entry). With no references, nodes[0] has
+// four empty lanes.
 #pragma once
 
 #include <cstdint>
@@ -23,15 +25,17 @@ struct BvhBuild {
   std::uint32_t depth = 1;  // nodes on the longest root-to-leaf path
 };
 
-BvhBuild build_bvh(const std::vector<Box3f>& prim_bounds, int max_leaf);
-
 // Build references: the boxes the BVH is built over, each naming a primitive.
 // A primitive may have several (see split_large_triangles); the BVH copies it
-// into every leaf that holds one of its references.
+// into every leaf that holds one of its references. triangle[k] says whether
+// reference k is a triangle, which a leaf tests four at a time.
 struct BuildRefs {
   std::vector<Box3f> bounds;
   std::vector<std::uint32_t> prim;
+  std::vector<bool> triangle;
 };
+
+BvhBuild build_bvh(const BuildRefs& refs, int max_leaf);
 
 // Early split clipping: a triangle whose box is much larger than the average
 // box is cut in halves of its box (recursively, at most 2^max_depth pieces),
