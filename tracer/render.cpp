@@ -103,12 +103,33 @@ namespace {
 using Float4 = float __attribute__((vector_size(16)));
 using Mask4 = int __attribute__((vector_size(16)));
 
-// Byte offsets in a BvhNode of each axis's entry (near) and exit (far) planes
-// for one ray, chosen once per ray rather than per node.
-struct PlaneOffsets {
+// Bit i set when lane i of a comparison result is true (all ones).
+inline unsigned lane_bits(Mask4 m) {
+#ifdef __SSE__
+  return static_cast<unsigned>(__builtin_ia32_movmskps(reinterpret_cast<Float4>(m)));
+#else
+  return unsigned(m[0] & 1) | unsigned(m[1] & 2) | unsigned(m[2] & 4) | unsigned(m[3] & 8);
+#endif
+}
+
+inline Float4 splat(float x) { return Float4{x, x, x, x}; }
+inline float load_float(const std::byte* p) {
+  float f;
+  std::memcpy(&f, p, sizeof f);
+  return f;
+}
+
+// A ray prepared once for the slab tests of four-wide nodes: its origin and
+// reciprocal direction in every lane, and the byte offsets in a BvhNode of
+// each axis's entry (near) and exit (far) planes.
+struct SlabRay {
+  Float4 origin[3], inv_dir[3];
   std::size_t near[3], far[3];
-  explicit PlaneOffsets(const RayInverse& inv) {
+  explicit SlabRay(const Ray& ray) {
+    const RayInverse inv(ray);
     for (int a = 0; a < 3; ++a) {
+      origin[a] = splat(ray.origin[a]);
+      inv_dir[a] = splat(inv.inv_dir[a]);
       const std::size_t lo = offsetof(BvhNode, lo) + a * sizeof(Float4);
       const std::size_t hi = offsetof(BvhNode, hi) + a * sizeof(Float4);
       near[a] = inv.inv_dir[a] < 0 ? hi : lo;
@@ -121,48 +142,53 @@ struct PlaneOffsets {
 // a BvhNode in a page (or the header); its planes are loaded with memcpy.
 // Entering by the near planes means an empty box (lo > hi) is never entered.
 // Returns a hit-lane mask.
-inline unsigned slab_test4(const std::byte* node, const Ray& ray, const RayInverse& inv,
-                           const PlaneOffsets& planes, float t_min, float t_max,
+inline unsigned slab_test4(const std::byte* node, const SlabRay& ray, float t_min, float t_max,
                            float t_entry[4]) {
-  Float4 tn = {t_min, t_min, t_min, t_min}, tf = {t_max, t_max, t_max, t_max};
+  Float4 tn = splat(t_min), tf = splat(t_max);
   for (int a = 0; a < 3; ++a) {
     Float4 near, far;
-    std::memcpy(&near, node + planes.near[a], sizeof near);
-    std::memcpy(&far, node + planes.far[a], sizeof far);
-    const float o = ray.origin[a], id = inv.inv_dir[a];
-    const Float4 n = (near - o) * id, f = (far - o) * id;
+    std::memcpy(&near, node + ray.near[a], sizeof near);
+    std::memcpy(&far, node + ray.far[a], sizeof far);
+    const Float4 n = (near - ray.origin[a]) * ray.inv_dir[a], f = (far - ray.origin[a]) * ray.inv_dir[a];
     tn = n > tn ? n : tn;  // a NaN plane distance keeps the running bound
     tf = f < tf ? f : tf;
   }
   std::memcpy(t_entry, &tn, sizeof tn);
-  const Mask4 hit = tn <= tf;
-  return unsigned(hit[0] & 1) | unsigned(hit[1] & 2) | unsigned(hit[2] & 4) | unsigned(hit[3] & 8);
+  return lane_bits(tn <= tf);
 }
 
-inline Float4 splat(float x) { return Float4{x, x, x, x}; }
-inline float load_float(const std::byte* p) {
-  float f;
-  std::memcpy(&f, p, sizeof f);
-  return f;
+// Four rows of four floats transposed into four columns (pure data moves).
+inline void transpose4(const Float4 row[4], Float4 col[4]) {
+  const Float4 xy01 = __builtin_shufflevector(row[0], row[1], 0, 4, 1, 5);
+  const Float4 xy23 = __builtin_shufflevector(row[2], row[3], 0, 4, 1, 5);
+  const Float4 zw01 = __builtin_shufflevector(row[0], row[1], 2, 6, 3, 7);
+  const Float4 zw23 = __builtin_shufflevector(row[2], row[3], 2, 6, 3, 7);
+  col[0] = __builtin_shufflevector(xy01, xy23, 0, 1, 4, 5);
+  col[1] = __builtin_shufflevector(xy01, xy23, 2, 3, 6, 7);
+  col[2] = __builtin_shufflevector(zw01, zw23, 0, 1, 4, 5);
+  col[3] = __builtin_shufflevector(zw01, zw23, 2, 3, 6, 7);
 }
 
 // Moeller-Trumbore on four triangles side by side, each lane the same float
 // operations in the same order as intersect_triangle, so t, u and v are
 // bit-identical to the scalar test (no FMA on baseline x86-64, and GCC does not
-// reassociate without -ffast-math). `recs` points at `count` (1..4) packed
-// triangle PrimRecords in a page. Returns the mask of lanes hit in (t_min, t_max).
-inline unsigned triangles4(const std::byte* recs, std::uint32_t count, const Ray& ray,
+// reassociate without -ffast-math). lane[k] points at the triangle PrimRecord
+// lane k tests, one of `count` (1..4) packed in a page; lanes past `count`
+// repeat the last one. Returns the mask of lanes hit in (t_min, t_max).
+inline unsigned triangles4(const std::byte* const lane[4], std::uint32_t count, const Ray& ray,
                            float t_min, float t_max, Float4& t, Float4& u, Float4& v) {
-  // Lanes past `count` repeat the last triangle; the count mask drops them.
-  const std::byte* lane[4];
-  for (std::uint32_t k = 0; k < 4; ++k)
-    lane[k] = recs + (k < count ? k : count - 1) * sizeof(PrimRecord) + offsetof(PrimRecord, p0);
-  // c[j]: float j of v0, e1, e2 in each lane, loaded straight into the vector
-  // (going through a stack array stalls store-to-load forwarding).
-  Float4 c[9];
-  for (int j = 0; j < 9; ++j)
-    c[j] = Float4{load_float(lane[0] + 4 * j), load_float(lane[1] + 4 * j),
-                  load_float(lane[2] + 4 * j), load_float(lane[3] + 4 * j)};
+  // c[j]: float j of v0, e1, e2 in each lane. Floats 0..7 of each record come
+  // in two 16-byte rows per lane and are transposed; float 8 is gathered.
+  Float4 rows[2][4], c[9];
+  constexpr std::size_t p0 = offsetof(PrimRecord, p0);
+  for (int k = 0; k < 4; ++k) {
+    std::memcpy(&rows[0][k], lane[k] + p0, sizeof(Float4));
+    std::memcpy(&rows[1][k], lane[k] + p0 + sizeof(Float4), sizeof(Float4));
+  }
+  transpose4(rows[0], c);
+  transpose4(rows[1], c + 4);
+  c[8] = Float4{load_float(lane[0] + p0 + 32), load_float(lane[1] + p0 + 32),
+                load_float(lane[2] + p0 + 32), load_float(lane[3] + p0 + 32)};
   const Float4 dx = splat(ray.dir.x), dy = splat(ray.dir.y), dz = splat(ray.dir.z);
   const Float4 px = dy * c[8] - dz * c[7], py = dz * c[6] - dx * c[8], pz = dx * c[7] - dy * c[6];
   const Float4 det = c[3] * px + c[4] * py + c[5] * pz;
@@ -174,43 +200,55 @@ inline unsigned triangles4(const std::byte* recs, std::uint32_t count, const Ray
   t = (c[6] * qx + c[7] * qy + c[8] * qz) * inv_det;
   // The scalar test's rejections, negated as written there (a NaN u or v passes them).
   const Mask4 miss = (det == 0.0f) | (u < 0.0f) | (u > 1.0f) | (v < 0.0f) | (u + v > 1.0f);
-  const Mask4 hit = ~miss & (t > t_min) & (t < t_max);
-  const unsigned bits = unsigned(hit[0] & 1) | unsigned(hit[1] & 2) | unsigned(hit[2] & 4) |
-                        unsigned(hit[3] & 8);
-  return bits & ((1u << count) - 1);
+  return lane_bits(~miss & (t > t_min) & (t < t_max)) & ((1u << count) - 1);
 }
 
-// Lane references of a node in a page: child index and primitive count.
-inline void lane_refs(const std::byte* node, std::uint32_t child[4], std::uint32_t count[4]) {
-  std::memcpy(child, node + offsetof(BvhNode, child), 4 * sizeof(std::uint32_t));
-  std::memcpy(count, node + offsetof(BvhNode, count), 4 * sizeof(std::uint32_t));
-}
 }  // namespace
 
 // A BVH leaf: primitives first..first+count-1 in order, as test_prim one by
-// one would. When they are all triangles in one page, the four-wide test
-// replaces the loop with the same outcome: the nearest hit, the first of equal
-// ones (the loop's strict t < t_max), or for any-hit rays the first hit in
-// order, with the statistics of the records the loop would have read.
+// one would, in runs of at most four records that lie in one page. A run of
+// triangles goes through the four-wide test with the loop's outcome: the
+// nearest hit, the first of equal ones (the loop's strict t < t_max), or for
+// any-hit rays the first hit in order, with the statistics of the records the
+// loop would have read. Runs follow each other as the loop's records do, the
+// next one seeing the t_max the previous one left.
 template <bool Any>
 [[gnu::always_inline]] inline bool Tracer::test_leaf(std::uint32_t first, std::uint32_t count, const Ray& ray,
                                                      float t_min, float& t_max, Hit* hit, RayStats& stats) {
-  const std::uint64_t last_byte = (std::uint64_t{first} + count) * sizeof(PrimRecord) - 1;
-  const std::uint64_t first_byte = std::uint64_t{first} * sizeof(PrimRecord);
-  bool batch = count <= 4 && (first_byte >> header_.page_shift) == (last_byte >> header_.page_shift);
-  const std::byte* recs = nullptr;
-  if (batch) {
-    // Records are counted below, as many as the loop would read.
-    const PageId page = header_.section(Section::prims).first_page +
-                        static_cast<PageId>(first_byte >> header_.page_shift);
-    recs = fetch(page, stats) + (first_byte & (header_.page_size - 1));
-    for (std::uint32_t k = 0; k < count && batch; ++k) {
-      PrimKind kind;
-      std::memcpy(&kind, recs + k * sizeof(PrimRecord) + offsetof(PrimRecord, kind), sizeof kind);
-      batch = kind == PrimKind::flat_triangle || kind == PrimKind::smooth_triangle;
+  const std::uint32_t page_records = header_.page_size / sizeof(PrimRecord);  // a power of two >= 4
+  bool found = false;
+  for (std::uint32_t k = first, end = first + count; k < end;) {
+    const std::uint32_t run = std::min({end - k, 4u, page_records - (k & (page_records - 1))});
+    if (test_run<Any>(k, run, ray, t_min, t_max, hit, stats)) {
+      if (Any) return true;
+      found = true;
     }
+    k += run;
   }
-  if (!batch) {
+  return found;
+}
+
+template <bool Any>
+[[gnu::always_inline]] inline bool Tracer::test_run(std::uint32_t first, std::uint32_t count, const Ray& ray,
+                                                    float t_min, float& t_max, Hit* hit, RayStats& stats) {
+  const std::uint64_t first_byte = std::uint64_t{first} * sizeof(PrimRecord);
+  // Records are counted below, as many as the loop would read.
+  const PageId page = header_.section(Section::prims).first_page +
+                      static_cast<PageId>(first_byte >> header_.page_shift);
+  const std::byte* recs = fetch(page, stats) + (first_byte & (header_.page_size - 1));
+  // The record each lane of the four-wide test reads; lanes past `count`
+  // repeat the last one. The kinds of triangles are 0 and 1, so the bitwise
+  // or of the four kinds is at most 1 exactly when all are triangles.
+  static_assert(std::uint32_t(PrimKind::flat_triangle) == 0 && std::uint32_t(PrimKind::smooth_triangle) == 1);
+  const std::byte* lane[4];
+  std::uint32_t kinds = 0;
+  for (std::uint32_t k = 0; k < 4; ++k) {
+    lane[k] = recs + std::min(k, count - 1) * sizeof(PrimRecord);
+    std::uint32_t kind;
+    std::memcpy(&kind, lane[k] + offsetof(PrimRecord, kind), sizeof kind);
+    kinds |= kind;
+  }
+  if (kinds > 1) {
     bool found = false;
     for (std::uint32_t k = 0; k < count; ++k) {
       if (!test_prim<Any>(first + k, ray, t_min, t_max, hit, stats)) continue;
@@ -220,7 +258,7 @@ template <bool Any>
     return found;
   }
   Float4 t, u, v;
-  const unsigned mask = triangles4(recs, count, ray, t_min, t_max, t, u, v);
+  const unsigned mask = triangles4(lane, count, ray, t_min, t_max, t, u, v);
   if (Any) {
     const std::uint32_t tested = mask ? std::countr_zero(mask) + 1 : count;
     stats.prim_tests += tested;
@@ -246,49 +284,58 @@ template <bool Any>
 template <bool Any>
 bool Tracer::traverse_bvh(const Ray& ray, float t_min, float& t_max_io, Hit* hit, RayStats& stats) {
   float t_max = t_max_io;  // a local, so stores to the stack or the hit need not reload it
-  const RayInverse inv(ray);
-  const PlaneOffsets planes(inv);
+  const SlabRay slab_ray(ray);
   bool found = false;
   std::size_t sp = 0;
   StackEntry* const stack = stack_.data();  // a local: stores through it cannot move it
-  std::uint64_t box_tests = 0;
+  // Where node records lie, in locals: stores made while traversing cannot change them.
+  const PageId node_pages = header_.section(Section::bvh_nodes).first_page;
+  const std::uint32_t page_shift = header_.page_shift;
+  const std::uint64_t offset_mask = header_.page_size - 1;
+  std::uint64_t box_tests = 0, node_reads = 0;
+  const auto finish = [&] {
+    stats.box_tests += box_tests;
+    stats.record_reads += node_reads;
+    t_max_io = t_max;
+  };
   // The node being tested, in place: valid until the next page read.
   const std::byte* node = reinterpret_cast<const std::byte*>(&header_.bvh_root);
   for (;;) {
     box_tests += 4;
     float t[4];
-    unsigned mask = slab_test4(node, ray, inv, planes, t_min, t_max, t);
-    std::uint32_t child[4], count[4];
-    lane_refs(node, child, count);
+    unsigned mask = slab_test4(node, slab_ray, t_min, t_max, t);
     // Stack the lanes met, farthest first, so the nearest is popped next
     // (any-hit rays need no order).
     const std::size_t base = sp;
     for (; mask; mask &= mask - 1) {
       const int lane = std::countr_zero(mask);
+      StackEntry e{0, 0, t[lane]};
+      std::memcpy(&e.child, node + offsetof(BvhNode, child) + lane * sizeof(std::uint32_t), sizeof e.child);
+      std::memcpy(&e.count, node + offsetof(BvhNode, count) + lane * sizeof(std::uint32_t), sizeof e.count);
       std::size_t k = sp++;
       if constexpr (!Any)
-        for (; k > base && stack[k - 1].t < t[lane]; --k) stack[k] = stack[k - 1];
-      stack[k] = {child[lane], count[lane], t[lane]};
+        for (; k > base && stack[k - 1].t < e.t; --k) stack[k] = stack[k - 1];
+      stack[k] = e;
     }
     // Run leaves and pop until the next inner node.
     for (;;) {
       StackEntry e;
       do {
         if (sp == 0) {
-          stats.box_tests += box_tests;
-          t_max_io = t_max;
+          finish();
           return found;
         }
         e = stack[--sp];
       } while (!Any && e.t > t_max);  // beyond the closest hit so far
       if (e.count == 0) {
-        node = locate(Section::bvh_nodes, e.child, sizeof(BvhNode), stats);
+        const std::uint64_t byte = std::uint64_t{e.child} * sizeof(BvhNode);
+        node = fetch(node_pages + static_cast<PageId>(byte >> page_shift), stats) + (byte & offset_mask);
+        ++node_reads;
         break;
       }
       if (test_leaf<Any>(e.child, e.count, ray, t_min, t_max, hit, stats)) {
         if (Any) {
-          stats.box_tests += box_tests;
-          t_max_io = t_max;
+          finish();
           return true;
         }
         found = true;

@@ -80,6 +80,9 @@ class Tracer {
   template <bool Any> bool traverse_grid(const Ray& ray, float t_min, float& t_max, Hit* hit, RayStats& stats);
   template <bool Any> bool test_leaf(std::uint32_t first, std::uint32_t count, const Ray& ray, float t_min,
                                       float& t_max, Hit* hit, RayStats& stats);
+  // Up to four records of a leaf in one page.
+  template <bool Any> bool test_run(std::uint32_t first, std::uint32_t count, const Ray& ray, float t_min,
+                                     float& t_max, Hit* hit, RayStats& stats);
   template <bool Any> bool test_prim(std::uint32_t index, const Ray& ray, float t_min, float& t_max, Hit* hit, RayStats& stats);
 
   // Shading (shading.cpp).
