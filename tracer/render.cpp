@@ -18,7 +18,7 @@ Tracer::Tracer(const DatabaseHeader& header, PageSource& pages, TraceOptions opt
 // ---- Paged reads ----
 
 inline const std::byte* Tracer::fetch(PageId id, RayStats& stats) {
-  if (last_ptr_ && id == last_page_) return last_ptr_;
+  if (id == last_page_) return last_ptr_;
   ++stats.page_calls;
   if (page_stamp_[id] != generation_) {
     page_stamp_[id] = generation_;
@@ -54,7 +54,7 @@ void Tracer::begin_sample() {
     std::fill(page_stamp_.begin(), page_stamp_.end(), 0);
     generation_ = 1;
   }
-  last_ptr_ = nullptr;  // so every page a sample touches goes through page()
+  last_page_ = kNoPage;  // so every page a sample touches goes through page()
   sample_pages_ = 0;
 }
 
@@ -293,6 +293,11 @@ bool Tracer::traverse_bvh(const Ray& ray, float t_min, float& t_max_io, Hit* hit
   const std::uint32_t page_shift = header_.page_shift;
   const std::uint64_t offset_mask = header_.page_size - 1;
   std::uint64_t box_tests = 0, node_reads = 0;
+  const auto node_at = [&](std::uint32_t index) {
+    const std::uint64_t byte = std::uint64_t{index} * sizeof(BvhNode);
+    ++node_reads;
+    return fetch(node_pages + static_cast<PageId>(byte >> page_shift), stats) + (byte & offset_mask);
+  };
   const auto finish = [&] {
     stats.box_tests += box_tests;
     stats.record_reads += node_reads;
@@ -304,6 +309,17 @@ bool Tracer::traverse_bvh(const Ray& ray, float t_min, float& t_max_io, Hit* hit
     box_tests += 4;
     float t[4];
     unsigned mask = slab_test4(node, slab_ray, t_min, t_max, t);
+    // One inner lane met: go down to it without a stack round trip.
+    if (mask && !(mask & (mask - 1))) {
+      const int lane = std::countr_zero(mask);
+      std::uint32_t child, count;
+      std::memcpy(&child, node + offsetof(BvhNode, child) + lane * sizeof(std::uint32_t), sizeof child);
+      std::memcpy(&count, node + offsetof(BvhNode, count) + lane * sizeof(std::uint32_t), sizeof count);
+      if (count == 0) {
+        node = node_at(child);
+        continue;
+      }
+    }
     // Stack the lanes met, farthest first, so the nearest is popped next
     // (any-hit rays need no order).
     const std::size_t base = sp;
@@ -328,9 +344,7 @@ bool Tracer::traverse_bvh(const Ray& ray, float t_min, float& t_max_io, Hit* hit
         e = stack[--sp];
       } while (!Any && e.t > t_max);  // beyond the closest hit so far
       if (e.count == 0) {
-        const std::uint64_t byte = std::uint64_t{e.child} * sizeof(BvhNode);
-        node = fetch(node_pages + static_cast<PageId>(byte >> page_shift), stats) + (byte & offset_mask);
-        ++node_reads;
+        node = node_at(e.child);
         break;
       }
       if (test_leaf<Any>(e.child, e.count, ray, t_min, t_max, hit, stats)) {

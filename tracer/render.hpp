@@ -95,8 +95,9 @@ class Tracer {
   PageSource& pages_;
   TraceOptions options_;
   CameraModel camera_;
-  PageId last_page_ = 0;
-  const std::byte* last_ptr_ = nullptr;  // page last_page_, or null
+  static constexpr PageId kNoPage = ~PageId{0};  // never a page id: a database has fewer than 2^32 pages
+  PageId last_page_ = kNoPage;
+  const std::byte* last_ptr_ = nullptr;  // page last_page_ unless that is kNoPage
   std::vector<std::uint32_t> page_stamp_;  // sample generation that last touched each page
   std::uint32_t generation_ = 0;
   std::uint64_t sample_pages_ = 0;
