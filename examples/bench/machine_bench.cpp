@@ -86,10 +86,10 @@ MachineRun machine_seconds(const std::string& spec, int size, int nodes, unsigne
 
 void print_run(const char* label, const MachineRun& r, double baseline) {
   if (r.seconds < 0) {
-    std::printf("%-34s failed: %s\n", label, r.error.c_str());
+    std::printf("%-50s failed: %s\n", label, r.error.c_str());
     return;
   }
-  std::printf("%-34s %8.3f s   ratio to shared memory %5.2fx   miss ratio %.4f   image %s\n", label, r.seconds,
+  std::printf("%-50s %8.3f s   ratio to shared memory %5.2fx   miss ratio %.4f   image %s\n", label, r.seconds,
               r.seconds / baseline, r.miss_ratio, r.same_image ? "identical" : "DIFFERS");
 }
 
