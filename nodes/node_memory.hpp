@@ -10,11 +10,9 @@
 //  - entry_[p] says where page p lives on this node, so one array load
 //    answers every access: >= 0 own page (its index in own_), -1 not here,
 //    <= -2 cache slot (-2 - entry).
-//  - every occupied slot carries the tick of its last use from a counter
-//    that only grows, so the least recently used slot is the one with the
-//    smallest tick: touching and installing are one store (they happen on
-//    every access); evicting scans the slots for the smallest unpinned tick
-//    (it happens once per miss, beside a round trip through the network).
+//  - the LRU list holds exactly the occupied slots, most recent at the head;
+//    touching, installing and evicting are O(1) (eviction skips pinned
+//    slots, of which there are at most one per worker).
 //  - a pinned slot is never evicted: a worker pins the slot whose bytes it
 //    is using, so another worker of the node cannot pull them away.
 //  - resident bytes = own pages + occupied slots; slots are allocated on
@@ -68,7 +66,7 @@ class NodeMemory {
   const std::byte* own_page(std::int32_t index) const { return own_[static_cast<std::size_t>(index)].data(); }
   const std::byte* slot_bytes(int slot) const { return slots_[static_cast<std::size_t>(slot)].get(); }
 
-  void touch(int slot) { last_use_[static_cast<std::size_t>(slot)] = ++tick_; }  // make most recently used
+  void touch(int slot);  // make most recently used
   void pin(int slot) { ++pins_[static_cast<std::size_t>(slot)]; }
   void unpin(int slot) { --pins_[static_cast<std::size_t>(slot)]; }
 
@@ -92,6 +90,8 @@ class NodeMemory {
 
  private:
   int take_slot();
+  void unlink(int slot);
+  void push_front(int slot);
 
   std::size_t page_size_;
   std::uint32_t capacity_;
@@ -99,9 +99,8 @@ class NodeMemory {
   std::vector<std::int32_t> entry_;
   std::vector<std::unique_ptr<std::byte[]>> slots_;  // stable addresses
   std::vector<std::uint32_t> slot_page_;
-  std::vector<std::uint64_t> last_use_;  // per slot: tick of its last use
-  std::uint64_t tick_ = 0;
-  std::vector<int> pins_;
+  std::vector<int> prev_, next_, pins_;
+  int head_ = -1, tail_ = -1;  // most / least recently used occupied slot
   std::uint64_t evictions_ = 0;
   std::unordered_map<std::uint32_t, std::vector<int>> pending_;  // page -> waiting workers
 };
