@@ -135,7 +135,7 @@ void check_machine(Options& o, const Raw& raw, const po::variables_map& vm) {
   m.threads = in_range<unsigned>(raw.threads, 0, 4096, "--threads");
   m.grain = in_range<std::uint32_t>(raw.grain, 1, 1 << 20, "--grain");
   m.workers_per_node = in_range<int>(raw.workers, 1, 64, "--workers-per-node");
-  m.prefetch = in_range<std::uint16_t>(raw.prefetch, 0, 3, "--prefetch");
+  m.prefetch = in_range<std::uint16_t>(raw.prefetch, 0, nodes::max_prefetch(m), "--prefetch");
   m.trace_routes = in_range<std::uint64_t>(raw.trace_routes, 0, 1 << 20, "--trace-routes");
   if (raw.schedule == "dynamic") m.schedule = nodes::Schedule::dynamic;
   else if (raw.schedule == "static") m.schedule = nodes::Schedule::static_split;

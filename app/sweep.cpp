@@ -78,7 +78,8 @@ void check_sweep(SweepOptions& o, const RawSweep& raw) {
   else throw UsageError("sweep: expected 'nodes' or 'cache', got '" + raw.kind + "'");
   if (o.size < 1 || o.size > 4096) throw UsageError("--size: expected 1..4096");
   if (o.grain < 1) throw UsageError("--grain: expected at least 1");
-  if (o.prefetch > 3) throw UsageError("--prefetch: expected 0..3");
+  const std::uint16_t max_prefetch = nodes::max_prefetch(nodes::MachineOptions{});
+  if (o.prefetch > max_prefetch) throw UsageError("--prefetch: expected 0.." + std::to_string(max_prefetch));
   if (o.fit_seconds < 0) throw UsageError("--fit-seconds: expected a positive time");
   o.topologies = split(raw.topologies);
   if (o.topologies.empty()) throw UsageError("--topology: empty list");

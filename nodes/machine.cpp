@@ -41,10 +41,8 @@ void validate(const MachineOptions& options) {
   if (options.workers_per_node < 1) throw std::invalid_argument("--workers-per-node must be at least 1");
   if (options.grain < 1) throw std::invalid_argument("--grain must be at least 1");
   if (options.buffer_capacity < 1) throw std::invalid_argument("network buffer capacity must be at least 1");
-  // While a worker traces, P answers and a page reply may come to its port:
-  // they must fit the network's delivery buffer.
-  if (options.prefetch + 1u > options.buffer_capacity)
-    throw std::invalid_argument("--prefetch must be at most " + std::to_string(options.buffer_capacity - 1) +
+  if (options.prefetch > max_prefetch(options))
+    throw std::invalid_argument("--prefetch must be at most " + std::to_string(max_prefetch(options)) +
                                 " (a worker's answers and a page reply must fit the network buffer of " +
                                 std::to_string(options.buffer_capacity) + " packets)");
 }

@@ -77,6 +77,12 @@ struct MachineOptions {
   Progress progress;                   // called by the collector (on its thread)
 };
 
+// The most tiles a worker may keep asked for ahead: its answers and a page
+// reply must fit the network's delivery buffer (see the buffer bounds above).
+inline std::uint16_t max_prefetch(const MachineOptions& options) {
+  return static_cast<std::uint16_t>(options.buffer_capacity - 1);
+}
+
 struct NodeReport {
   SvmStats svm;
   ServerCounters served;
