@@ -7,7 +7,12 @@
 // holding the whole database (no page traffic), and with tiles of 256
 // pixels (little farming traffic).
 //
-// usage: machine_bench [SCENE [SIZE [THREADS]]]   default: teapot 512 2
+// Every configuration runs REPEATS times, the runs of a comparison
+// interleaved so that load from other work falls on both sides alike; a
+// line gives the median and the fastest run, and ratios are of medians.
+//
+// usage: machine_bench [SCENE [SIZE [THREADS [REPEATS]]]]   default: teapot 512 2 5
+#include <algorithm>
 #include <atomic>
 #include <chrono>
 #include <cstdio>
@@ -51,18 +56,34 @@ double shared_memory_seconds(const tracer::Database& db, unsigned threads, std::
   return std::chrono::duration<double>(Clock::now() - start).count();
 }
 
+// Wall times of repeated runs of one configuration.
+struct Times {
+  std::vector<double> seconds;
+
+  double median() const {
+    std::vector<double> v = seconds;
+    std::sort(v.begin(), v.end());
+    const std::size_t n = v.size();
+    return n % 2 ? v[n / 2] : (v[n / 2 - 1] + v[n / 2]) / 2;
+  }
+  double fastest() const { return *std::min_element(seconds.begin(), seconds.end()); }
+};
+
 struct MachineRun {
-  double seconds = -1;  // < 0: failed
+  Times times;
   double miss_ratio = 0;
-  bool same_image = false;
-  std::string error;
+  bool same_image = true;  // every run's image equal to the reference
+  std::string error;       // non-empty: a run failed
+
+  bool ok() const { return error.empty() && !times.seconds.empty(); }
 };
 
 using Variant = std::function<void(nodes::MachineOptions&, const tracer::DatabaseHeader&)>;
 
-MachineRun machine_seconds(const std::string& spec, int size, int nodes, unsigned threads,
-                           const std::vector<tracer::Color>& reference, const Variant& variant = {}) {
-  MachineRun run;
+// One more run of a configuration, added to `run`.
+void run_machine_once(MachineRun& run, const std::string& spec, int size, int nodes, unsigned threads,
+                      const std::vector<tracer::Color>& reference, const Variant& variant = {}) {
+  if (!run.error.empty()) return;
   try {
     auto db = make_db(spec, size);
     nodes::MachineOptions options;
@@ -72,25 +93,25 @@ MachineRun machine_seconds(const std::string& spec, int size, int nodes, unsigne
     options.cache_pages = std::max<std::uint32_t>(1, db.header.page_count / 8);
     if (variant) variant(options, db.header);
     const auto result = nodes::run_machine(std::move(db), options);
-    run.seconds = result.report.wall_seconds;
+    run.times.seconds.push_back(result.report.wall_seconds);
     run.miss_ratio = result.report.svm().miss_ratio();
     const auto& px = result.image.pixels();
-    run.same_image = px.size() == reference.size() &&
+    run.same_image = run.same_image && px.size() == reference.size() &&
                      std::memcmp(px.data(), reference.data(), px.size() * sizeof(tracer::Color)) == 0;
   } catch (const std::exception& e) {
     run.error = e.what();
     run.error = run.error.substr(0, run.error.find('\n'));
   }
-  return run;
 }
 
 void print_run(const char* label, const MachineRun& r, double baseline) {
-  if (r.seconds < 0) {
-    std::printf("%-50s failed: %s\n", label, r.error.c_str());
+  if (!r.ok()) {
+    std::printf("%-46s failed: %s\n", label, r.error.c_str());
     return;
   }
-  std::printf("%-50s %8.3f s   ratio to shared memory %5.2fx   miss ratio %.4f   image %s\n", label, r.seconds,
-              r.seconds / baseline, r.miss_ratio, r.same_image ? "identical" : "DIFFERS");
+  std::printf("%-46s %6.3f s (fastest %6.3f)   ratio to shared memory %5.2fx   miss ratio %.4f   image %s\n", label,
+              r.times.median(), r.times.fastest(), r.times.median() / baseline, r.miss_ratio,
+              r.same_image ? "identical" : "DIFFERS");
 }
 
 }  // namespace
@@ -99,25 +120,36 @@ int main(int argc, char** argv) {
   const std::string spec = argc > 1 ? argv[1] : "teapot";
   const int size = argc > 2 ? std::stoi(argv[2]) : 512;
   const unsigned threads = argc > 3 ? static_cast<unsigned>(std::stoul(argv[3])) : 2u;
+  const int repeats = argc > 4 ? std::max(1, std::stoi(argv[4])) : 5;
   const auto db = make_db(spec, size);
-  std::printf("scene %s at %dx%d, %u database pages of %u bytes, cache = 1/8 of the database per node\n",
-              spec.c_str(), size, size, db.header.page_count, db.header.page_size);
+  std::printf("scene %s at %dx%d, %u database pages of %u bytes, cache = 1/8 of the database per node, "
+              "%d runs of each line: median (fastest)\n",
+              spec.c_str(), size, size, db.header.page_count, db.header.page_size, repeats);
 
   std::vector<tracer::Color> image;
-  const double shared1 = shared_memory_seconds(db, 1, image);
-  const double shared_t = shared_memory_seconds(db, threads, image);
-  std::printf("shared memory, 1 thread          %8.3f s\n", shared1);
-  std::printf("shared memory, %u threads         %8.3f s   speedup %.2fx\n", threads, shared_t, shared1 / shared_t);
+  Times shared1, shared_t;
+  for (int r = 0; r < repeats; ++r) {
+    shared1.seconds.push_back(shared_memory_seconds(db, 1, image));
+    shared_t.seconds.push_back(shared_memory_seconds(db, threads, image));
+  }
+  std::printf("shared memory, 1 thread                        %6.3f s (fastest %6.3f)\n", shared1.median(),
+              shared1.fastest());
+  std::printf("shared memory, %u threads                       %6.3f s (fastest %6.3f)   speedup %.2fx\n", threads,
+              shared_t.median(), shared_t.fastest(), shared1.median() / shared_t.median());
 
   for (int nodes : {16, 64}) {
-    const MachineRun one = machine_seconds(spec, size, nodes, 1, image);
-    const MachineRun many = machine_seconds(spec, size, nodes, threads, image);
+    MachineRun one, many;
+    for (int r = 0; r < repeats; ++r) {
+      run_machine_once(one, spec, size, nodes, 1, image);
+      run_machine_once(many, spec, size, nodes, threads, image);
+    }
     const std::string l1 = "machine hypercube " + std::to_string(nodes) + ", 1 thread";
     const std::string lt = "machine hypercube " + std::to_string(nodes) + ", " + std::to_string(threads) + " threads";
-    print_run(l1.c_str(), one, shared1);
-    print_run(lt.c_str(), many, shared_t);
-    if (one.seconds > 0 && many.seconds > 0)
-      std::printf("  speedup of %u threads over 1: %.2fx\n", threads, one.seconds / many.seconds);
+    print_run(l1.c_str(), one, shared1.median());
+    print_run(lt.c_str(), many, shared_t.median());
+    if (one.ok() && many.ok())
+      std::printf("  speedup of %u threads over 1: %.2fx (fastest runs %.2fx)\n", threads,
+                  one.times.median() / many.times.median(), one.times.fastest() / many.times.fastest());
   }
 
   std::printf("where the time goes: hypercube 16, %u threads, against shared memory on %u threads\n", threads,
@@ -126,11 +158,14 @@ int main(int argc, char** argv) {
       {"  as above (prefetch 1, grain 16)", {}},
       {"  prefetch 0 (ask when idle)",
        [](nodes::MachineOptions& o, const tracer::DatabaseHeader&) { o.prefetch = 0; }},
-      {"  cache = whole database (first-touch misses only)",
+      {"  cache = whole database (first-touch misses)",
        [](nodes::MachineOptions& o, const tracer::DatabaseHeader& h) { o.cache_pages = h.page_count; }},
       {"  grain 256", [](nodes::MachineOptions& o, const tracer::DatabaseHeader&) { o.grain = 256; }},
   };
-  for (const auto& [label, variant] : variants)
-    print_run(label, machine_seconds(spec, size, 16, threads, image, variant), shared_t);
+  std::vector<MachineRun> runs(variants.size());
+  for (int r = 0; r < repeats; ++r)
+    for (std::size_t v = 0; v < variants.size(); ++v)
+      run_machine_once(runs[v], spec, size, 16, threads, image, variants[v].second);
+  for (std::size_t v = 0; v < variants.size(); ++v) print_run(variants[v].first, runs[v], shared_t.median());
   return 0;
 }
