@@ -13,7 +13,28 @@ namespace csp {
 using detail::Clock;
 using detail::WaitState;
 
+Alt::Alt(Waiting waiting) {
+  if (waiting == Waiting::doorbell) bell_ = std::make_unique<detail::Bell>("ALT bell");
+}
+
+Alt::~Alt() {
+  if (!bell_) return;
+  for (const Guard& g : guards_)
+    if (on_channel(g.kind)) watch(g, nullptr);
+}
+
+// Registers (or with null, unregisters) the bell a channel guard's channel
+// rings for this ALT.
+void Alt::watch(const Guard& g, detail::Bell* bell) {
+  detail::ChannelLock lk(g.channel->lock_);
+  detail::Bell*& slot = g.kind == Kind::room ? g.channel->room_bell_ : g.channel->data_bell_;
+  if (bell && slot)
+    throw std::logic_error("Alt: '" + g.channel->name() + "' is already watched by another doorbell ALT");
+  slot = bell;
+}
+
 std::size_t Alt::add(Guard g) {
+  if (bell_ && on_channel(g.kind)) watch(g, bell_.get());
   guards_.push_back(std::move(g));
   dirty_ = true;
   return guards_.size() - 1;
@@ -40,6 +61,7 @@ std::size_t Alt::select_from(std::size_t first) {
   if (channels_.empty() && timeout_guard_ == none && !has_skip_) {
     throw std::logic_error("Alt::select: every guard is disabled (occam STOP)");
   }
+  if (bell_) return select_by_bell(first);
   const std::size_t by_hint = poll_hints(first);
   if (by_hint != none) return by_hint;
   const Clock::time_point start = timeout_guard_ == none ? Clock::time_point() : Clock::now();
@@ -62,6 +84,14 @@ void Alt::prepare() {
   channels_.clear();
   timeout_guard_ = none;
   has_skip_ = false;
+  pollable_.clear();
+  for (std::size_t i = 0; i < guards_.size(); ++i) {
+    const Guard& g = guards_[i];
+    if (!g.enabled) continue;
+    if (on_channel(g.kind)) pollable_.push_back({i, g.channel.get(), g.kind == Kind::room});
+    if (g.kind == Kind::skip || (g.kind == Kind::timeout && g.after <= Clock::duration::zero()))
+      pollable_.push_back({i, nullptr, false});
+  }
   for (std::size_t i : by_address_) {
     const Guard& g = guards_[i];
     if (!g.enabled) continue;
@@ -110,6 +140,41 @@ std::size_t Alt::poll_locked(std::size_t first) const {
     const bool ready = g.kind == Kind::skip || (on_channel(g.kind) && ready_locked(g)) ||
                        (g.kind == Kind::timeout && g.after <= Clock::duration::zero());
     if (ready) return i;
+  }
+  return none;
+}
+
+// Doorbell waiting: clear the bell, poll; if nothing is ready, wait for a
+// ring (at once if one came during the poll) and start again.
+std::size_t Alt::select_by_bell(std::size_t first) {
+  const Clock::time_point deadline =
+      timeout_guard_ == none ? Clock::time_point::max() : Clock::now() + guards_[timeout_guard_].after;
+  for (;;) {
+    bell_->clear();
+    const std::size_t ready = poll_each(first);
+    if (ready != none) return ready;
+    detail::Waiter w;
+    w.op = "in ALT over";
+    w.channels = &channels_;
+    const WaitState s = bell_->wait(w, deadline);
+    if (s == WaitState::timed_out) return timeout_guard_;
+    if (s == WaitState::aborted) detail::unwind_deadlock();
+  }
+}
+
+// The first ready guard from guard `first` on, over the guards prepare()
+// listed as possibly ready: SKIP, an expired timeout, or a channel whose
+// hint says ready, confirmed under its lock alone.
+std::size_t Alt::poll_each(std::size_t first) const {
+  const std::size_t n = pollable_.size();
+  std::size_t start = 0;
+  while (start < n && pollable_[start].guard < first) ++start;
+  for (std::size_t k = 0; k < n; ++k) {
+    const Pollable& p = pollable_[(start + k) % n];
+    if (!p.channel) return p.guard;
+    if (!(p.room ? p.channel->room_hint() : p.channel->ready_hint())) continue;
+    detail::ChannelLock lk(p.channel->lock_);
+    if (p.room ? p.channel->room_locked() : p.channel->ready_locked()) return p.guard;
   }
   return none;
 }

@@ -17,6 +17,17 @@
 // single reader, the read does not block. Likewise a room guard is for the
 // channel's only writer, whose next write then does not block.
 // A poisoned channel counts as ready; the read or write throws Poisoned.
+//
+// Waiting::doorbell trades that linking for a bell: each channel guard
+// registers this ALT's bell with its channel once, and the channel rings it
+// (detail/wait.hpp) when it may have become ready for this ALT; a select
+// polls the guards, and if none is ready parks on the bell alone, then polls
+// again. That makes a park cost one lock instead of two locks and a record
+// link per channel, and the channels' other ends one bell ring per write or
+// freed slot. For a process that selects over several busy channels and
+// often finds none ready, such as a router. A channel has one reader and
+// one writer, so at most one doorbell ALT per end may watch it; the ALT
+// unregisters when destroyed.
 #pragma once
 
 #include <chrono>
@@ -31,6 +42,12 @@ namespace csp {
 
 class Alt {
  public:
+  enum class Waiting { relink, doorbell };
+  explicit Alt(Waiting waiting = Waiting::relink);
+  ~Alt();
+  Alt(const Alt&) = delete;
+  Alt& operator=(const Alt&) = delete;
+
   template <class T>
   std::size_t add_input(In<T> in) {
     return add(Guard{Kind::input, std::move(in.state_), {}, true});
@@ -63,6 +80,9 @@ class Alt {
 
   std::size_t add(Guard g);
   std::size_t select_from(std::size_t first);
+  std::size_t select_by_bell(std::size_t first);
+  std::size_t poll_each(std::size_t first) const;
+  void watch(const Guard& g, detail::Bell* bell);
   void prepare();
   void sort_by_address();
   std::size_t poll_hints(std::size_t first) const;
@@ -86,6 +106,13 @@ class Alt {
   std::size_t timeout_guard_ = none;            // earliest enabled timeout
   bool has_skip_ = false;
   std::vector<detail::Record> records_;         // scratch: one per enabled input
+  struct Pollable {
+    std::size_t guard;
+    detail::ChannelBase* channel;  // null: SKIP or an expired timeout, always ready
+    bool room;
+  };
+  std::vector<Pollable> pollable_;              // enabled guards that may be ready, by index
+  std::unique_ptr<detail::Bell> bell_;          // doorbell waiting only
 };
 
 }  // namespace csp

@@ -22,6 +22,9 @@
 //   either end throws Poisoned, even with values still buffered.
 // - try_write on a rendezvous channel succeeds only if a reader is parked in
 //   read(); a parked ALT would still have to run before taking the value.
+// - A doorbell ALT (alt.hpp) watching a channel is rung, under the lock, when
+//   a value is buffered or a writer parks (data_bell_), when a read frees a
+//   slot that no parked writer refills (room_bell_), and by poison.
 // Who wakes whom: writers wake readers (and fire ALTs), readers wake writers
 // (and fire room guards), poison wakes all; see detail/wait.hpp for the claiming rules.
 #pragma once
@@ -111,6 +114,7 @@ class ChannelState final : public ChannelBase {
     rec.slot = &value;
     writers_.push_back(rec);
     publish_hints_locked();
+    if (data_bell_) data_bell_->ring();
     finish_wait(park(w, lk.get()), rec, writers_);
   }
 
@@ -135,10 +139,12 @@ class ChannelState final : public ChannelBase {
       if (Record* r = claim_front_locked(writers_)) {
         push_locked(std::move(*static_cast<T*>(r->slot)));
         complete(*r->waiter, WaitState::data, r->guard);
-      } else if (Record* alt = claim_front_locked(room_waiters_)) {
-        complete(*alt->waiter, WaitState::data, alt->guard);
+        publish_hints_locked();
+        return v;
       }
+      if (Record* alt = claim_front_locked(room_waiters_)) complete(*alt->waiter, WaitState::data, alt->guard);
       publish_hints_locked();
+      if (room_bell_) room_bell_->ring();
       return v;
     }
     if (Record* r = claim_front_locked(writers_)) {
@@ -167,6 +173,7 @@ class ChannelState final : public ChannelBase {
     }
     if (count_ == capacity_) return false;
     push_locked(std::move(value));
+    if (data_bell_) data_bell_->ring();
     return true;
   }
 

@@ -54,6 +54,36 @@ void ChannelBase::poison() {
   wake_all_locked(readers_, WaitState::poisoned);
   wake_all_locked(writers_, WaitState::poisoned);
   wake_all_locked(room_waiters_, WaitState::poisoned);
+  if (data_bell_) data_bell_->ring();
+  if (room_bell_) room_bell_->ring();
+}
+
+// Called with a channel's lock held, whose release flushes any cross-thread
+// wake this queues.
+void Bell::ring() {
+  if (rung_.exchange(true, std::memory_order_acq_rel)) return;  // already rung, not yet seen
+  SpinlockLock lk(lock_);
+  if (Record* r = claim_front_locked(readers_)) complete(*r->waiter, WaitState::data, 0);
+}
+
+WaitState Bell::wait(Waiter& w, Clock::time_point deadline) {
+  ChannelLock lk(lock_);
+  if (rung_.exchange(false, std::memory_order_acq_rel)) return WaitState::data;
+  Record rec;
+  rec.waiter = &w;
+  readers_.push_back(rec);
+  WaitState s = WaitState::waiting;
+  if (deadline == Clock::time_point::max()) {
+    s = park(w, lk.get());
+    if (s == WaitState::data) return s;
+    lk.lock();
+  } else {
+    park_until(w, lk.get(), deadline);
+    lk.lock();
+    s = resolve_timeout(w);
+  }
+  readers_.erase(rec);
+  return s;
 }
 
 Record* ChannelBase::claim_front_locked(RecordQueue& q) {

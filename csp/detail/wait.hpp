@@ -37,6 +37,7 @@ using Clock = std::chrono::steady_clock;
 
 struct Process;
 class ChannelBase;
+class Bell;
 
 // How a wait ended. `claiming` is transient: held by a claimer between its CAS
 // and complete(), always under a channel lock.
@@ -106,6 +107,13 @@ class ChannelBase {
   RecordQueue readers_;  // guarded by lock_
   RecordQueue writers_;  // guarded by lock_
   RecordQueue room_waiters_;  // ALTs waiting for a free slot; guarded by lock_
+  // The bells of doorbell ALTs watching this channel (alt.hpp), guarded by
+  // lock_: data_bell_ is rung after every change that may let its reader
+  // read without blocking (a value buffered, a writer parked, poison),
+  // room_bell_ after every change that frees a slot for its writer (and by
+  // poison). Rung with lock_ held: the lock order is channel, then bell.
+  Bell* data_bell_ = nullptr;
+  Bell* room_bell_ = nullptr;
 
  protected:
   // Lock must be held. Claims and completes the first live record of q with
@@ -122,6 +130,34 @@ class ChannelBase {
   std::atomic<bool> poisoned_{false};
   std::atomic<bool> ready_hint_{false};
   std::atomic<bool> room_hint_{false};
+};
+
+// The bell of a doorbell ALT: a one-bit event with one waiter, the ALT's
+// owner, who clears it before each poll of its channels and then waits.
+// ring() sets it and, if it was clear, wakes the waiter when parked; wait()
+// returns at once if it was rung since the last clear, else parks until the
+// next ring or the deadline. Every ring is a release on rung_ (an exchange,
+// so a run of rings forms one release sequence) and every clear an acquire,
+// so a channel change made before a ring is visible to the poll that follows
+// the clear or the wait that sees it.
+class Bell final : public ChannelBase {
+ public:
+  explicit Bell(std::string name) : ChannelBase(std::move(name), 0) {}
+  bool ready_locked() const override { return rung_.load(std::memory_order_relaxed); }
+  bool room_locked() const override { return true; }
+
+  void ring();
+  void clear() {
+    if (rung_.load(std::memory_order_relaxed)) rung_.exchange(false, std::memory_order_acq_rel);
+  }
+  // w describes the wait for the deadlock dump. Returns data (rung),
+  // timed_out (deadline first) or aborted (deadlocked run: unwind).
+  WaitState wait(Waiter& w, Clock::time_point deadline);
+
+ private:
+  // Set only by ring(), cleared only by the waiter. Once a ring finds it
+  // clear, that ring wakes the waiter if it is parked (under lock_).
+  std::atomic<bool> rung_{false};
 };
 
 // Claiming: try_claim() wins the waiter or reports a lost race; complete()

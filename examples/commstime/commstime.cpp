@@ -5,7 +5,9 @@
 // It runs on csp channels and, in the same run, on raw Boost.Fiber
 // unbuffered_channel, on one thread and across two, and prints ns per
 // communication and the ratio. Then it times ALT over 1, 4 and 16 channels,
-// with the input already waiting (ready) and with the ALT parking (idle).
+// with the input already waiting (ready) and with the ALT parking (idle),
+// for both ways an ALT can wait (relinking records on every channel, and the
+// doorbell).
 //
 // One-thread figures are CPU time of that thread, two-thread ones wall time.
 // Each figure is the best of several runs, alternating csp and raw, so that
@@ -170,7 +172,7 @@ std::optional<double> raw_commstime_guarded(unsigned threads, long cycles, std::
 // One writer feeds channel k of n (k cycles through all); the ALT selects and
 // reads `count` times. Buffered channels keep input waiting (ready path);
 // unbuffered ones make the ALT park before each input (idle path).
-double alt_cost(std::size_t n, bool ready, long count) {
+double alt_cost(std::size_t n, bool ready, long count, csp::Alt::Waiting waiting) {
   std::vector<csp::Channel<long>> chans;
   for (std::size_t i = 0; i < n; ++i) chans.emplace_back(std::to_string(i), ready ? 64 : 0);
   Clock::duration elapsed{};
@@ -180,8 +182,8 @@ double alt_cost(std::size_t n, bool ready, long count) {
     for (auto& c : chans) outs.push_back(c.writer());
     for (long i = 0; i < count; ++i) outs[static_cast<std::size_t>(i) % n].write(i);
   });
-  rt.spawn("alt", 0, [&chans, &elapsed, count] {
-    csp::Alt alt;
+  rt.spawn("alt", 0, [&chans, &elapsed, count, waiting] {
+    csp::Alt alt(waiting);
     std::vector<csp::In<long>> ins;
     for (auto& c : chans) ins.push_back(c.reader());
     for (auto& in : ins) alt.add_input(in);
@@ -212,13 +214,18 @@ void print_commstime(unsigned threads, long cycles, int runs) {
 }
 
 void print_alt(std::size_t n, long count, int runs) {
-  double ready = std::numeric_limits<double>::max();
-  double idle = std::numeric_limits<double>::max();
-  for (int r = 0; r < runs; ++r) {
-    ready = std::min(ready, alt_cost(n, true, count));
-    idle = std::min(idle, alt_cost(n, false, count));
+  using Waiting = csp::Alt::Waiting;
+  std::printf("%-8zu", n);
+  for (Waiting waiting : {Waiting::relink, Waiting::doorbell}) {
+    double ready = std::numeric_limits<double>::max();
+    double idle = std::numeric_limits<double>::max();
+    for (int r = 0; r < runs; ++r) {
+      ready = std::min(ready, alt_cost(n, true, count, waiting));
+      idle = std::min(idle, alt_cost(n, false, count, waiting));
+    }
+    std::printf(" %10.1f %10.1f", ready, idle);
   }
-  std::printf("%-8zu %10.1f %10.1f\n", n, ready, idle);
+  std::printf("\n");
 }
 
 }  // namespace
@@ -236,7 +243,8 @@ int main(int argc, char** argv) {
   std::printf("%-8s %10s %12s %8s\n", "threads", "csp", "raw boost", "raw/csp");
   for (unsigned threads : {1u, 2u}) print_commstime(threads, cycles, runs);
   std::printf("\nALT on one thread, CPU ns per select + read, best of %d runs\n", runs);
-  std::printf("%-8s %10s %10s\n", "inputs", "ready", "idle");
+  std::printf("%-8s %21s %21s\n", "", "relink", "doorbell");
+  std::printf("%-8s %10s %10s %10s %10s\n", "inputs", "ready", "idle", "ready", "idle");
   for (std::size_t n : {1u, 4u, 16u}) print_alt(n, cycles, runs);
   return 0;
 }

@@ -1,5 +1,7 @@
 // ALT: fairness, priority, boolean guards, timeout, SKIP, poisoned inputs,
-// room guards on buffered outputs.
+// room guards on buffered outputs — each for both ways of waiting (relinking
+// records on every channel, and the doorbell); then what only the doorbell
+// has: one watcher per channel end, released when the ALT goes.
 #include <gtest/gtest.h>
 
 #include <array>
@@ -13,6 +15,8 @@ namespace {
 
 using namespace std::chrono_literals;
 
+class Alt : public ::testing::TestWithParam<csp::Alt::Waiting> {};
+
 // n writers, each writing `count` values of its own index into its channel.
 std::vector<csp::Channel<int>> spawn_writers(csp::Runtime& rt, int n, int count, std::size_t capacity = 0) {
   std::vector<csp::Channel<int>> chans;
@@ -25,14 +29,44 @@ std::vector<csp::Channel<int>> spawn_writers(csp::Runtime& rt, int n, int count,
   return chans;
 }
 
-TEST(Alt, FairSelectStarvesNoGuard) {
+// Moves `count` values from r to w holding at most one, selecting over the
+// input while it holds none and over room in w while it holds one.
+void forward_with_room_guard(csp::In<int> r, csp::Out<int> w, int count, csp::Alt::Waiting waiting) {
+  csp::Alt alt(waiting);
+  const std::size_t input = alt.add_input(r);
+  const std::size_t room = alt.add_room(w);
+  int held = 0;
+  bool holding = false;
+  for (int moved = 0; moved < count;) {
+    alt.enable(input, !holding);
+    alt.enable(room, holding);
+    if (alt.select() == input) {
+      held = r.read();
+      holding = true;
+    }
+    if (w.try_write(held)) {
+      holding = false;
+      ++moved;
+    }
+  }
+}
+
+// Reads `count` values; true if they were 1, 2, ..., count.
+bool reads_one_to_count(csp::In<int> r, int count) {
+  bool ordered = true;
+  for (int k = 1; k <= count; ++k) ordered = r.read() == k && ordered;
+  return ordered;
+}
+
+TEST_P(Alt, FairSelectStarvesNoGuard) {
+  const csp::Alt::Waiting waiting = GetParam();
   constexpr int n = 4;
   constexpr int selections = 10000;
   csp::Runtime rt(1);
   auto chans = spawn_writers(rt, n, selections);  // every writer always ready
   std::array<int, n> chosen{};
   rt.spawn("alt", 0, [&] {
-    csp::Alt alt;
+    csp::Alt alt(waiting);
     std::vector<csp::In<int>> ins;
     for (auto& c : chans) ins.push_back(c.reader());
     for (auto& in : ins) alt.add_input(in);
@@ -47,13 +81,14 @@ TEST(Alt, FairSelectStarvesNoGuard) {
   for (int c : chosen) EXPECT_EQ(c, selections / n);
 }
 
-TEST(Alt, PriSelectPrefersLowestReadyIndex) {
+TEST_P(Alt, PriSelectPrefersLowestReadyIndex) {
+  const csp::Alt::Waiting waiting = GetParam();
   csp::Runtime rt(1);
   auto chans = spawn_writers(rt, 3, 10, 10);
   std::vector<std::size_t> chosen;
   rt.spawn("alt", 0, [&] {
     csp::sleep_for(1ms);  // let every writer fill its buffer
-    csp::Alt alt;
+    csp::Alt alt(waiting);
     std::vector<csp::In<int>> ins;
     for (auto& c : chans) ins.push_back(c.reader());
     for (auto& in : ins) alt.add_input(in);
@@ -68,13 +103,14 @@ TEST(Alt, PriSelectPrefersLowestReadyIndex) {
   EXPECT_EQ(chosen, std::vector<std::size_t>(5, 0));
 }
 
-TEST(Alt, DisabledGuardIsNeverChosen) {
+TEST_P(Alt, DisabledGuardIsNeverChosen) {
+  const csp::Alt::Waiting waiting = GetParam();
   csp::Runtime rt(1);
   auto chans = spawn_writers(rt, 2, 100);
   std::vector<std::size_t> chosen;
   rt.spawn("alt", 0, [&] {
     csp::sleep_for(1ms);
-    csp::Alt alt;
+    csp::Alt alt(waiting);
     auto a = chans[0].reader();
     auto b = chans[1].reader();
     alt.add_input(a);
@@ -91,14 +127,15 @@ TEST(Alt, DisabledGuardIsNeverChosen) {
   EXPECT_EQ(chosen, std::vector<std::size_t>(5, 1));
 }
 
-TEST(Alt, GuardsMayChangeBetweenSelects) {
+TEST_P(Alt, GuardsMayChangeBetweenSelects) {
+  const csp::Alt::Waiting waiting = GetParam();
   csp::Channel<int> a("a", 4);
   csp::Channel<int> b("b", 4);
   for (int i = 0; i < 4; ++i) {
     a.writer().write(i);
     b.writer().write(i);
   }
-  csp::Alt alt;
+  csp::Alt alt(waiting);
   auto ia = a.reader();
   auto ib = b.reader();
   alt.add_input(ia);
@@ -115,19 +152,21 @@ TEST(Alt, GuardsMayChangeBetweenSelects) {
   EXPECT_EQ(alt.pri_select(), skip);
 }
 
-TEST(Alt, AllGuardsDisabledIsAnError) {
+TEST_P(Alt, AllGuardsDisabledIsAnError) {
+  const csp::Alt::Waiting waiting = GetParam();
   csp::Channel<int> c("c");
-  csp::Alt alt;
+  csp::Alt alt(waiting);
   alt.enable(alt.add_input(c.reader()), false);
   EXPECT_THROW(alt.select(), std::logic_error);
 }
 
-TEST(Alt, TimeoutFiresWhenNothingElseIsReady) {
+TEST_P(Alt, TimeoutFiresWhenNothingElseIsReady) {
+  const csp::Alt::Waiting waiting = GetParam();
   csp::Channel<int> c("c");
   std::size_t chosen = 99;
   csp::Runtime rt(1);
   rt.spawn("alt", 0, [&] {
-    csp::Alt alt;
+    csp::Alt alt(waiting);
     alt.add_input(c.reader());
     const std::size_t t = alt.add_timeout(2ms);
     chosen = alt.select();
@@ -137,7 +176,8 @@ TEST(Alt, TimeoutFiresWhenNothingElseIsReady) {
   EXPECT_EQ(chosen, 1u);
 }
 
-TEST(Alt, InputBeatsLaterTimeout) {
+TEST_P(Alt, InputBeatsLaterTimeout) {
+  const csp::Alt::Waiting waiting = GetParam();
   csp::Channel<int> c("c");
   int got = 0;
   csp::Runtime rt(2);
@@ -146,7 +186,7 @@ TEST(Alt, InputBeatsLaterTimeout) {
     out.write(5);
   });
   rt.spawn("alt", 0, [&] {
-    csp::Alt alt;
+    csp::Alt alt(waiting);
     auto in = c.reader();
     alt.add_input(in);
     alt.add_timeout(10s);
@@ -157,21 +197,23 @@ TEST(Alt, InputBeatsLaterTimeout) {
   EXPECT_EQ(got, 5);
 }
 
-TEST(Alt, SkipIsAlwaysReady) {
+TEST_P(Alt, SkipIsAlwaysReady) {
+  const csp::Alt::Waiting waiting = GetParam();
   csp::Channel<int> c("c");
-  csp::Alt alt;
+  csp::Alt alt(waiting);
   alt.add_input(c.reader());
   const std::size_t skip = alt.add_skip();
   EXPECT_EQ(alt.pri_select(), skip);
   EXPECT_EQ(alt.select(), skip);
 }
 
-TEST(Alt, PoisonedInputIsReadyAndItsReadThrows) {
+TEST_P(Alt, PoisonedInputIsReadyAndItsReadThrows) {
+  const csp::Alt::Waiting waiting = GetParam();
   csp::Channel<int> c("c");
   bool threw = false;
   csp::Runtime rt(1);
   rt.spawn("alt", 0, [&] {
-    csp::Alt alt;
+    csp::Alt alt(waiting);
     auto in = c.reader();
     alt.add_input(in);
     ASSERT_EQ(alt.select(), 0u);
@@ -189,7 +231,8 @@ TEST(Alt, PoisonedInputIsReadyAndItsReadThrows) {
   EXPECT_TRUE(threw);
 }
 
-TEST(Alt, BufferedInputWakesParkedAlt) {
+TEST_P(Alt, BufferedInputWakesParkedAlt) {
+  const csp::Alt::Waiting waiting = GetParam();
   csp::Channel<int> a("a", 4);
   csp::Channel<int> b("b");
   int sum = 0;
@@ -198,7 +241,7 @@ TEST(Alt, BufferedInputWakesParkedAlt) {
     for (int i = 1; i <= 100; ++i) out.write(i);
   });
   rt.spawn("alt", 0, [&] {
-    csp::Alt alt;
+    csp::Alt alt(waiting);
     auto ia = a.reader();
     auto ib = b.reader();
     alt.add_input(ib);
@@ -212,7 +255,8 @@ TEST(Alt, BufferedInputWakesParkedAlt) {
   EXPECT_EQ(sum, 5050);
 }
 
-TEST(Alt, CrossThreadStressLosesNothing) {
+TEST_P(Alt, CrossThreadStressLosesNothing) {
+  const csp::Alt::Waiting waiting = GetParam();
   constexpr int writers = 8;
   constexpr int per_writer = 2000;
   std::vector<csp::Channel<int>> chans;
@@ -225,7 +269,7 @@ TEST(Alt, CrossThreadStressLosesNothing) {
     });
   }
   rt.spawn("alt", 0, [&] {
-    csp::Alt alt;
+    csp::Alt alt(waiting);
     std::vector<csp::In<int>> ins;
     for (auto& c : chans) ins.push_back(c.reader());
     for (auto& in : ins) alt.add_input(in);
@@ -241,7 +285,8 @@ TEST(Alt, CrossThreadStressLosesNothing) {
   EXPECT_EQ(sum, long{writers} * per_writer * (per_writer + 1) / 2);
 }
 
-TEST(Alt, RoomGuardFiresOnlyOnceAReaderFreesASlot) {
+TEST_P(Alt, RoomGuardFiresOnlyOnceAReaderFreesASlot) {
+  const csp::Alt::Waiting waiting = GetParam();
   csp::Channel<int> full("full", 2);
   std::vector<std::string> events;
   csp::Runtime rt(1);
@@ -250,7 +295,7 @@ TEST(Alt, RoomGuardFiresOnlyOnceAReaderFreesASlot) {
     out.write(2);
     int three = 3;
     EXPECT_FALSE(out.try_write(three));
-    csp::Alt alt;
+    csp::Alt alt(waiting);
     alt.add_room(out);
     events.push_back("alt waits");
     EXPECT_EQ(alt.select(), 0u);
@@ -270,18 +315,20 @@ TEST(Alt, RoomGuardFiresOnlyOnceAReaderFreesASlot) {
   EXPECT_EQ(events[2], "alt woken");
 }
 
-TEST(Alt, RoomGuardOnAnUnbufferedChannelIsAnError) {
+TEST_P(Alt, RoomGuardOnAnUnbufferedChannelIsAnError) {
+  const csp::Alt::Waiting waiting = GetParam();
   csp::Channel<int> rendezvous("rendezvous");
-  csp::Alt alt;
+  csp::Alt alt(waiting);
   EXPECT_THROW(alt.add_room(rendezvous.writer()), std::logic_error);
 }
 
-TEST(Alt, PoisonedRoomGuardIsReadyAndTheWriteThrows) {
+TEST_P(Alt, PoisonedRoomGuardIsReadyAndTheWriteThrows) {
+  const csp::Alt::Waiting waiting = GetParam();
   csp::Channel<int> full("full", 1);
   csp::Runtime rt(1);
   rt.spawn("alt", 0, [&, out = full.writer()]() mutable {
     out.write(1);
-    csp::Alt alt;
+    csp::Alt alt(waiting);
     alt.add_room(out);
     EXPECT_EQ(alt.select(), 0u);
     EXPECT_THROW(out.write(2), csp::Poisoned);
@@ -296,46 +343,77 @@ TEST(Alt, PoisonedRoomGuardIsReadyAndTheWriteThrows) {
 // A forwarder that never blocks on output, as a router does: it holds back
 // at most one value, reading no input until room for it appears. Across two
 // threads every value arrives once and in order.
-TEST(Alt, ForwarderWithRoomGuardLosesNothingAcrossThreads) {
+TEST_P(Alt, ForwarderWithRoomGuardLosesNothingAcrossThreads) {
+  const csp::Alt::Waiting waiting = GetParam();
   constexpr int count = 20000;
   csp::Channel<int> in("in", 1), out("out", 2);
-  long sum = 0;
-  int last = 0;
-  bool ordered = true;
+  bool ordered = false;
   csp::Runtime rt(2);
   rt.spawn("source", 0, [w = in.writer()]() mutable {
     for (int k = 1; k <= count; ++k) w.write(k);
   });
-  rt.spawn("forwarder", 0, [r = in.reader(), w = out.writer()]() mutable {
-    csp::Alt alt;
-    const std::size_t input = alt.add_input(r);
-    const std::size_t room = alt.add_room(w);
-    int held = 0;
-    bool holding = false;
-    for (int moved = 0; moved < count;) {
-      alt.enable(input, !holding);
-      alt.enable(room, holding);
-      if (alt.select() == input) {
-        held = r.read();
-        holding = true;
-      }
-      if (w.try_write(held)) {
-        holding = false;
-        ++moved;
-      }
-    }
+  rt.spawn("forwarder", 0, [r = in.reader(), w = out.writer(), waiting] {
+    forward_with_room_guard(r, w, count, waiting);
   });
-  rt.spawn("sink", 1, [&, r = out.reader()]() mutable {
-    for (int k = 1; k <= count; ++k) {
-      const int v = r.read();
-      ordered = ordered && v == last + 1;
-      last = v;
-      sum += v;
-    }
-  });
+  rt.spawn("sink", 1, [&ordered, r = out.reader()] { ordered = reads_one_to_count(r, count); });
   rt.run();
   EXPECT_TRUE(ordered);
-  EXPECT_EQ(sum, long{count} * (count + 1) / 2);
+}
+
+INSTANTIATE_TEST_SUITE_P(Waiting, Alt, ::testing::Values(csp::Alt::Waiting::relink, csp::Alt::Waiting::doorbell),
+                         [](const ::testing::TestParamInfo<csp::Alt::Waiting>& info) {
+                           return info.param == csp::Alt::Waiting::relink ? "relink" : "doorbell";
+                         });
+
+TEST(AltDoorbell, OneDoorbellAltPerChannelEnd) {
+  csp::Channel<int> c("c", 1);
+  csp::Alt reader(csp::Alt::Waiting::doorbell);
+  reader.add_input(c.reader());
+  csp::Alt other(csp::Alt::Waiting::doorbell);
+  EXPECT_THROW(other.add_input(c.reader()), std::logic_error);
+  // The other end is free: the writer's ALT may watch for room.
+  csp::Alt writer(csp::Alt::Waiting::doorbell);
+  EXPECT_NO_THROW(writer.add_room(c.writer()));
+  EXPECT_THROW(other.add_room(c.writer()), std::logic_error);
+}
+
+TEST(AltDoorbell, DestroyedAltReleasesItsChannels) {
+  csp::Channel<int> c("c", 2);
+  {
+    csp::Alt gone(csp::Alt::Waiting::doorbell);
+    gone.add_input(c.reader());
+    gone.add_room(c.writer());
+  }
+  // Writes and reads no longer ring the freed bell (ASan checks), and the
+  // ends may be watched again.
+  int v = 1;
+  EXPECT_TRUE(c.writer().try_write(v));
+  EXPECT_EQ(c.reader().read(), 1);
+  csp::Alt again(csp::Alt::Waiting::doorbell);
+  EXPECT_NO_THROW(again.add_input(c.reader()));
+}
+
+// Forwarders in a line, each selecting over its input and the room in its
+// output, on alternating threads: every channel between two of them is
+// watched at both ends, by the bells of two ALTs on different threads.
+TEST(AltDoorbell, LineOfForwardersLosesNothingAcrossThreads) {
+  constexpr int stages = 4;
+  constexpr int count = 20000;
+  std::vector<csp::Channel<int>> links;
+  for (int i = 0; i <= stages; ++i) links.emplace_back("link" + std::to_string(i), 1);
+  bool ordered = false;
+  csp::Runtime rt(2);
+  rt.spawn("source", 0, [w = links[0].writer()]() mutable {
+    for (int k = 1; k <= count; ++k) w.write(k);
+  });
+  for (int i = 0; i < stages; ++i)
+    rt.spawn("forwarder" + std::to_string(i), static_cast<unsigned>(i % 2),
+             [r = links[i].reader(), w = links[i + 1].writer()] {
+               forward_with_room_guard(r, w, count, csp::Alt::Waiting::doorbell);
+             });
+  rt.spawn("sink", 1, [&ordered, r = links[stages].reader()] { ordered = reads_one_to_count(r, count); });
+  rt.run();
+  EXPECT_TRUE(ordered);
 }
 
 }  // namespace

@@ -279,6 +279,34 @@ TEST(Deadlock, DetectedThroughAltAndPar) {
   }
 }
 
+TEST(Deadlock, DetectedThroughDoorbellAlt) {
+  csp::Channel<int> a("a", 1);
+  csp::Channel<int> b("b");
+  csp::Channel<int> c("c");
+  bool unwound = false;
+  csp::Runtime rt(2);
+  rt.spawn("alt", 1, [&] {
+    struct Unwound {
+      bool& flag;
+      ~Unwound() { flag = true; }
+    } guard{unwound};
+    csp::Alt alt(csp::Alt::Waiting::doorbell);
+    alt.add_input(a.reader());
+    alt.add_input(b.reader());
+    alt.select();
+  });
+  rt.spawn("reader", 0, [in = c.reader()]() mutable { in.read(); });
+  try {
+    rt.run();
+    FAIL() << "no deadlock reported";
+  } catch (const csp::Deadlock& e) {
+    const std::string what = e.what();
+    EXPECT_NE(what.find("'alt' (thread 1): in ALT over channels"), std::string::npos) << what;
+    EXPECT_NE(what.find("'a'"), std::string::npos) << what;
+  }
+  EXPECT_TRUE(unwound);
+}
+
 TEST(Deadlock, TimersAreNotMistakenForDeadlock) {
   csp::Channel<int> c("c");
   csp::Channel<int> d("d");
