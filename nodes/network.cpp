@@ -111,7 +111,8 @@ NetworkStats Network::stats() const {
     const RouterCounters& r = *router_counters_[node];
     s.routers.push_back(r);
     s.hops.merge(r.hops);
-    for (const auto& [kind, h] : r.hops_by_kind) s.hops_by_kind[kind].merge(h);
+    for (std::size_t kind = 0; kind < r.hops_by_kind.size(); ++kind)
+      if (r.hops_by_kind[kind].packets) s.hops_by_kind[static_cast<std::uint8_t>(kind)].merge(r.hops_by_kind[kind]);
     s.routes.insert(s.routes.end(), r.routes.begin(), r.routes.end());
     // Link queues come first, classes_ per port, in port order.
     const auto neighbours = topology_.neighbours(node);

@@ -9,7 +9,10 @@
 //                 numbering as inputs), then one delivery queue per local port
 //
 // Protocol: one ALT (fair select) over the inputs and, for every output that
-// a held-back packet waits for, a room guard. A packet read from input i is
+// a held-back packet waits for, a room guard. It is a doorbell ALT
+// (csp/alt.hpp): a router selects for every packet and usually finds nothing
+// ready, so its channels ring it rather than have it link a record on each
+// of them every time it parks. A packet read from input i is
 // written to its output queue at once if that has room (try_write: the router
 // never blocks on output while a neighbour blocks on it); otherwise it waits
 // in pending[i], input i is disabled, and the output's room guard is enabled
@@ -30,8 +33,8 @@
 // cycle through the network with its own injection.
 #pragma once
 
+#include <array>
 #include <cstdint>
-#include <map>
 #include <optional>
 #include <vector>
 
@@ -66,7 +69,7 @@ struct RouterCounters {
   std::uint32_t peak_pending = 0;  // most packets held back at once (outputs full)
   std::vector<LinkCounters> sent;  // per output queue: packets and payload bytes
   HopSummary hops;                 // of packets delivered here
-  std::map<std::uint8_t, HopSummary> hops_by_kind;
+  std::array<HopSummary, 256> hops_by_kind{};  // index = packet kind
   std::vector<RouteRecord> routes;  // traced packets delivered here
 };
 
@@ -110,7 +113,7 @@ class Router {
   std::vector<std::uint32_t> held_for_;          // per output: pending packets waiting for it
   std::uint32_t pending_count_ = 0;
   std::size_t next_admit_ = 0;  // rotates which pending packet is admitted first
-  csp::Alt alt_;
+  csp::Alt alt_{csp::Alt::Waiting::doorbell};
   std::vector<std::size_t> room_guard_, source_guard_;
 };
 
