@@ -298,6 +298,13 @@ bool Tracer::traverse_bvh(const Ray& ray, float t_min, float& t_max_io, Hit* hit
     ++node_reads;
     return fetch(node_pages + static_cast<PageId>(byte >> page_shift), stats) + (byte & offset_mask);
   };
+  // Lane `lane` of a node in a page: its child index and primitive count, met at t.
+  const auto lane_entry = [](const std::byte* at, int lane, float t) {
+    StackEntry e{0, 0, t};
+    std::memcpy(&e.child, at + offsetof(BvhNode, child) + lane * sizeof(std::uint32_t), sizeof e.child);
+    std::memcpy(&e.count, at + offsetof(BvhNode, count) + lane * sizeof(std::uint32_t), sizeof e.count);
+    return e;
+  };
   const auto finish = [&] {
     stats.box_tests += box_tests;
     stats.record_reads += node_reads;
@@ -311,12 +318,9 @@ bool Tracer::traverse_bvh(const Ray& ray, float t_min, float& t_max_io, Hit* hit
     unsigned mask = slab_test4(node, slab_ray, t_min, t_max, t);
     // One inner lane met: go down to it without a stack round trip.
     if (mask && !(mask & (mask - 1))) {
-      const int lane = std::countr_zero(mask);
-      std::uint32_t child, count;
-      std::memcpy(&child, node + offsetof(BvhNode, child) + lane * sizeof(std::uint32_t), sizeof child);
-      std::memcpy(&count, node + offsetof(BvhNode, count) + lane * sizeof(std::uint32_t), sizeof count);
-      if (count == 0) {
-        node = node_at(child);
+      const StackEntry only = lane_entry(node, std::countr_zero(mask), t[std::countr_zero(mask)]);
+      if (only.count == 0) {
+        node = node_at(only.child);
         continue;
       }
     }
@@ -325,9 +329,7 @@ bool Tracer::traverse_bvh(const Ray& ray, float t_min, float& t_max_io, Hit* hit
     const std::size_t base = sp;
     for (; mask; mask &= mask - 1) {
       const int lane = std::countr_zero(mask);
-      StackEntry e{0, 0, t[lane]};
-      std::memcpy(&e.child, node + offsetof(BvhNode, child) + lane * sizeof(std::uint32_t), sizeof e.child);
-      std::memcpy(&e.count, node + offsetof(BvhNode, count) + lane * sizeof(std::uint32_t), sizeof e.count);
+      const StackEntry e = lane_entry(node, lane, t[lane]);
       std::size_t k = sp++;
       if constexpr (!Any)
         for (; k > base && stack[k - 1].t < e.t; --k) stack[k] = stack[k - 1];
