@@ -85,7 +85,7 @@ void Alt::prepare() {
   timeout_guard_ = none;
   has_skip_ = false;
   pollable_.clear();
-  for (std::size_t i = 0; i < guards_.size(); ++i) {
+  for (std::size_t i = 0; bell_ && i < guards_.size(); ++i) {
     const Guard& g = guards_[i];
     if (!g.enabled) continue;
     if (on_channel(g.kind)) pollable_.push_back({i, g.channel.get(), g.kind == Kind::room});

@@ -111,7 +111,7 @@ class Alt {
     detail::ChannelBase* channel;  // null: SKIP or an expired timeout, always ready
     bool room;
   };
-  std::vector<Pollable> pollable_;              // enabled guards that may be ready, by index
+  std::vector<Pollable> pollable_;              // doorbell only: enabled guards that may be ready, by index
   std::unique_ptr<detail::Bell> bell_;          // doorbell waiting only
 };
 
