@@ -14,6 +14,7 @@ ExperimentPoint run_point(const tracer::Database& db, const ExperimentSetup& set
   options.cache_pages = setup.cache_pages;
   options.grain = setup.grain;
   options.prefetch = setup.prefetch;
+  options.schedule = setup.schedule;
   options.timing = setup.model;
   options.trace = setup.trace;
   const nodes::MachineResult result = nodes::run_machine(db, options);

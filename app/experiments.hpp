@@ -25,6 +25,7 @@ struct ExperimentSetup {
   std::optional<std::uint32_t> cache_pages;  // default: the machine's (1/8 of the database)
   std::uint32_t grain = 4;
   std::uint16_t prefetch = 0;  // the paper's protocol: a processor asks for work when idle
+  nodes::Schedule schedule = nodes::Schedule::dynamic;
   nodes::CostModel model = nodes::ipsc2_profile();
   tracer::TraceOptions trace;
 };

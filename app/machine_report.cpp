@@ -112,7 +112,12 @@ void print_machine_report(std::ostream& out, const MachineSummary& m) {
   const nodes::ServerCounters served = r.served();
   out << std::fixed << std::setprecision(1);
   out << "machine        " << r.topology << ": " << r.nodes << " nodes, " << r.workers_per_node
-      << " pixel computer(s) each (prefetch " << r.prefetch << "), " << r.threads << " thread(s), cache "
+      << " pixel computer(s) each (prefetch " << r.prefetch << "), " << nodes::schedule_name(r.schedule)
+      << " schedule";
+  if (r.schedule != nodes::Schedule::static_split) out << " (grain " << r.grain;
+  if (r.schedule == nodes::Schedule::affinity) out << ", " << r.farmer.steals << " steals";
+  if (r.schedule != nodes::Schedule::static_split) out << ")";
+  out << ", " << r.threads << " thread(s), cache "
       << r.cache_pages << " pages (" << double(r.cache_pages) * r.page_size / 1024.0 << " KB) per node\n"
       << std::setprecision(4) << "svm            " << svm.accesses << " page accesses: "
       << svm.own_hits << " local, " << svm.cache_hits << " cache hits, " << svm.misses << " misses (" << svm.coalesced
@@ -140,7 +145,8 @@ void write_machine_json(std::ostream& out, const MachineSummary& m, const std::s
   out << "{\n"
       << in << "\"topology\": " << json_string(r.topology) << ", \"nodes\": " << r.nodes
       << ", \"threads\": " << r.threads << ", \"workers_per_node\": " << r.workers_per_node
-      << ", \"prefetch\": " << r.prefetch << ",\n"
+      << ", \"prefetch\": " << r.prefetch << ", \"schedule\": " << json_string(nodes::schedule_name(r.schedule))
+      << ", \"grain\": " << r.grain << ", \"steals\": " << r.farmer.steals << ",\n"
       << in << "\"cache_pages\": " << r.cache_pages << ", \"cache_kb\": "
       << double(r.cache_pages) * r.page_size / 1024.0 << ", \"database_pages\": " << r.page_count
       << ", \"database_kb\": " << double(r.page_count) * r.page_size / 1024.0 << ",\n"

@@ -63,7 +63,8 @@ po::options_description describe_machine(Options& o, Raw& raw) {
       ("cache-kb", po::value(&raw.cache_kb), "the cache per node in KB instead of pages")
       ("grain", po::value(&raw.grain)->default_value(16), "pixels handed out per work request (a run along a scanline)")
       ("schedule", po::value(&raw.schedule)->default_value("dynamic"),
-       "dynamic (pixels to whoever asks) or static (fixed shares)")
+       "dynamic (pixels in frame order to whoever asks, as in the paper), static (fixed shares), or affinity "
+       "(dynamic, each processor working through its own region first)")
       ("workers-per-node", po::value(&raw.workers)->default_value(1),
        "pixel computers per processor")
       ("prefetch", po::value(&raw.prefetch)->default_value(1),
@@ -137,9 +138,7 @@ void check_machine(Options& o, const Raw& raw, const po::variables_map& vm) {
   m.workers_per_node = in_range<int>(raw.workers, 1, 64, "--workers-per-node");
   m.prefetch = in_range<std::uint16_t>(raw.prefetch, 0, nodes::max_prefetch(m), "--prefetch");
   m.trace_routes = in_range<std::uint64_t>(raw.trace_routes, 0, 1 << 20, "--trace-routes");
-  if (raw.schedule == "dynamic") m.schedule = nodes::Schedule::dynamic;
-  else if (raw.schedule == "static") m.schedule = nodes::Schedule::static_split;
-  else throw UsageError("--schedule: expected dynamic or static, got '" + raw.schedule + "'");
+  m.schedule = parse_schedule(raw.schedule);
   if (raw.distribution == "modulo") m.distribution = nodes::Distribution::modulo;
   else if (raw.distribution == "block") m.distribution = nodes::Distribution::block;
   else throw UsageError("--distribution: expected modulo or block, got '" + raw.distribution + "'");
@@ -158,6 +157,12 @@ tracer::Accel parse_accel(const std::string& name) {
   if (name == "bvh") return tracer::Accel::bvh;
   if (name == "grid") return tracer::Accel::grid;
   throw UsageError("--accel: expected bvh or grid, got '" + name + "'");
+}
+
+nodes::Schedule parse_schedule(const std::string& name) {
+  for (auto schedule : {nodes::Schedule::dynamic, nodes::Schedule::static_split, nodes::Schedule::affinity})
+    if (name == nodes::schedule_name(schedule)) return schedule;
+  throw UsageError("--schedule: expected dynamic, static or affinity, got '" + name + "'");
 }
 
 const char* accel_name(tracer::Accel accel) { return accel == tracer::Accel::bvh ? "bvh" : "grid"; }

@@ -52,6 +52,8 @@ bool parse_shadow_rays(const std::string& policy);
 // --accel: "bvh" or "grid"; UsageError otherwise. accel_name() is the inverse.
 tracer::Accel parse_accel(const std::string& name);
 const char* accel_name(tracer::Accel accel);
+// --schedule: "dynamic", "static" or "affinity"; UsageError otherwise.
+nodes::Schedule parse_schedule(const std::string& name);
 
 // The --help text (options and built-in scenes).
 std::string usage_text();

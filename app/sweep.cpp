@@ -46,7 +46,7 @@ std::vector<std::string> split(const std::string& text) {
 
 struct RawSweep {
   std::string kind, topologies = "hypercube", nodes, cache, profile = "ipsc2", costs, out;
-  std::string accel = "bvh", shadow_rays = "facing";
+  std::string accel = "bvh", shadow_rays = "facing", schedule = "dynamic";
 };
 
 po::options_description describe(SweepOptions& o, RawSweep& raw) {
@@ -61,6 +61,7 @@ po::options_description describe(SweepOptions& o, RawSweep& raw) {
       ("cache-pages", po::value(&raw.cache), "cache sizes in pages, comma-separated (cache: the axis)")
       ("grain", po::value(&o.grain), "pixels per work item (default 4)")
       ("prefetch", po::value(&o.prefetch), "tiles asked for ahead, 0..3 (default 0: ask when idle, as in the paper)")
+      ("schedule", po::value(&raw.schedule), "dynamic (default, as in the paper), static or affinity")
       ("accel", po::value(&raw.accel), "acceleration structure: bvh (default) or grid")
       ("shadow-rays", po::value(&raw.shadow_rays),
        "facing (default): shadow rays only to lights in front of the surface; all: to every light")
@@ -89,6 +90,7 @@ void check_sweep(SweepOptions& o, const RawSweep& raw) {
   else if (o.kind == SweepOptions::Kind::cache) o.cache_pages = {8, 16, 32, 64, 128, 256, 512};
   o.out_dir = raw.out.empty() ? "sweep-" + raw.kind : raw.out;
   o.accel = parse_accel(raw.accel);
+  o.schedule = parse_schedule(raw.schedule);
   o.trace.shadow_rays_to_all_lights = parse_shadow_rays(raw.shadow_rays);
 }
 
@@ -151,9 +153,12 @@ SweepTable run_sweep(const SweepOptions& o, std::ostream* progress) {
   table.page_count = db.header.page_count;
   table.tracing = std::string(accel_name(o.accel)) + ", shadow rays " +
                   (o.trace.shadow_rays_to_all_lights ? "all" : "facing");
+  table.farming = std::string(nodes::schedule_name(o.schedule)) + " schedule, grain " + std::to_string(o.grain) +
+                  ", prefetch " + std::to_string(o.prefetch);
   ExperimentSetup setup;
   setup.grain = o.grain;
   setup.prefetch = o.prefetch;
+  setup.schedule = o.schedule;
   setup.model = o.model;
   setup.trace = o.trace;
   setup.nodes = 1;

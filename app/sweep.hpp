@@ -30,6 +30,7 @@ struct SweepOptions {
   std::vector<std::uint32_t> cache_pages;  // sweep cache: the axis; nodes: the first (empty: default)
   std::uint32_t grain = 4;
   std::uint16_t prefetch = 0;
+  nodes::Schedule schedule = nodes::Schedule::dynamic;
   nodes::CostModel model = nodes::ipsc2_profile();
   tracer::Accel accel = tracer::Accel::bvh;
   tracer::TraceOptions trace;             // --shadow-rays
@@ -44,6 +45,7 @@ struct SweepTable {
   int width = 0, height = 0;
   std::uint32_t page_count = 0;
   std::string tracing;        // "bvh, shadow rays facing": what the counted work was
+  std::string farming;        // "dynamic schedule, grain 4, prefetch 0": how it was handed out
   nodes::CostModel model;
   double serial_seconds = 0;  // T1
   std::vector<ExperimentPoint> points;

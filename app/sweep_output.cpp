@@ -128,7 +128,8 @@ std::string sweep_json(const SweepTable& t) {
   std::ostringstream out;
   out << "{\n  \"sweep\": " << quoted(kind_name(t.kind)) << ",\n  \"scene\": " << quoted(t.scene)
       << ",\n  \"width\": " << t.width << ",\n  \"height\": " << t.height << ",\n  \"pages\": " << t.page_count
-      << ",\n  \"tracing\": " << quoted(t.tracing) << ",\n  \"cost_model\": " << quoted(t.model.describe())
+      << ",\n  \"tracing\": " << quoted(t.tracing) << ",\n  \"farming\": " << quoted(t.farming)
+      << ",\n  \"cost_model\": " << quoted(t.model.describe())
       << ",\n  \"serial_seconds\": "
       << number(t.serial_seconds) << ",\n  \"points\": [";
   for (std::size_t i = 0; i < t.points.size(); ++i) {
@@ -159,7 +160,7 @@ std::vector<std::filesystem::path> write_sweep(const SweepTable& t, const std::f
   }
   viz::Report report{.title = "vmpray sweep " + stem + ": " + t.scene};
   viz::Section section{.heading = t.scene + " at " + std::to_string(t.width) + "x" + std::to_string(t.height) +
-                                  ", " + std::to_string(t.page_count) + " pages, " + t.tracing};
+                                  ", " + std::to_string(t.page_count) + " pages, " + t.tracing + "; " + t.farming};
   section.blocks.push_back(viz::Paragraph{"T1 (one node, same model) = " + paper_duration(t.serial_seconds) +
                                           "; efficiency = T1 / (N * TN)."});
   section.blocks.push_back(html_table(t));

@@ -32,6 +32,7 @@ struct FarmerCounters {
   std::uint64_t items = 0;  // items handed out
   std::uint64_t stops = 0;
   std::uint64_t results = 0;  // result packets passed to the collector
+  std::uint64_t steals = 0;   // affinity schedule: tiles taken from another worker's share
 };
 
 class Farmer {

@@ -258,7 +258,10 @@ MachineResult run_machine(tracer::Database db, const MachineOptions& options) {
   report.page_count = header.page_count;
   report.items = items;
   for (const auto& node : nodes) report.per_node.push_back(node_report(*node));
+  report.schedule = options.schedule;
+  report.grain = options.grain;
   report.farmer = host.farmer;
+  report.farmer.steals = host.plan->steals();
   report.collected = host.frame->received();
   report.owners = std::move(host.owners);
   report.network = net.stats();

@@ -99,6 +99,8 @@ struct MachineReport {
   unsigned threads = 0;
   int workers_per_node = 0;
   std::uint16_t prefetch = 0;
+  Schedule schedule = Schedule::dynamic;
+  std::uint32_t grain = 0;
   std::uint32_t cache_pages = 0;  // requested per node (before capping at remote pages)
   std::uint32_t page_size = 0;
   std::uint32_t page_count = 0;

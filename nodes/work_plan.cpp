@@ -6,11 +6,22 @@
 
 namespace nodes {
 
+const char* schedule_name(Schedule schedule) {
+  switch (schedule) {
+    case Schedule::dynamic: return "dynamic";
+    case Schedule::static_split: return "static";
+    case Schedule::affinity: return "affinity";
+  }
+  return "?";
+}
+
 WorkPlan::WorkPlan(std::uint32_t items, std::uint32_t grain, Schedule schedule, int nodes, int workers_per_node)
     : items_(items), grain_(grain), schedule_(schedule), nodes_(nodes), workers_(workers_per_node) {
   if (grain == 0) throw std::invalid_argument("--grain must be at least 1");
   if (nodes < 1 || workers_per_node < 1) throw std::invalid_argument("work plan needs at least one worker");
-  share_taken_.assign(static_cast<std::size_t>(nodes) * static_cast<std::size_t>(workers_per_node), false);
+  if (schedule == Schedule::dynamic) return;
+  for (int n = 0; n < nodes; ++n)
+    for (int w = 0; w < workers_per_node; ++w) shares_.push_back(static_share(n, w));
 }
 
 std::optional<Tile> WorkPlan::next(int node, int worker) {
@@ -21,14 +32,39 @@ std::optional<Tile> WorkPlan::next(int node, int worker) {
     tile = {cursor_, std::min(grain_, items_ - cursor_)};
     cursor_ += tile.count;
   } else {
-    const auto share = static_cast<std::size_t>(node * workers_ + worker);
-    if (share_taken_[share]) return std::nullopt;
-    share_taken_[share] = true;
-    tile = static_share(node, worker);
+    Tile& share = shares_[static_cast<std::size_t>(node * workers_ + worker)];
+    if (schedule_ == Schedule::static_split) tile = take_front(share, share.count);
+    else if (share.count > 0) tile = take_front(share, affinity_chunk(share.count));
+    else tile = steal();
   }
   if (tile.count == 0) return std::nullopt;
   handed_out_ += tile.count;
   return tile;
+}
+
+std::uint32_t WorkPlan::affinity_chunk(std::uint32_t left) const {
+  const auto parts = static_cast<std::uint32_t>(std::max(shares_.size(), min_affinity_parts));
+  return std::max(grain_, (left + parts - 1) / parts);
+}
+
+Tile WorkPlan::take_front(Tile& share, std::uint32_t most) {
+  const Tile tile{share.first, std::min(most, share.count)};
+  share.first += tile.count;
+  share.count -= tile.count;
+  return tile;
+}
+
+// A chunk off the back of the largest share left (the first such, for
+// determinism): far from where its owner is working, and from the share that
+// would otherwise finish last.
+Tile WorkPlan::steal() {
+  auto victim = std::max_element(shares_.begin(), shares_.end(),
+                                 [](const Tile& a, const Tile& b) { return a.count < b.count; });
+  if (victim->count == 0) return {};
+  const std::uint32_t take = std::min(victim->count, affinity_chunk(victim->count));
+  victim->count -= take;
+  ++steals_;
+  return {victim->first + victim->count, take};
 }
 
 Tile WorkPlan::static_share(int node, int worker) const {

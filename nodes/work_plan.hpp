@@ -6,11 +6,23 @@
 // contiguous range (a compact message) and neighbouring rays along a row
 // touch the same pages, which is what the cache needs.
 //
-// Invariants: every item is handed out exactly once over the plan's life;
-// dynamic hands tiles of `grain` items in order to whoever asks; static gives
-// worker (node, w) one fixed share: the frame in N equal parts, one per
-// processor, each split among its workers; a worker's second request gets
-// nothing.
+// Schedules:
+//  - dynamic: tiles of `grain` items, in frame order, to whoever asks (the
+//    paper's pixel farming);
+//  - static: worker (node, w) gets one fixed share, the frame in N equal
+//    parts, one per processor, each split among its workers; a worker's
+//    second request gets nothing;
+//  - affinity (Markatos and LeBlanc's affinity scheduling): each worker
+//    starts on its static share and takes tiles from its front, each 1/P of
+//    what is left of it (P workers, at least 16 parts, at least `grain`
+//    items), so that a processor's rays stay near each other, its cache
+//    holds their pages, and big early tiles save farming messages; a worker
+//    whose share is used up takes 1/P of the largest share left, from its
+//    back.
+//
+// Invariants: every item is handed out exactly once over the plan's life; a
+// share is always one contiguous run; dynamic tiles are at most `grain`
+// items; the plan's answers depend only on the order of requests.
 #pragma once
 
 #include <cstdint>
@@ -21,7 +33,10 @@
 
 namespace nodes {
 
-enum class Schedule { dynamic, static_split };
+enum class Schedule { dynamic, static_split, affinity };
+
+// The name --schedule takes: dynamic, static or affinity.
+const char* schedule_name(Schedule schedule);
 
 class WorkPlan {
  public:
@@ -32,18 +47,28 @@ class WorkPlan {
 
   std::uint32_t items() const { return items_; }
   std::uint32_t handed_out() const { return handed_out_; }  // items given so far
+  std::uint32_t steals() const { return steals_; }          // affinity: tiles taken from another's share
 
  private:
   Tile static_share(int node, int worker) const;
+  // Affinity tiles are 1/parts of what is left; at least this many parts,
+  // so that a share on a small machine still comes back in pieces the
+  // progress display and the balancing can use.
+  static constexpr std::size_t min_affinity_parts = 16;
+
+  std::uint32_t affinity_chunk(std::uint32_t left) const;
+  Tile take_front(Tile& share, std::uint32_t most);
+  Tile steal();
 
   std::uint32_t items_;
   std::uint32_t grain_;
   Schedule schedule_;
   int nodes_;
   int workers_;
-  std::uint32_t cursor_ = 0;       // dynamic: first item not yet handed out
+  std::uint32_t cursor_ = 0;  // dynamic: first item not yet handed out
   std::uint32_t handed_out_ = 0;
-  std::vector<bool> share_taken_;  // static: per (node, worker)
+  std::uint32_t steals_ = 0;
+  std::vector<Tile> shares_;  // static and affinity: what is left of each worker's run
 };
 
 }  // namespace nodes

@@ -161,6 +161,10 @@ int main(int argc, char** argv) {
       {"  cache = whole database (first-touch misses)",
        [](nodes::MachineOptions& o, const tracer::DatabaseHeader& h) { o.cache_pages = h.page_count; }},
       {"  grain 256", [](nodes::MachineOptions& o, const tracer::DatabaseHeader&) { o.grain = 256; }},
+      {"  affinity schedule",
+       [](nodes::MachineOptions& o, const tracer::DatabaseHeader&) { o.schedule = nodes::Schedule::affinity; }},
+      {"  static schedule (no farming, no balancing)",
+       [](nodes::MachineOptions& o, const tracer::DatabaseHeader&) { o.schedule = nodes::Schedule::static_split; }},
   };
   std::vector<MachineRun> runs(variants.size());
   for (int r = 0; r < repeats; ++r)

@@ -178,6 +178,21 @@ TEST_F(MachineCli, DefaultMachineWritesImageAndJsonWithMachineFields) {
   EXPECT_GE(m["imbalance"]["pixels"].number, 1.0);
   EXPECT_GT(m["network"]["packets"].number, 0);
   EXPECT_EQ(m["serial"].type, Json::Type::null);
+  EXPECT_EQ(m["schedule"].text, "dynamic");
+  EXPECT_EQ(m["grain"].number, 16);
+  EXPECT_EQ(m["steals"].number, 0);
+}
+
+TEST_F(MachineCli, AffinityScheduleIsReportedWithItsSteals) {
+  const Outcome r = run(std::string(kSmall) + " --schedule affinity --grain 4 -o out.png --stats s.json");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_NE(r.out.find("affinity schedule (grain 4, "), std::string::npos) << r.out;
+  const Json j = JsonReader(read_file(dir_ / "s.json")).document();
+  const Json& m = j["machine"];
+  EXPECT_EQ(m["schedule"].text, "affinity");
+  EXPECT_EQ(m["grain"].number, 4);
+  // Nodes whose share is background finish early and take from the others.
+  EXPECT_GT(m["steals"].number, 0);
 }
 
 TEST_F(MachineCli, EveryMachineMakesTheSingleProcessImage) {
@@ -191,6 +206,7 @@ TEST_F(MachineCli, EveryMachineMakesTheSingleProcessImage) {
       "--topology ring --nodes 5 --workers-per-node 2 --page-size 256",
       "--topology torus:4x2 --cache-kb 2 --grain 1 --prefetch 0",
       "--topology hypercube:3 --grain 3 --prefetch 3",
+      "--topology ring:6 --schedule affinity --grain 2 --workers-per-node 2",
       "--topology complete:1",
   };
   for (const std::string& m : machines) {
@@ -293,6 +309,7 @@ TEST(MachineOptions, ValuesReachTheMachine) {
   EXPECT_EQ(o.machine.cache_kb, 8u);
   EXPECT_EQ(o.machine.grain, 9u);
   EXPECT_EQ(o.machine.schedule, nodes::Schedule::static_split);
+  EXPECT_EQ(parse({"--schedule", "affinity"}).machine.schedule, nodes::Schedule::affinity);
   EXPECT_EQ(o.machine.workers_per_node, 3);
   EXPECT_EQ(o.machine.distribution, nodes::Distribution::block);
   EXPECT_EQ(o.machine.trace_routes, 5u);

@@ -57,6 +57,7 @@ TEST(SweepOptions, BadValuesNameTheOption) {
       {{"nodes", "--shadow-rays", "some"}, "--shadow-rays"},
       {{"nodes", "--accel", "kd"}, "--accel"},
       {{"nodes", "--prefetch", "4"}, "--prefetch"},
+      {{"nodes", "--schedule", "guided"}, "--schedule"},
   };
   for (const auto& [args, option] : cases) {
     try {
@@ -101,6 +102,7 @@ TEST(Sweep, NodesSweepWritesWellFormedTablesAndPlots) {
   EXPECT_EQ(std::count(json.begin(), json.end(), '['), std::count(json.begin(), json.end(), ']'));
   EXPECT_NE(json.find("\"efficiency\": 1,"), std::string::npos);
   EXPECT_NE(json.find("\"tracing\": \"bvh, shadow rays facing\""), std::string::npos);
+  EXPECT_NE(json.find("\"farming\": \"dynamic schedule, grain 4, prefetch 0\""), std::string::npos);
   EXPECT_EQ(json.find("nan"), std::string::npos);
 
   const std::string svg_text = read(dir / "nodes.svg");
@@ -121,6 +123,19 @@ TEST(Sweep, ShadowRaysToAllLightsCountMoreRaysAndTakeLonger) {
   EXPECT_GT(all.points[0].rays, facing.points[0].rays);
   EXPECT_GT(all.serial_seconds, facing.serial_seconds);
   EXPECT_EQ(all.tracing, "bvh, shadow rays all");
+}
+
+// The affinity schedule reaches the runs: the same rays, fewer farming
+// messages (its early tiles are larger than the grain).
+TEST(Sweep, AffinityScheduleReachesTheRuns) {
+  auto o = parse({"nodes", "teapot:2", "--size", "24", "--nodes", "4", "--grain", "1"});
+  const app::SweepTable dynamic = app::run_sweep(o, nullptr);
+  o = parse({"nodes", "teapot:2", "--size", "24", "--nodes", "4", "--grain", "1", "--schedule", "affinity"});
+  const app::SweepTable affinity = app::run_sweep(o, nullptr);
+  ASSERT_EQ(affinity.points.size(), 1u);
+  EXPECT_EQ(affinity.points[0].rays, dynamic.points[0].rays);
+  EXPECT_LT(affinity.points[0].messages, dynamic.points[0].messages);
+  EXPECT_EQ(affinity.farming, "affinity schedule, grain 1, prefetch 0");
 }
 
 TEST(Sweep, CacheSweepCountsFewerMissesWithMoreCache) {

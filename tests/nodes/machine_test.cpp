@@ -81,7 +81,7 @@ nodes::MachineResult run_case(const Case& c) {
 std::string describe(const Case& c) {
   return c.topology + " n=" + std::to_string(c.nodes) + " cache=" + std::to_string(c.cache_pages) +
          " page=" + std::to_string(c.page_size) + " grain=" + std::to_string(c.grain) +
-         (c.schedule == Schedule::dynamic ? " dynamic" : " static") + " k=" + std::to_string(c.workers) +
+         " " + nodes::schedule_name(c.schedule) + " k=" + std::to_string(c.workers) +
          " threads=" + std::to_string(c.threads) + " prefetch=" + std::to_string(c.prefetch) + " " + c.scene;
 }
 
@@ -102,6 +102,9 @@ TEST(Machine, ImageIsBitIdenticalToSingleProcessRenderAcrossConfigurations) {
       {"hypercube", 64, 4, 256, 2, Schedule::dynamic, 1, 1},
       {"torus", 64, 1, 1024, 4, Schedule::static_split, 2, 1},
       {"hypercube", 16, 2, 1024, 4, Schedule::dynamic, 2, 1, "balls:1", 24},
+      {"hypercube", 16, 2, 256, 1, Schedule::affinity, 1, 1},
+      {"ring", 5, 1, 1024, 3, Schedule::affinity, 2, 1},
+      {"torus", 64, 3, 1024, 2, Schedule::affinity, 1, 1},
   };
   for (const auto& c : cases) {
     const auto result = run_case(c);
@@ -115,6 +118,7 @@ TEST(Machine, ImageIsBitIdenticalOnTwoThreads) {
       {"hypercube", 2, 1, 256, 1, Schedule::dynamic, 1, 2},
       {"torus", 4, 1, 256, 4, Schedule::dynamic, 3, 2},
       {"mesh", 4, 3, 1024, 4, Schedule::dynamic, 2, 2},
+      {"hypercube", 8, 2, 256, 2, Schedule::affinity, 2, 2},
   };
   for (const auto& c : cases) {
     const auto result = run_case(c);
@@ -161,7 +165,8 @@ TEST(Machine, PrefetchKeepsTheImageAndTheCounts) {
   for (std::uint16_t prefetch = 0; prefetch <= 3; ++prefetch) {
     for (Case c : {Case{"hypercube", 8, 2, 256, 3, Schedule::dynamic, 2, 1},
                    Case{"ring", 5, 1, 1024, 7, Schedule::static_split, 1, 1},
-                   Case{"torus", 4, 1, 256, 4, Schedule::dynamic, 3, 2}}) {
+                   Case{"torus", 4, 1, 256, 4, Schedule::dynamic, 3, 2},
+                   Case{"mesh", 6, 2, 1024, 2, Schedule::affinity, 2, 1}}) {
       c.prefetch = prefetch;
       const auto result = run_case(c);
       const auto& r = result.report;

@@ -55,6 +55,61 @@ TEST(WorkPlan, StaticWithMoreWorkersThanItemsStopsTheIdleOnes) {
   for (int t : times) EXPECT_EQ(t, 1);
 }
 
+// Requests in a fixed pseudo-random order, as the network might deliver them.
+std::vector<int> coverage_shuffled(WorkPlan& plan, int nodes, int workers, unsigned seed) {
+  std::vector<int> times(plan.items(), 0);
+  std::vector<bool> stopped(static_cast<std::size_t>(nodes * workers), false);
+  int running = nodes * workers;
+  while (running > 0) {
+    seed = seed * 1103515245u + 12345u;
+    const int who = static_cast<int>((seed >> 8) % static_cast<unsigned>(nodes * workers));
+    if (stopped[static_cast<std::size_t>(who)]) continue;
+    if (auto tile = plan.next(who / workers, who % workers)) {
+      for (std::uint32_t i = 0; i < tile->count; ++i) ++times[tile->first + i];
+    } else {
+      stopped[static_cast<std::size_t>(who)] = true;
+      --running;
+    }
+  }
+  return times;
+}
+
+TEST(WorkPlan, AffinityHandsEveryItemOnceWhateverTheOrderOfRequests) {
+  for (unsigned seed : {1u, 7u, 99u}) {
+    WorkPlan plan(1000, 3, Schedule::affinity, 5, 2);
+    const auto times = coverage_shuffled(plan, 5, 2, seed);
+    for (std::uint32_t i = 0; i < 1000; ++i) ASSERT_EQ(times[i], 1) << "item " << i << " seed " << seed;
+    EXPECT_EQ(plan.handed_out(), 1000u);
+    EXPECT_GT(plan.steals(), 0u) << seed;
+  }
+}
+
+TEST(WorkPlan, AffinityStartsEachWorkerOnItsOwnShareInShrinkingTiles) {
+  // 16 workers with shares of 100 items: tiles are 1/16 of what is left, at
+  // least the grain.
+  WorkPlan plan(1600, 2, Schedule::affinity, 8, 2);
+  EXPECT_EQ(plan.next(3, 1), (Tile{700, 7}));  // ceil(100 / 16)
+  EXPECT_EQ(plan.next(3, 1), (Tile{707, 6}));  // ceil(93 / 16)
+  EXPECT_EQ(plan.next(0, 0), (Tile{0, 7}));
+  std::uint32_t last = 0;
+  for (auto tile = plan.next(0, 0); tile && tile->first < 100; tile = plan.next(0, 0)) {
+    EXPECT_GE(tile->count, 2u);
+    last = tile->first + tile->count;
+  }
+  EXPECT_EQ(last, 100u);  // worker (0, 0) went through its share in order
+}
+
+TEST(WorkPlan, AffinityStealsFromTheBackOfTheLargestShare) {
+  WorkPlan plan(64, 1, Schedule::affinity, 4, 1);  // shares of 16
+  for (int i = 0; i < 16; ++i) ASSERT_TRUE(plan.next(0, 0));
+  EXPECT_EQ(plan.next(2, 0), (Tile{32, 1}));  // node 2 leaves 15 items in its share
+  // Node 0's share is gone: it takes 1/16 of node 1's (the first of the
+  // largest), from the far end.
+  EXPECT_EQ(plan.next(0, 0), (Tile{31, 1}));
+  EXPECT_EQ(plan.steals(), 1u);
+  EXPECT_EQ(plan.next(1, 0), (Tile{16, 1}));  // node 1 goes on at its front
+}
+
 TEST(WorkPlan, ZeroGrainIsRejectedNamingTheOption) {
   try {
     WorkPlan(10, 0, Schedule::dynamic, 1, 1);
