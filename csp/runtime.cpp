@@ -1,4 +1,4 @@
-// Runtime, par, sleep_for: threads, placement, process lifetime, failures.
+// Runtime, par, sleep_for, yield: threads, placement, process lifetime, failures.
 #include "csp/runtime.hpp"
 
 #include <boost/fiber/fiber.hpp>
@@ -192,11 +192,12 @@ Runtime::~Runtime() = default;
 
 unsigned Runtime::threads() const { return impl_->options.threads; }
 
-void Runtime::spawn(std::string name, unsigned thread, std::function<void()> body) {
+void Runtime::spawn(std::string name, unsigned thread, std::function<void()> body, Priority priority) {
   if (impl_->finished) throw std::logic_error("Runtime::spawn: the run has ended, '" + name + "' cannot start");
   auto p = std::make_shared<Process>();
   p->name = std::move(name);
   p->thread = thread % threads();
+  p->priority = priority;
   p->stack_size = impl_->options.stack_size;
   impl_->tracker.add(*p);
   impl_->post(p->thread, Spawn{p, std::move(body)});
@@ -271,6 +272,7 @@ void par(std::vector<std::function<void()>> processes) {
       child = std::make_shared<Process>();
       child->name = name;
       child->thread = parent->thread;
+      child->priority = parent->priority;
       child->stack_size = parent->stack_size;
       parent->tracker->add(*child);
     }
@@ -296,6 +298,8 @@ void par(std::vector<std::function<void()>> processes) {
 }
 
 void sleep_for(std::chrono::steady_clock::duration d) { boost::this_fiber::sleep_for(d); }
+
+void yield() { boost::this_fiber::yield(); }
 
 const std::string& current_process_name() {
   static const std::string none;

@@ -39,7 +39,7 @@ class Runtime {
 
   unsigned threads() const;
   // Before run(), or from inside a running process. thread is taken modulo threads().
-  void spawn(std::string name, unsigned thread, std::function<void()> body);
+  void spawn(std::string name, unsigned thread, std::function<void()> body, Priority priority = Priority::high);
   // Runs every process to its end; once per Runtime. Rethrows a process's
   // exception (ProcessesFailed if several failed); Poisoned ends a process
   // normally. Throws Deadlock listing the blocked processes.
@@ -56,6 +56,11 @@ void par(std::vector<std::function<void()>> processes);
 
 // Fiber-aware sleep; never counted as blocked by the deadlock detector.
 void sleep_for(std::chrono::steady_clock::duration d);
+
+// Lets the other ready processes of this thread run before the caller goes
+// on (FifoScheduler: every high-priority one, and the low-priority ones
+// queued before it). Never counted as blocked.
+void yield();
 
 // Name of the calling process ("" outside a Runtime).
 const std::string& current_process_name();

@@ -1,32 +1,43 @@
-// FifoScheduler: FIFO ready queue; when idle, a short spin, then a sleep.
+// FifoScheduler: FIFO ready queues, high priority first; when idle, a short
+// spin, then a sleep.
 #include "csp/scheduler.hpp"
 
 #include <utility>
 
 #include <boost/fiber/detail/cpu_relax.hpp>
 
+#include "csp/detail/process.hpp"
+
 namespace csp {
 
-void FifoScheduler::awakened(boost::fibers::context* ctx, ProcessProps&) noexcept {
+// A process's fiber is bound to its record when it first runs, so its first
+// wake-up, at spawn, takes the high-priority queue.
+void FifoScheduler::awakened(boost::fibers::context* ctx, ProcessProps& props) noexcept {
   if (ctx->is_context(boost::fibers::type::dispatcher_context)) {
     dispatcher_ = ctx;
+  } else if (props.process && props.process->priority == Priority::low) {
+    ctx->ready_link(ready_low_);
   } else {
     ctx->ready_link(ready_);
   }
 }
 
 boost::fibers::context* FifoScheduler::pick_next() noexcept {
-  if (dispatcher_ && (ready_.empty() || ++picks_since_dispatch_ >= dispatch_period)) {
+  const bool none_ready = ready_.empty() && ready_low_.empty();
+  if (dispatcher_ && (none_ready || ++picks_since_dispatch_ >= dispatch_period)) {
     picks_since_dispatch_ = 0;
     return std::exchange(dispatcher_, nullptr);
   }
-  if (ready_.empty()) return nullptr;
-  boost::fibers::context* ctx = &ready_.front();
-  ready_.pop_front();
+  if (none_ready) return nullptr;
+  auto& queue = ready_.empty() ? ready_low_ : ready_;
+  boost::fibers::context* ctx = &queue.front();
+  queue.pop_front();
   return ctx;
 }
 
-bool FifoScheduler::has_ready_fibers() const noexcept { return dispatcher_ || !ready_.empty(); }
+bool FifoScheduler::has_ready_fibers() const noexcept {
+  return dispatcher_ || !ready_.empty() || !ready_low_.empty();
+}
 
 // Spins until notified (true), the spin limit or `when`, whichever first.
 // Reads before it claims, so the spinning thread does not keep taking the

@@ -4,8 +4,9 @@
 // SchedulerFactory. A Scheduler is a Boost.Fiber algorithm whose per-fiber
 // properties are ProcessProps, so the runtime can find the process a fiber
 // belongs to (and a virtual-time scheduler can keep a clock per process).
-// FifoScheduler is the default: ready fibers run in FIFO order; when none is
-// ready the thread first spins for a few microseconds watching for notify()
+// FifoScheduler is the default: ready fibers run in FIFO order, those of
+// high-priority processes before any of low priority (as a transputer runs
+// its two priority levels); when none is ready the thread first spins for a few microseconds watching for notify()
 // (a wake from another thread: waking a sleeping thread costs a system call
 // on both sides, several times a message's own cost), then sleeps on a
 // condition variable until notify() or the next timer deadline. Boost's
@@ -34,6 +35,14 @@ namespace detail {
 struct Process;
 }
 
+// A transputer's two levels. A ready high-priority process always runs
+// before a ready low-priority one of the same thread; neither preempts the
+// running process, so a low-priority process that computes for long offers
+// the thread now and then with csp::yield() (runtime.hpp), as the
+// transputer time-slices its low-priority processes. The virtual-time
+// scheduler (virtual_time.hpp) orders by clock alone.
+enum class Priority { high, low };
+
 class ProcessProps : public boost::fibers::fiber_properties {
  public:
   explicit ProcessProps(boost::fibers::context* ctx) : fiber_properties(ctx) {}
@@ -58,7 +67,8 @@ class FifoScheduler final : public Scheduler {
 
   bool spin_until_notified(std::chrono::steady_clock::time_point when) noexcept;
 
-  boost::fibers::scheduler::ready_queue_type ready_;
+  boost::fibers::scheduler::ready_queue_type ready_;      // high priority, and fibers of no process
+  boost::fibers::scheduler::ready_queue_type ready_low_;
   boost::fibers::context* dispatcher_ = nullptr;  // set while it is ready
   unsigned picks_since_dispatch_ = 0;
   std::mutex mutex_;  // orders notify() against the check before sleeping

@@ -22,6 +22,7 @@
 #include <boost/fiber/scheduler.hpp>
 
 #include "csp/detail/wait.hpp"
+#include "csp/scheduler.hpp"
 
 namespace csp::detail {
 
@@ -30,6 +31,7 @@ class Tracker;
 struct Process {
   std::string name;
   unsigned thread = 0;
+  Priority priority = Priority::high;     // its PAR children's too
   Tracker* tracker = nullptr;
   std::size_t stack_size = 256 * 1024;    // for the fibers of its PAR children
   std::atomic<Waiter*> waiting{nullptr};  // published while counted as blocked

@@ -307,6 +307,96 @@ TEST(Deadlock, DetectedThroughDoorbellAlt) {
   EXPECT_TRUE(unwound);
 }
 
+// One thread, so the order of the log is the scheduler's. Each low-priority
+// process yields first: a process's first run, at spawn, is not yet sorted
+// by its priority.
+TEST(Priority, AReadyHighPriorityProcessRunsBeforeQueuedLowPriorityOnes) {
+  csp::Channel<int> c("c", 1);
+  std::vector<std::string> log;
+  csp::Runtime rt(1);
+  rt.spawn("high", 0, [in = c.reader(), &log]() mutable {
+    log.push_back("high waits");
+    in.read();
+    log.push_back("high got");
+  });
+  rt.spawn(
+      "low 1", 0,
+      [out = c.writer(), &log]() mutable {
+        csp::yield();
+        out.write(1);
+        log.push_back("low 1 wrote");
+        csp::yield();
+        log.push_back("low 1 again");
+      },
+      csp::Priority::low);
+  rt.spawn(
+      "low 2", 0,
+      [&log] {
+        csp::yield();
+        log.push_back("low 2");
+      },
+      csp::Priority::low);
+  rt.run();
+  // In plain FIFO order "low 2" would come before "high got".
+  EXPECT_EQ(log, (std::vector<std::string>{"high waits", "low 1 wrote", "high got", "low 2", "low 1 again"}));
+}
+
+TEST(Priority, ParChildrenRunAtTheirParentsPriority) {
+  csp::Channel<int> c("c", 1);
+  std::vector<std::string> log;
+  csp::Runtime rt(1);
+  rt.spawn("high", 0, [in = c.reader(), &log]() mutable {
+    in.read();
+    log.push_back("high got");
+  });
+  rt.spawn(
+      "low", 0,
+      [out = c.writer(), &log]() mutable {
+        csp::par({[&] {
+                    csp::yield();
+                    out.write(1);
+                    log.push_back("a wrote");
+                    csp::yield();
+                    log.push_back("a again");
+                  },
+                  [&] {
+                    csp::yield();
+                    log.push_back("b");
+                  }});
+      },
+      csp::Priority::low);
+  rt.run();
+  // Children at high priority would queue "b" ahead of the reader.
+  EXPECT_EQ(log, (std::vector<std::string>{"a wrote", "high got", "b", "a again"}));
+}
+
+TEST(Priority, LowPriorityProcessesOnTwoThreadsDeliverEverything) {
+  constexpr int count = 2000;
+  csp::Channel<int> c("c", 4);
+  long sum = 0;
+  csp::Runtime rt(2);
+  rt.spawn(
+      "producer", 0,
+      [out = c.writer()]() mutable {
+        for (int i = 1; i <= count; ++i) {
+          out.write(i);
+          if (i % 7 == 0) csp::yield();
+        }
+      },
+      csp::Priority::low);
+  rt.spawn(
+      "consumer", 1,
+      [in = c.reader(), &sum]() mutable {
+        for (int i = 0; i < count; ++i) sum += in.read();
+      },
+      csp::Priority::low);
+  rt.spawn("busy high", 1, [] {
+    for (int i = 0; i < 100; ++i) csp::yield();
+  });
+  rt.run();
+  EXPECT_EQ(sum, long{count} * (count + 1) / 2);
+}
+
 TEST(Deadlock, TimersAreNotMistakenForDeadlock) {
   csp::Channel<int> c("c");
   csp::Channel<int> d("d");
