@@ -72,6 +72,10 @@ std::vector<std::unique_ptr<NodeState>> distribute(tracer::Database& db, const P
 // Results the farmer may pass on before the collector runs.
 constexpr std::size_t results_buffer = 16;
 
+// Pixels a pixel computer traces between two yields: some tens of
+// microseconds of tracing for one context switch.
+constexpr std::uint32_t timeslice_items = 16;
+
 struct Wiring {
   csp::Runtime& runtime;
   Network& net;
@@ -115,12 +119,19 @@ void spawn_node(const Wiring& w, NodeId n, NodeState& node) {
       charge = [&meter] { meter.charge(); };
     }
     SvmSource& source = node.svm->add_worker(std::move(fetch));
-    w.runtime.spawn(name + " pixel computer " + std::to_string(i), thread,
-                    [&w, port, &source, &in, &out, &counters, charge] {
-                      PixelComputer(port, w.options.prefetch, source, w.header, w.options.trace, w.grid, in, out,
-                                    counters, charge)
-                          .run();
-                    });
+    // On one thread nobody waits across threads, and first-in first-out
+    // order lets a router take more packets per wake-up; under virtual time
+    // the scheduler orders by clock.
+    const bool prioritised = !w.timing && w.runtime.threads() > 1;
+    const std::uint32_t timeslice = prioritised ? timeslice_items : 0;
+    w.runtime.spawn(
+        name + " pixel computer " + std::to_string(i), thread,
+        [&w, port, &source, &in, &out, &counters, charge, timeslice] {
+          PixelComputer(port, w.options.prefetch, source, w.header, w.options.trace, w.grid, in, out, counters, charge,
+                        timeslice)
+              .run();
+        },
+        prioritised ? csp::Priority::low : csp::Priority::high);
   }
 }
 

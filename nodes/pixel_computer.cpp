@@ -41,7 +41,8 @@ Packet WorkerPort::page_reply() {
 
 PixelComputer::PixelComputer(std::uint16_t port, std::uint16_t prefetch, SvmSource& source,
                              const tracer::DatabaseHeader& header, tracer::TraceOptions options, ItemGrid grid,
-                             WorkerPort& in, Outbox& out, WorkerCounters& counters, std::function<void()> after_tile)
+                             WorkerPort& in, Outbox& out, WorkerCounters& counters, std::function<void()> after_tile,
+                             std::uint32_t timeslice)
     : port_(port),
       prefetch_(prefetch),
       source_(source),
@@ -50,7 +51,8 @@ PixelComputer::PixelComputer(std::uint16_t port, std::uint16_t prefetch, SvmSour
       in_(in),
       out_(out),
       counters_(counters),
-      after_tile_(std::move(after_tile)) {}
+      after_tile_(std::move(after_tile)),
+      timeslice_(timeslice) {}
 
 void PixelComputer::run() {
   std::uint32_t owed = prefetch_ + 1u;  // answers the farmer still has to send
@@ -78,6 +80,11 @@ void PixelComputer::compute(Tile tile) {
     const int x = item % grid_.width;
     const int y = item / grid_.width;
     colors_[i] = grid_.corners ? tracer_.trace_sample(x, y, counters_.rays) : tracer_.trace_pixel(x, y, counters_.rays);
+    // Between samples: the tracer asks for every page anew at a sample's start.
+    if (timeslice_ > 0 && (i + 1) % timeslice_ == 0) {
+      source_.release();  // another worker of the node may run and evict our page
+      csp::yield();
+    }
   }
   counters_.items += tile.count;
   ++counters_.tiles;

@@ -20,6 +20,11 @@
 // worker traces or sends, at most P answers and one page reply are on their
 // way to the port; the machine keeps that within the network's delivery
 // buffer, so the port drains whenever the worker blocks.
+// On several threads the machine runs pixel computers at low priority and
+// the processes that move messages at high priority, as on a transputer,
+// and a pixel computer yields every `timeslice` items, so that a long run of
+// pixels free of misses does not hold up the routers and page servers of its
+// thread while pixel computers on other threads wait for them.
 #pragma once
 
 #include <cstdint>
@@ -63,7 +68,7 @@ class PixelComputer {
  public:
   PixelComputer(std::uint16_t port, std::uint16_t prefetch, SvmSource& source, const tracer::DatabaseHeader& header,
                 tracer::TraceOptions options, ItemGrid grid, WorkerPort& in, Outbox& out, WorkerCounters& counters,
-                std::function<void()> after_tile = {});
+                std::function<void()> after_tile = {}, std::uint32_t timeslice = 0);
   void run();
 
  private:
@@ -79,6 +84,7 @@ class PixelComputer {
   WorkerCounters& counters_;
   std::vector<tracer::Color> colors_;
   std::function<void()> after_tile_;  // before the result is sent: virtual time charges the work here
+  std::uint32_t timeslice_;           // items traced between two csp::yield()s; 0: never yield
 };
 
 // The miss path of a worker's SvmSource: page_request to the owner, then

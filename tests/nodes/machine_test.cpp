@@ -119,6 +119,9 @@ TEST(Machine, ImageIsBitIdenticalOnTwoThreads) {
       {"torus", 4, 1, 256, 4, Schedule::dynamic, 3, 2},
       {"mesh", 4, 3, 1024, 4, Schedule::dynamic, 2, 2},
       {"hypercube", 8, 2, 256, 2, Schedule::affinity, 2, 2},
+      // Tiles longer than a pixel computer's timeslice: workers yield
+      // mid-tile and share a one-page cache.
+      {"ring", 4, 1, 256, 48, Schedule::dynamic, 3, 2},
   };
   for (const auto& c : cases) {
     const auto result = run_case(c);
