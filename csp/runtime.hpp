@@ -57,9 +57,10 @@ void par(std::vector<std::function<void()>> processes);
 // Fiber-aware sleep; never counted as blocked by the deadlock detector.
 void sleep_for(std::chrono::steady_clock::duration d);
 
-// Lets the other ready processes of this thread run before the caller goes
-// on (FifoScheduler: every high-priority one, and the low-priority ones
-// queued before it). Never counted as blocked.
+// Puts the caller at the back of its thread's ready queue, so that the
+// processes ready before it run first (FifoScheduler: a low-priority caller
+// lets every ready high-priority process run, and the low-priority ones
+// ahead of it). Never counted as blocked.
 void yield();
 
 // Name of the calling process ("" outside a Runtime).

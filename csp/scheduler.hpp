@@ -6,15 +6,16 @@
 // belongs to (and a virtual-time scheduler can keep a clock per process).
 // FifoScheduler is the default: ready fibers run in FIFO order, those of
 // high-priority processes before any of low priority (as a transputer runs
-// its two priority levels); when none is ready the thread first spins for a few microseconds watching for notify()
-// (a wake from another thread: waking a sleeping thread costs a system call
-// on both sides, several times a message's own cost), then sleeps on a
-// condition variable until notify() or the next timer deadline. Boost's
-// dispatcher fiber (which moves timed-out and remotely woken fibers to the
-// ready queue, and reads the clock to do so) is kept aside and run when
-// nothing else is ready or after every `dispatch_period` picks, not once per
-// round of the queue: that bounds the delay of timers and cross-thread wakes
-// while taking the clock read off most context switches.
+// its two priority levels); when none is ready the thread first spins for a
+// few microseconds watching for notify() (a wake from another thread: waking
+// a sleeping thread costs a system call on both sides, several times a
+// message's own cost), then sleeps on a condition variable until notify() or
+// the next timer deadline. Boost's dispatcher fiber (which moves timed-out
+// and remotely woken fibers to the ready queue, and reads the clock to do
+// so) is kept aside and run when nothing else is ready or after every
+// `dispatch_period` picks, not once per round of the queue: that bounds the
+// delay of timers and cross-thread wakes while taking the clock read off
+// most context switches.
 #pragma once
 
 #include <atomic>

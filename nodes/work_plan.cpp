@@ -44,7 +44,7 @@ std::optional<Tile> WorkPlan::next(int node, int worker) {
 
 std::uint32_t WorkPlan::affinity_chunk(std::uint32_t left) const {
   const auto parts = static_cast<std::uint32_t>(std::max(shares_.size(), min_affinity_parts));
-  return std::max(grain_, (left + parts - 1) / parts);
+  return std::max(grain_, static_cast<std::uint32_t>((std::uint64_t{left} + parts - 1) / parts));
 }
 
 Tile WorkPlan::take_front(Tile& share, std::uint32_t most) {
