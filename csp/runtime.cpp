@@ -111,6 +111,8 @@ struct Runtime::Impl {
   explicit Impl(RuntimeOptions o) : options(std::move(o)), tracker([this] { stop_all(); }) {
     if (options.threads == 0) options.threads = std::max(1u, std::thread::hardware_concurrency());
     for (unsigned i = 0; i < options.threads; ++i) workers.push_back(std::make_unique<Worker>());
+    use.resize(options.threads);
+    idle.resize(options.threads);
   }
 
   void post(unsigned thread, Spawn s) {
@@ -134,6 +136,9 @@ struct Runtime::Impl {
 
   RuntimeOptions options;
   std::vector<std::unique_ptr<Worker>> workers;
+  std::vector<ThreadUse> use;  // element i written by thread i only, read after the join
+  // Element i gathered by thread i's FifoScheduler, which may outlive worker_main.
+  std::vector<std::chrono::steady_clock::duration> idle;
   detail::Tracker tracker;
   std::mutex failures_mutex;
   std::vector<Failure> failures;  // guarded by failures_mutex
@@ -142,7 +147,8 @@ struct Runtime::Impl {
 };
 
 void Runtime::Impl::worker_main(unsigned index, std::barrier<>& finished) {
-  Scheduler* algo = options.scheduler ? options.scheduler(index) : new FifoScheduler;
+  const auto started = std::chrono::steady_clock::now();
+  Scheduler* algo = options.scheduler ? options.scheduler(index) : new FifoScheduler(&idle[index]);
   boost::fibers::scheduler* scheduler = boost::fibers::context::active()->get_scheduler();
   scheduler->set_algo(boost::fibers::algo::algorithm::ptr_t(algo));
   detail::set_thread_scheduler(scheduler);
@@ -163,6 +169,8 @@ void Runtime::Impl::worker_main(unsigned index, std::barrier<>& finished) {
     for (Spawn& s : batch) fibers.push_back(launch(std::move(s)));
   }
   for (boost::fibers::fiber& f : fibers) f.join();
+  use[index].seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
+  use[index].idle_seconds = std::chrono::duration<double>(idle[index]).count();
   // A fiber of another thread may still be inside this thread's scheduler,
   // waking it; the scheduler dies with the thread, so wait for every thread
   // to finish its fibers first.
@@ -191,6 +199,8 @@ Runtime::Runtime(RuntimeOptions options) : impl_(std::make_unique<Impl>(std::mov
 Runtime::~Runtime() = default;
 
 unsigned Runtime::threads() const { return impl_->options.threads; }
+
+std::vector<ThreadUse> Runtime::thread_use() const { return impl_->use; }
 
 void Runtime::spawn(std::string name, unsigned thread, std::function<void()> body, Priority priority) {
   if (impl_->finished) throw std::logic_error("Runtime::spawn: the run has ended, '" + name + "' cannot start");

@@ -23,6 +23,12 @@
 
 namespace csp {
 
+// How one runtime thread spent a run.
+struct ThreadUse {
+  double seconds = 0;       // from its start until its last process ended
+  double idle_seconds = 0;  // waiting with no process ready (default scheduler only; 0 under others)
+};
+
 struct RuntimeOptions {
   unsigned threads = 0;                   // 0: std::thread::hardware_concurrency()
   std::size_t stack_size = 256 * 1024;    // bytes per process fiber
@@ -44,6 +50,8 @@ class Runtime {
   // exception (ProcessesFailed if several failed); Poisoned ends a process
   // normally. Throws Deadlock listing the blocked processes.
   void run();
+  // After run(): one entry per thread.
+  std::vector<ThreadUse> thread_use() const;
 
  private:
   struct Impl;

@@ -55,6 +55,13 @@ bool FifoScheduler::spin_until_notified(std::chrono::steady_clock::time_point wh
 }
 
 void FifoScheduler::suspend_until(std::chrono::steady_clock::time_point const& when) noexcept {
+  if (!idle_) return wait_for_notify(when);
+  const auto start = std::chrono::steady_clock::now();
+  wait_for_notify(when);
+  *idle_ += std::chrono::steady_clock::now() - start;
+}
+
+void FifoScheduler::wait_for_notify(std::chrono::steady_clock::time_point when) noexcept {
   if (spin_until_notified(when)) return;
   std::unique_lock<std::mutex> lk(mutex_);
   const auto woken = [this] { return notified_.load(std::memory_order_acquire); };

@@ -56,6 +56,10 @@ using SchedulerFactory = std::function<Scheduler*(unsigned thread)>;
 
 class FifoScheduler final : public Scheduler {
  public:
+  // `idle`, if given, gathers the time the thread waits with nothing to
+  // run; only this thread writes it.
+  explicit FifoScheduler(std::chrono::steady_clock::duration* idle = nullptr) : idle_(idle) {}
+
   void awakened(boost::fibers::context* ctx, ProcessProps& props) noexcept override;
   boost::fibers::context* pick_next() noexcept override;
   bool has_ready_fibers() const noexcept override;
@@ -67,6 +71,7 @@ class FifoScheduler final : public Scheduler {
   static constexpr std::chrono::microseconds spin_limit{50};
 
   bool spin_until_notified(std::chrono::steady_clock::time_point when) noexcept;
+  void wait_for_notify(std::chrono::steady_clock::time_point when) noexcept;
 
   boost::fibers::scheduler::ready_queue_type ready_;      // high priority, and fibers of no process
   boost::fibers::scheduler::ready_queue_type ready_low_;
@@ -75,6 +80,7 @@ class FifoScheduler final : public Scheduler {
   std::mutex mutex_;  // orders notify() against the check before sleeping
   std::condition_variable wakeup_;
   std::atomic<bool> notified_{false};
+  std::chrono::steady_clock::duration* idle_;
 };
 
 }  // namespace csp

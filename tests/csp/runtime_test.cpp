@@ -397,6 +397,34 @@ TEST(Priority, LowPriorityProcessesOnTwoThreadsDeliverEverything) {
   EXPECT_EQ(sum, long{count} * (count + 1) / 2);
 }
 
+// Thread 1 waits 30 ms for thread 0, which computes meanwhile: the waiting
+// shows as idle time on thread 1, the computing as busy time on thread 0.
+TEST(Runtime, ThreadUseCountsTimeWithNothingToRun) {
+  csp::Channel<int> started("started");
+  csp::Channel<int> done("done");
+  csp::Runtime rt(2);
+  rt.spawn("busy", 0, [in = started.reader(), out = done.writer()]() mutable {
+    in.read();
+    const auto until = std::chrono::steady_clock::now() + 30ms;
+    while (std::chrono::steady_clock::now() < until) {
+    }
+    out.write(1);
+  });
+  rt.spawn("waiting", 1, [out = started.writer(), in = done.reader()]() mutable {
+    out.write(1);
+    in.read();
+  });
+  rt.run();
+  const auto use = rt.thread_use();
+  ASSERT_EQ(use.size(), 2u);
+  for (const auto& thread : use) {
+    EXPECT_GE(thread.seconds, 0.03);
+    EXPECT_LE(thread.idle_seconds, thread.seconds);
+  }
+  EXPECT_GE(use[1].idle_seconds, 0.025);
+  EXPECT_LE(use[0].idle_seconds, use[0].seconds - 0.025);
+}
+
 TEST(Deadlock, TimersAreNotMistakenForDeadlock) {
   csp::Channel<int> c("c");
   csp::Channel<int> d("d");
