@@ -129,7 +129,8 @@ void print_machine_report(std::ostream& out, const MachineSummary& m) {
   out << nodes::format_summary(r.network, topology::parse_topology(r.topology), kind_name);
   out << std::setprecision(3) << "wall time      " << r.wall_seconds << " s on " << r.threads
       << " thread(s)";
-  if (!r.cost_model.empty()) out << "; predicted " << r.predicted_seconds << " s (" << r.cost_model << ")";
+  if (r.cost_model.empty()) out << std::setprecision(1) << ", idle " << 100 * r.idle_share() << "% of thread time";
+  else out << "; predicted " << r.predicted_seconds << " s (" << r.cost_model << ")";
   out << "\n";
   if (m.serial)
     out << "speedup        " << m.speedup() << " (1 node: " << m.serial->seconds << " s on "
@@ -164,6 +165,13 @@ void write_machine_json(std::ostream& out, const MachineSummary& m, const std::s
   out << ",\n" << in << "\"routes\": ";
   json_routes(out, r.network);
   out << ",\n" << in << "\"wall_seconds\": " << r.wall_seconds;
+  if (r.cost_model.empty()) {
+    out << ", \"host_threads\": [";
+    for (std::size_t t = 0; t < r.host_threads.size(); ++t)
+      out << (t ? ", " : "") << "{\"seconds\": " << r.host_threads[t].seconds
+          << ", \"idle_seconds\": " << r.host_threads[t].idle_seconds << "}";
+    out << "]";
+  }
   if (!r.cost_model.empty())
     out << ", \"cost_model\": " << json_string(r.cost_model) << ", \"predicted_seconds\": "
         << r.predicted_seconds;

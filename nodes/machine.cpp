@@ -254,6 +254,7 @@ MachineResult run_machine(tracer::Database db, const MachineOptions& options) {
   MachineResult result;
   MachineReport& report = result.report;
   report.wall_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
+  report.host_threads = runtime.thread_use();
   if (timing) {
     report.cost_model = timing->model().describe();
     report.predicted_seconds = timing->predicted_seconds();
@@ -317,6 +318,15 @@ double MachineReport::ray_imbalance() const {
   std::vector<double> v;
   for (const auto& n : per_node) v.push_back(static_cast<double>(n.work.rays.rays()));
   return imbalance(v);
+}
+
+double MachineReport::idle_share() const {
+  double seconds = 0, idle = 0;
+  for (const auto& thread : host_threads) {
+    seconds += thread.seconds;
+    idle += thread.idle_seconds;
+  }
+  return seconds > 0 ? idle / seconds : 0.0;
 }
 
 std::string format_routes(const MachineReport& report) {

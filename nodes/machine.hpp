@@ -106,6 +106,7 @@ struct MachineReport {
   std::uint32_t page_count = 0;
   std::uint64_t items = 0;  // pixels, or SPD corner samples
   double wall_seconds = 0;
+  std::vector<csp::ThreadUse> host_threads;  // how each OS thread spent the run
   std::string cost_model;          // CostModel::describe(), empty without virtual time
   double predicted_seconds = 0;    // virtual time at the end of the run
   double compute_seconds = 0;      // virtual compute time summed over the pixel computers
@@ -122,6 +123,9 @@ struct MachineReport {
   // max / mean over nodes of the items and of the rays each computed.
   double item_imbalance() const;
   double ray_imbalance() const;
+  // Time the OS threads waited with no process ready, over their time (wall
+  // time only: the virtual-time scheduler does not measure it).
+  double idle_share() const;
 };
 
 struct MachineResult {

@@ -181,6 +181,14 @@ TEST_F(MachineCli, DefaultMachineWritesImageAndJsonWithMachineFields) {
   EXPECT_EQ(m["schedule"].text, "dynamic");
   EXPECT_EQ(m["grain"].number, 16);
   EXPECT_EQ(m["steals"].number, 0);
+  ASSERT_EQ(m["host_threads"].items.size(), 2u);
+  for (const Json& t : m["host_threads"].items) {
+    EXPECT_GT(t["seconds"].number, 0);
+    EXPECT_LE(t["seconds"].number, m["wall_seconds"].number);
+    EXPECT_GE(t["idle_seconds"].number, 0);
+    EXPECT_LE(t["idle_seconds"].number, t["seconds"].number);
+  }
+  EXPECT_NE(r.out.find("% of thread time"), std::string::npos) << r.out;
 }
 
 TEST_F(MachineCli, AffinityScheduleIsReportedWithItsSteals) {
