@@ -129,7 +129,8 @@ void print_machine_report(std::ostream& out, const MachineSummary& m) {
   out << nodes::format_summary(r.network, topology::parse_topology(r.topology), kind_name);
   out << std::setprecision(3) << "wall time      " << r.wall_seconds << " s on " << r.threads
       << " thread(s)";
-  if (r.cost_model.empty()) out << std::setprecision(1) << ", idle " << 100 * r.idle_share() << "% of thread time";
+  if (r.cost_model.empty())
+    out << std::setprecision(1) << ", idle " << 100 * r.idle_share() << "% of thread time" << std::setprecision(3);
   else out << "; predicted " << r.predicted_seconds << " s (" << r.cost_model << ")";
   out << "\n";
   if (m.serial)

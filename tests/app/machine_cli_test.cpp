@@ -10,6 +10,7 @@
 #include <fstream>
 #include <map>
 #include <memory>
+#include <regex>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -271,6 +272,8 @@ TEST_F(MachineCli, CompareSerialReportsSpeedupAndEfficiency) {
   const Outcome r = run(std::string(kSmall) + " --nodes 4 --compare-serial -o out.png --stats s.json");
   ASSERT_EQ(r.exit_code, 0) << r.err;
   EXPECT_NE(r.out.find("efficiency"), std::string::npos);
+  // Times, speedup and efficiency keep three decimals after the wall-time line.
+  EXPECT_TRUE(std::regex_search(r.out, std::regex(R"(speedup +\d+\.\d{3} \(1 node: \d+\.\d{3} s)"))) << r.out;
   const Json doc = JsonReader(read_file(dir_ / "s.json")).document();
   const Json& serial = doc["machine"]["serial"];
   ASSERT_EQ(serial.type, Json::Type::object);
