@@ -318,7 +318,8 @@ bool Tracer::traverse_bvh(const Ray& ray, float t_min, float& t_max_io, Hit* hit
     unsigned mask = slab_test4(node, slab_ray, t_min, t_max, t);
     // One inner lane met: go down to it without a stack round trip.
     if (mask && !(mask & (mask - 1))) {
-      const StackEntry only = lane_entry(node, std::countr_zero(mask), t[std::countr_zero(mask)]);
+      const int lane = std::countr_zero(mask);
+      const StackEntry only = lane_entry(node, lane, t[lane]);
       if (only.count == 0) {
         node = node_at(only.child);
         continue;
