@@ -15,6 +15,7 @@ ExperimentPoint run_point(const tracer::Database& db, const ExperimentSetup& set
   options.grain = setup.grain;
   options.prefetch = setup.prefetch;
   options.schedule = setup.schedule;
+  options.pixel_order = setup.pixel_order;
   options.timing = setup.model;
   options.trace = setup.trace;
   const nodes::MachineResult result = nodes::run_machine(db, options);

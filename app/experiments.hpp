@@ -26,6 +26,7 @@ struct ExperimentSetup {
   std::uint32_t grain = 4;
   std::uint16_t prefetch = 0;  // the paper's protocol: a processor asks for work when idle
   nodes::Schedule schedule = nodes::Schedule::dynamic;
+  nodes::PixelOrder pixel_order = nodes::PixelOrder::scanline;
   nodes::CostModel model = nodes::ipsc2_profile();
   tracer::TraceOptions trace;
 };

@@ -117,7 +117,7 @@ void print_machine_report(std::ostream& out, const MachineSummary& m) {
   if (r.schedule != nodes::Schedule::static_split) out << " (grain " << r.grain;
   if (r.schedule == nodes::Schedule::affinity) out << ", " << r.farmer.steals << " steals";
   if (r.schedule != nodes::Schedule::static_split) out << ")";
-  out << ", " << r.threads << " thread(s), cache "
+  out << " in " << nodes::pixel_order_name(r.pixel_order) << " order, " << r.threads << " thread(s), cache "
       << r.cache_pages << " pages (" << double(r.cache_pages) * r.page_size / 1024.0 << " KB) per node\n"
       << std::setprecision(4) << "svm            " << svm.accesses << " page accesses: "
       << svm.own_hits << " local, " << svm.cache_hits << " cache hits, " << svm.misses << " misses (" << svm.coalesced
@@ -148,7 +148,8 @@ void write_machine_json(std::ostream& out, const MachineSummary& m, const std::s
       << in << "\"topology\": " << json_string(r.topology) << ", \"nodes\": " << r.nodes
       << ", \"threads\": " << r.threads << ", \"workers_per_node\": " << r.workers_per_node
       << ", \"prefetch\": " << r.prefetch << ", \"schedule\": " << json_string(nodes::schedule_name(r.schedule))
-      << ", \"grain\": " << r.grain << ", \"steals\": " << r.farmer.steals << ",\n"
+      << ", \"pixel_order\": " << json_string(nodes::pixel_order_name(r.pixel_order)) << ", \"grain\": " << r.grain
+      << ", \"steals\": " << r.farmer.steals << ",\n"
       << in << "\"cache_pages\": " << r.cache_pages << ", \"cache_kb\": "
       << double(r.cache_pages) * r.page_size / 1024.0 << ", \"database_pages\": " << r.page_count
       << ", \"database_kb\": " << double(r.page_count) * r.page_size / 1024.0 << ",\n"

@@ -17,7 +17,7 @@ namespace {
 struct Raw {
   std::string accel, shadow_rays;
   std::int64_t page_size = 0;
-  std::string topology, schedule, distribution;
+  std::string topology, schedule, pixel_order, distribution;
   std::int64_t nodes = 0, threads = 0, cache_pages = 0, cache_kb = 0, grain = 0, workers = 0,
                prefetch = 0, trace_routes = 0;
   TimingChoice timing;
@@ -61,10 +61,14 @@ po::options_description describe_machine(Options& o, Raw& raw) {
       ("cache-pages", po::value(&raw.cache_pages),
        "remote pages cached per node (default: 1/8 of the database)")
       ("cache-kb", po::value(&raw.cache_kb), "the cache per node in KB instead of pages")
-      ("grain", po::value(&raw.grain)->default_value(16), "pixels handed out per work request (a run along a scanline)")
+      ("grain", po::value(&raw.grain)->default_value(16),
+       "pixels handed out per work request (a run of the pixel order)")
       ("schedule", po::value(&raw.schedule)->default_value("dynamic"),
        "dynamic (pixels in frame order to whoever asks, as in the paper), static (fixed shares), or affinity "
        "(dynamic, each processor working through its own region first)")
+      ("pixel-order", po::value(&raw.pixel_order)->default_value("scanline"),
+       "how pixels are numbered, so where a tile or a share lies: scanline (rows, as in the paper) or hilbert "
+       "(along a Hilbert curve: compact patches whose rays share pages)")
       ("workers-per-node", po::value(&raw.workers)->default_value(1),
        "pixel computers per processor")
       ("prefetch", po::value(&raw.prefetch)->default_value(1),
@@ -139,6 +143,7 @@ void check_machine(Options& o, const Raw& raw, const po::variables_map& vm) {
   m.prefetch = in_range<std::uint16_t>(raw.prefetch, 0, nodes::max_prefetch(m), "--prefetch");
   m.trace_routes = in_range<std::uint64_t>(raw.trace_routes, 0, 1 << 20, "--trace-routes");
   m.schedule = parse_schedule(raw.schedule);
+  m.pixel_order = parse_pixel_order(raw.pixel_order);
   if (raw.distribution == "modulo") m.distribution = nodes::Distribution::modulo;
   else if (raw.distribution == "block") m.distribution = nodes::Distribution::block;
   else throw UsageError("--distribution: expected modulo or block, got '" + raw.distribution + "'");
@@ -163,6 +168,12 @@ nodes::Schedule parse_schedule(const std::string& name) {
   for (auto schedule : {nodes::Schedule::dynamic, nodes::Schedule::static_split, nodes::Schedule::affinity})
     if (name == nodes::schedule_name(schedule)) return schedule;
   throw UsageError("--schedule: expected dynamic, static or affinity, got '" + name + "'");
+}
+
+nodes::PixelOrder parse_pixel_order(const std::string& name) {
+  for (auto order : {nodes::PixelOrder::scanline, nodes::PixelOrder::hilbert})
+    if (name == nodes::pixel_order_name(order)) return order;
+  throw UsageError("--pixel-order: expected scanline or hilbert, got '" + name + "'");
 }
 
 const char* accel_name(tracer::Accel accel) { return accel == tracer::Accel::bvh ? "bvh" : "grid"; }

@@ -38,8 +38,8 @@ struct Options {
   // The distributed machine (the default) or the plain in-process renderer.
   bool single = false;
   bool compare_serial = false;  // also run the 1-node machine: speedup, efficiency
-  // Topology, nodes, threads, cache, grain, schedule, workers, distribution and
-  // route tracing; trace and progress are filled in at run time.
+  // Topology, nodes, threads, cache, grain, schedule, pixel order, workers,
+  // distribution and route tracing; trace and progress are filled in at run time.
   nodes::MachineOptions machine;
   PicturePaths pictures;  // written after a machine render (timing_options.hpp)
 };
@@ -54,6 +54,8 @@ tracer::Accel parse_accel(const std::string& name);
 const char* accel_name(tracer::Accel accel);
 // --schedule: "dynamic", "static" or "affinity"; UsageError otherwise.
 nodes::Schedule parse_schedule(const std::string& name);
+// --pixel-order: "scanline" or "hilbert"; UsageError otherwise.
+nodes::PixelOrder parse_pixel_order(const std::string& name);
 
 // The --help text (options and built-in scenes).
 std::string usage_text();

@@ -46,7 +46,7 @@ std::vector<std::string> split(const std::string& text) {
 
 struct RawSweep {
   std::string kind, topologies = "hypercube", nodes, cache, profile = "ipsc2", costs, out;
-  std::string accel = "bvh", shadow_rays = "facing", schedule = "dynamic";
+  std::string accel = "bvh", shadow_rays = "facing", schedule = "dynamic", pixel_order = "scanline";
 };
 
 po::options_description describe(SweepOptions& o, RawSweep& raw) {
@@ -62,6 +62,7 @@ po::options_description describe(SweepOptions& o, RawSweep& raw) {
       ("grain", po::value(&o.grain), "pixels per work item (default 4)")
       ("prefetch", po::value(&o.prefetch), "tiles asked for ahead, 0..3 (default 0: ask when idle, as in the paper)")
       ("schedule", po::value(&raw.schedule), "dynamic (default, as in the paper), static or affinity")
+      ("pixel-order", po::value(&raw.pixel_order), "scanline (default, as in the paper) or hilbert")
       ("accel", po::value(&raw.accel), "acceleration structure: bvh (default) or grid")
       ("shadow-rays", po::value(&raw.shadow_rays),
        "facing (default): shadow rays only to lights in front of the surface; all: to every light")
@@ -91,6 +92,7 @@ void check_sweep(SweepOptions& o, const RawSweep& raw) {
   o.out_dir = raw.out.empty() ? "sweep-" + raw.kind : raw.out;
   o.accel = parse_accel(raw.accel);
   o.schedule = parse_schedule(raw.schedule);
+  o.pixel_order = parse_pixel_order(raw.pixel_order);
   o.trace.shadow_rays_to_all_lights = parse_shadow_rays(raw.shadow_rays);
 }
 
@@ -154,11 +156,13 @@ SweepTable run_sweep(const SweepOptions& o, std::ostream* progress) {
   table.tracing = std::string(accel_name(o.accel)) + ", shadow rays " +
                   (o.trace.shadow_rays_to_all_lights ? "all" : "facing");
   table.farming = std::string(nodes::schedule_name(o.schedule)) + " schedule, grain " + std::to_string(o.grain) +
-                  ", prefetch " + std::to_string(o.prefetch);
+                  ", prefetch " + std::to_string(o.prefetch) + ", " + nodes::pixel_order_name(o.pixel_order) +
+                  " order";
   ExperimentSetup setup;
   setup.grain = o.grain;
   setup.prefetch = o.prefetch;
   setup.schedule = o.schedule;
+  setup.pixel_order = o.pixel_order;
   setup.model = o.model;
   setup.trace = o.trace;
   setup.nodes = 1;

@@ -31,6 +31,7 @@ struct SweepOptions {
   std::uint32_t grain = 4;
   std::uint16_t prefetch = 0;
   nodes::Schedule schedule = nodes::Schedule::dynamic;
+  nodes::PixelOrder pixel_order = nodes::PixelOrder::scanline;
   nodes::CostModel model = nodes::ipsc2_profile();
   tracer::Accel accel = tracer::Accel::bvh;
   tracer::TraceOptions trace;             // --shadow-rays
@@ -45,7 +46,7 @@ struct SweepTable {
   int width = 0, height = 0;
   std::uint32_t page_count = 0;
   std::string tracing;        // "bvh, shadow rays facing": what the counted work was
-  std::string farming;        // "dynamic schedule, grain 4, prefetch 0": how it was handed out
+  std::string farming;        // "dynamic schedule, grain 4, prefetch 0, scanline order": how it was handed out
   nodes::CostModel model;
   double serial_seconds = 0;  // T1
   std::vector<ExperimentPoint> points;

@@ -155,8 +155,18 @@ void spawn_host(const Wiring& w, Host& host) {
   });
 }
 
+// Values per item, in item order, put back in scanline order.
+template <class T>
+std::vector<T> in_scanline_order(const ItemGrid& grid, const std::vector<T>& by_item) {
+  if (grid.positions.empty()) return by_item;
+  std::vector<T> out(by_item.size());
+  for (std::size_t k = 0; k < by_item.size(); ++k) out[grid.positions[k]] = by_item[k];
+  return out;
+}
+
 tracer::Image assemble_image(const tracer::DatabaseHeader& header, const ItemGrid& grid,
-                             const std::vector<tracer::Color>& items) {
+                             const std::vector<tracer::Color>& by_item) {
+  const std::vector<tracer::Color> items = in_scanline_order(grid, by_item);
   const int width = header.camera.width, height = header.camera.height;
   tracer::Image image(width, height);
   for (int y = 0; y < height; ++y)
@@ -238,8 +248,11 @@ MachineResult run_machine(tracer::Database db, const MachineOptions& options) {
   Network net(runtime, topology, net_options);
 
   const bool corners = options.trace.spd_procedure;
-  const ItemGrid grid{header.camera.width + (corners ? 1 : 0), corners};
-  const auto items = static_cast<std::uint32_t>(grid.width) * static_cast<std::uint32_t>(header.camera.height + (corners ? 1 : 0));
+  const int rows = header.camera.height + (corners ? 1 : 0);
+  ItemGrid grid{header.camera.width + (corners ? 1 : 0), corners, {}};
+  const std::vector<std::uint32_t> positions = item_positions(grid.width, rows, options.pixel_order);
+  grid.positions = positions;
+  const auto items = static_cast<std::uint32_t>(grid.width) * static_cast<std::uint32_t>(rows);
   const Wiring wiring{runtime, net, placement, header, options, grid, topology.size() * net_options.ports_per_node,
                       timing ? &*timing : nullptr};
   Host host;
@@ -271,11 +284,12 @@ MachineResult run_machine(tracer::Database db, const MachineOptions& options) {
   report.items = items;
   for (const auto& node : nodes) report.per_node.push_back(node_report(*node));
   report.schedule = options.schedule;
+  report.pixel_order = options.pixel_order;
   report.grain = options.grain;
   report.farmer = host.farmer;
   report.farmer.steals = host.plan->steals();
   report.collected = host.frame->received();
-  report.owners = std::move(host.owners);
+  report.owners = in_scanline_order(grid, host.owners);
   report.network = net.stats();
   result.image = assemble_image(header, grid, host.frame->colors());
   return result;

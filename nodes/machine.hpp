@@ -49,6 +49,7 @@
 #include "nodes/network.hpp"
 #include "nodes/node_memory.hpp"
 #include "nodes/page_server.hpp"
+#include "nodes/pixel_order.hpp"
 #include "nodes/pixel_computer.hpp"
 #include "nodes/svm.hpp"
 #include "nodes/timing.hpp"
@@ -67,6 +68,7 @@ struct MachineOptions {
   std::optional<std::uint64_t> cache_kb;     // the same in KB; default (neither): 1/8 of the database
   std::uint32_t grain = 16;            // items per tile: balance vs farming traffic
   Schedule schedule = Schedule::dynamic;
+  PixelOrder pixel_order = PixelOrder::scanline;  // how items are numbered, so where a tile lies
   int workers_per_node = 1;
   std::uint16_t prefetch = 1;          // tiles a worker has asked for beyond the one it traces
   Distribution distribution = Distribution::modulo;
@@ -100,6 +102,7 @@ struct MachineReport {
   int workers_per_node = 0;
   std::uint16_t prefetch = 0;
   Schedule schedule = Schedule::dynamic;
+  PixelOrder pixel_order = PixelOrder::scanline;
   std::uint32_t grain = 0;
   std::uint32_t cache_pages = 0;  // requested per node (before capping at remote pages)
   std::uint32_t page_size = 0;
@@ -110,7 +113,7 @@ struct MachineReport {
   std::string cost_model;          // CostModel::describe(), empty without virtual time
   double predicted_seconds = 0;    // virtual time at the end of the run
   double compute_seconds = 0;      // virtual compute time summed over the pixel computers
-  std::vector<std::uint16_t> owners;  // per item (pixel or corner sample): the node that computed it
+  std::vector<std::uint16_t> owners;  // per pixel (or corner sample), in scanline order: the node that computed it
   std::vector<NodeReport> per_node;
   FarmerCounters farmer;
   std::uint64_t collected = 0;

@@ -76,9 +76,9 @@ void PixelComputer::run() {
 void PixelComputer::compute(Tile tile) {
   colors_.resize(tile.count);
   for (std::uint32_t i = 0; i < tile.count; ++i) {
-    const auto item = static_cast<int>(tile.first + i);
-    const int x = item % grid_.width;
-    const int y = item / grid_.width;
+    const auto position = static_cast<int>(grid_.position(tile.first + i));
+    const int x = position % grid_.width;
+    const int y = position / grid_.width;
     colors_[i] = grid_.corners ? tracer_.trace_sample(x, y, counters_.rays) : tracer_.trace_pixel(x, y, counters_.rays);
     // Between samples: the tracer asks for every page anew at a sample's start.
     if (timeslice_ > 0 && (i + 1) % timeslice_ == 0) {

@@ -30,6 +30,7 @@
 #include <cstdint>
 #include <deque>
 #include <functional>
+#include <span>
 
 #include "csp/csp.hpp"
 #include "nodes/messages.hpp"
@@ -44,11 +45,14 @@ struct WorkerCounters {
   tracer::RayStats rays;
 };
 
-// What a work item is: a pixel (x, y) in scanline order, or an SPD corner
-// sample on the (W+1) x (H+1) grid.
+// What a work item is: a pixel (x, y), or an SPD corner sample on the
+// (W+1) x (H+1) grid, numbered in the machine's pixel order.
 struct ItemGrid {
   int width = 0;  // items per row
   bool corners = false;
+  std::span<const std::uint32_t> positions;  // item -> scanline position; empty: scanline order
+
+  std::uint32_t position(std::uint32_t item) const { return positions.empty() ? item : positions[item]; }
 };
 
 // A worker's network port, shared by its two readers: the work loop (work

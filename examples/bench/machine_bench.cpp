@@ -4,8 +4,9 @@
 // side by side on the same threads; and the speedup of T threads over 1.
 // Then where the machine's time goes, on 16 nodes and T threads: the same
 // run with the paper's ask-when-idle protocol (prefetch 0), with every cache
-// holding the whole database (no page traffic), and with tiles of 256
-// pixels (little farming traffic).
+// holding the whole database (no page traffic), with tiles of 256 pixels
+// (little farming traffic), with the affinity and static schedules, and
+// with pixels numbered along a Hilbert curve (compact tiles and shares).
 //
 // Every configuration runs REPEATS times, the runs of a comparison
 // interleaved so that load from other work falls on both sides alike; a
@@ -165,6 +166,13 @@ int main(int argc, char** argv) {
        [](nodes::MachineOptions& o, const tracer::DatabaseHeader&) { o.schedule = nodes::Schedule::affinity; }},
       {"  static schedule (no farming, no balancing)",
        [](nodes::MachineOptions& o, const tracer::DatabaseHeader&) { o.schedule = nodes::Schedule::static_split; }},
+      {"  hilbert order",
+       [](nodes::MachineOptions& o, const tracer::DatabaseHeader&) { o.pixel_order = nodes::PixelOrder::hilbert; }},
+      {"  hilbert order, affinity schedule",
+       [](nodes::MachineOptions& o, const tracer::DatabaseHeader&) {
+         o.pixel_order = nodes::PixelOrder::hilbert;
+         o.schedule = nodes::Schedule::affinity;
+       }},
   };
   std::vector<MachineRun> runs(variants.size());
   for (int r = 0; r < repeats; ++r)

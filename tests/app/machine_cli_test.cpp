@@ -180,6 +180,7 @@ TEST_F(MachineCli, DefaultMachineWritesImageAndJsonWithMachineFields) {
   EXPECT_GT(m["network"]["packets"].number, 0);
   EXPECT_EQ(m["serial"].type, Json::Type::null);
   EXPECT_EQ(m["schedule"].text, "dynamic");
+  EXPECT_EQ(m["pixel_order"].text, "scanline");
   EXPECT_EQ(m["grain"].number, 16);
   EXPECT_EQ(m["steals"].number, 0);
   ASSERT_EQ(m["host_threads"].items.size(), 2u);
@@ -204,6 +205,14 @@ TEST_F(MachineCli, AffinityScheduleIsReportedWithItsSteals) {
   EXPECT_GT(m["steals"].number, 0);
 }
 
+TEST_F(MachineCli, HilbertPixelOrderIsReported) {
+  const Outcome r = run(std::string(kSmall) + " --pixel-order hilbert -o out.png --stats s.json");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_NE(r.out.find("dynamic schedule (grain 16) in hilbert order"), std::string::npos) << r.out;
+  const Json j = JsonReader(read_file(dir_ / "s.json")).document();
+  EXPECT_EQ(j["machine"]["pixel_order"].text, "hilbert");
+}
+
 TEST_F(MachineCli, EveryMachineMakesTheSingleProcessImage) {
   const std::string scene = "teapot:2 --width 24 --height 20 --threads 2 -q";
   ASSERT_EQ(run(scene + " --single -o single.ppm").exit_code, 0);
@@ -216,6 +225,8 @@ TEST_F(MachineCli, EveryMachineMakesTheSingleProcessImage) {
       "--topology torus:4x2 --cache-kb 2 --grain 1 --prefetch 0",
       "--topology hypercube:3 --grain 3 --prefetch 3",
       "--topology ring:6 --schedule affinity --grain 2 --workers-per-node 2",
+      "--topology mesh:2x3 --pixel-order hilbert --schedule static --cache-pages 2",
+      "--topology hypercube:2 --pixel-order hilbert --grain 5 --workers-per-node 3",
       "--topology complete:1",
   };
   for (const std::string& m : machines) {
@@ -236,6 +247,7 @@ TEST_F(MachineCli, EachBadInputIsOneLineWithNoOutputFile) {
       {"--topology mesh:4x4 --nodes 8", 2},
       {"--topology star:4", 2},
       {"--schedule random", 2},
+      {"--pixel-order spiral", 2},
       {"--distribution stripes", 2},
       {"--grain 0", 2},
       {"--prefetch 4", 2},
@@ -303,6 +315,7 @@ TEST(MachineOptions, DefaultIsASixteenNodeHypercubeWithTheDefaultCache) {
   EXPECT_FALSE(o.machine.cache_pages);
   EXPECT_FALSE(o.machine.cache_kb);
   EXPECT_EQ(o.machine.schedule, nodes::Schedule::dynamic);
+  EXPECT_EQ(o.machine.pixel_order, nodes::PixelOrder::scanline);
   EXPECT_EQ(o.machine.distribution, nodes::Distribution::modulo);
 }
 
@@ -321,6 +334,7 @@ TEST(MachineOptions, ValuesReachTheMachine) {
   EXPECT_EQ(o.machine.grain, 9u);
   EXPECT_EQ(o.machine.schedule, nodes::Schedule::static_split);
   EXPECT_EQ(parse({"--schedule", "affinity"}).machine.schedule, nodes::Schedule::affinity);
+  EXPECT_EQ(parse({"--pixel-order", "hilbert"}).machine.pixel_order, nodes::PixelOrder::hilbert);
   EXPECT_EQ(o.machine.workers_per_node, 3);
   EXPECT_EQ(o.machine.distribution, nodes::Distribution::block);
   EXPECT_EQ(o.machine.trace_routes, 5u);

@@ -1,6 +1,6 @@
 // End-to-end invariants of the VM_pRAY machine: the image is bit-identical
 // to the single-process render for every topology, size, cache, page size,
-// grain, schedule, worker count and thread count; every pixel is computed
+// grain, schedule, pixel order, worker count and thread count; every pixel is computed
 // once; memory per processor stays within its share plus its cache; misses
 // fall as the cache grows and equal the pages served; bad options fail with
 // one line. Small frames keep the suite quick.
@@ -18,6 +18,7 @@
 namespace {
 
 using nodes::MachineOptions;
+using nodes::PixelOrder;
 using nodes::Schedule;
 
 tracer::Database make_db(const std::string& spec, std::uint32_t page_size, int size) {
@@ -62,6 +63,7 @@ struct Case {
   std::string scene = "teapot:2";
   int size = 24;
   std::uint16_t prefetch = 1;
+  PixelOrder order = PixelOrder::scanline;
 };
 
 nodes::MachineResult run_case(const Case& c) {
@@ -75,6 +77,7 @@ nodes::MachineResult run_case(const Case& c) {
   options.schedule = c.schedule;
   options.workers_per_node = c.workers;
   options.prefetch = c.prefetch;
+  options.pixel_order = c.order;
   return nodes::run_machine(std::move(db), options);
 }
 
@@ -82,7 +85,8 @@ std::string describe(const Case& c) {
   return c.topology + " n=" + std::to_string(c.nodes) + " cache=" + std::to_string(c.cache_pages) +
          " page=" + std::to_string(c.page_size) + " grain=" + std::to_string(c.grain) +
          " " + nodes::schedule_name(c.schedule) + " k=" + std::to_string(c.workers) +
-         " threads=" + std::to_string(c.threads) + " prefetch=" + std::to_string(c.prefetch) + " " + c.scene;
+         " threads=" + std::to_string(c.threads) + " prefetch=" + std::to_string(c.prefetch) + " " + c.scene + " " +
+         nodes::pixel_order_name(c.order);
 }
 
 TEST(Machine, ImageIsBitIdenticalToSingleProcessRenderAcrossConfigurations) {
@@ -105,6 +109,10 @@ TEST(Machine, ImageIsBitIdenticalToSingleProcessRenderAcrossConfigurations) {
       {"hypercube", 16, 2, 256, 1, Schedule::affinity, 1, 1},
       {"ring", 5, 1, 1024, 3, Schedule::affinity, 2, 1},
       {"torus", 64, 3, 1024, 2, Schedule::affinity, 1, 1},
+      {"hypercube", 16, 2, 256, 4, Schedule::dynamic, 1, 1, "teapot:2", 24, 1, PixelOrder::hilbert},
+      {"ring", 5, 1, 1024, 7, Schedule::static_split, 2, 1, "teapot:2", 24, 0, PixelOrder::hilbert},
+      {"mesh", 6, 3, 1024, 3, Schedule::affinity, 1, 1, "teapot:2", 24, 2, PixelOrder::hilbert},
+      {"complete", 3, 1, 1024, 5, Schedule::dynamic, 2, 1, "teapot:2", 23, 1, PixelOrder::hilbert},
   };
   for (const auto& c : cases) {
     const auto result = run_case(c);
@@ -122,6 +130,7 @@ TEST(Machine, ImageIsBitIdenticalOnTwoThreads) {
       // Tiles longer than a pixel computer's timeslice: workers yield
       // mid-tile and share a one-page cache.
       {"ring", 4, 1, 256, 48, Schedule::dynamic, 3, 2},
+      {"torus", 9, 2, 1024, 5, Schedule::affinity, 2, 2, "teapot:2", 24, 1, PixelOrder::hilbert},
   };
   for (const auto& c : cases) {
     const auto result = run_case(c);
@@ -145,6 +154,46 @@ TEST(Machine, SpdProcedureMatchesSingleProcessSpdRender) {
   const auto result = nodes::run_machine(make_db("teapot:2", 1024, 20), options);
   EXPECT_TRUE(same_bits(result.image.pixels(), cached_reference("teapot:2", 20, true)));
   EXPECT_EQ(result.report.items, 21u * 21u);
+}
+
+TEST(Machine, SpdProcedureInHilbertOrderMatchesSingleProcessSpdRender) {
+  MachineOptions options;
+  options.topology = "ring";
+  options.nodes = 3;
+  options.threads = 1;
+  options.cache_pages = 2;
+  options.grain = 5;
+  options.schedule = Schedule::affinity;
+  options.pixel_order = PixelOrder::hilbert;
+  options.trace.spd_procedure = true;
+  const auto result = nodes::run_machine(make_db("teapot:2", 1024, 19), options);
+  EXPECT_TRUE(same_bits(result.image.pixels(), cached_reference("teapot:2", 19, true)));
+  EXPECT_EQ(result.report.items, 20u * 20u);
+  EXPECT_EQ(result.report.pixel_order, PixelOrder::hilbert);
+}
+
+// Static shares of a Hilbert order on a 2^k square frame are its quadrants,
+// and the owners map is in scanline order like the image.
+TEST(Machine, HilbertStaticSharesAreQuadrantsOfTheOwnersMap) {
+  const Case c{"hypercube", 4, 0, 1024, 1, Schedule::static_split, 1, 1, "teapot:2", 32, 1, PixelOrder::hilbert};
+  const auto result = run_case(c);
+  EXPECT_TRUE(same_bits(result.image.pixels(), cached_reference(c.scene, c.size)));
+  const auto& owners = result.report.owners;
+  ASSERT_EQ(owners.size(), 32u * 32u);
+  // The curve runs from (0, 0) to (31, 0): first quadrant, the two far ones, last quadrant.
+  const auto quadrant_node = [](int x, int y) { return x < 16 ? (y < 16 ? 0 : 1) : (y < 16 ? 3 : 2); };
+  for (int y = 0; y < 32; ++y)
+    for (int x = 0; x < 32; ++x) ASSERT_EQ(owners[static_cast<std::size_t>(y * 32 + x)], quadrant_node(x, y)) << x << "," << y;
+}
+
+// Compact patches share pages: with one worker per node and a static share,
+// each node's accesses do not depend on scheduling, so the counts are exact.
+TEST(Machine, HilbertOrderCutsTheMissesOfStaticShares) {
+  Case c{"hypercube", 16, 24, 1024, 16, Schedule::static_split, 1, 1, "teapot:3", 64};
+  const std::uint64_t scanline = run_case(c).report.svm().misses;
+  c.order = PixelOrder::hilbert;
+  const std::uint64_t hilbert = run_case(c).report.svm().misses;
+  EXPECT_LT(hilbert, scanline * 3 / 4) << "scanline " << scanline << ", hilbert " << hilbert;
 }
 
 TEST(Machine, EveryPixelIsComputedExactlyOnce) {
