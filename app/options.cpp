@@ -63,12 +63,12 @@ po::options_description describe_machine(Options& o, Raw& raw) {
       ("cache-kb", po::value(&raw.cache_kb), "the cache per node in KB instead of pages")
       ("grain", po::value(&raw.grain)->default_value(16),
        "pixels handed out per work request (a run of the pixel order)")
-      ("schedule", po::value(&raw.schedule)->default_value("dynamic"),
-       "dynamic (pixels in frame order to whoever asks, as in the paper), static (fixed shares), or affinity "
-       "(dynamic, each processor working through its own region first)")
-      ("pixel-order", po::value(&raw.pixel_order)->default_value("scanline"),
-       "how pixels are numbered, so where a tile or a share lies: scanline (rows, as in the paper) or hilbert "
-       "(along a Hilbert curve: compact patches whose rays share pages)")
+      ("schedule", po::value(&raw.schedule)->default_value("affinity"),
+       "affinity (dynamic, each processor working through its own region first), dynamic (pixels in frame "
+       "order to whoever asks, as in the paper), or static (fixed shares)")
+      ("pixel-order", po::value(&raw.pixel_order)->default_value("hilbert"),
+       "how pixels are numbered, so where a tile or a share lies: hilbert (along a Hilbert curve: compact "
+       "patches whose rays share pages) or scanline (rows, as in the paper)")
       ("workers-per-node", po::value(&raw.workers)->default_value(1),
        "pixel computers per processor")
       ("prefetch", po::value(&raw.prefetch)->default_value(1),

@@ -1,12 +1,12 @@
 // machine_bench: wall time of the VM_pRAY machine (shared virtual memory,
-// dynamic farming, hypercube network) against the same renderer over one
+// farming with the machine's defaults, hypercube network) against the same renderer over one
 // shared in-memory database with plain std::threads pulling rows, measured
 // side by side on the same threads; and the speedup of T threads over 1.
 // Then where the machine's time goes, on 16 nodes and T threads: the same
 // run with the paper's ask-when-idle protocol (prefetch 0), with every cache
 // holding the whole database (no page traffic), with tiles of 256 pixels
-// (little farming traffic), with the affinity and static schedules, and
-// with pixels numbered along a Hilbert curve (compact tiles and shares).
+// (little farming traffic), and with other schedules and pixel orders, down
+// to the paper's farming (dynamic, in scanline order).
 //
 // Every configuration runs REPEATS times, the runs of a comparison
 // interleaved so that load from other work falls on both sides alike; a
@@ -156,23 +156,23 @@ int main(int argc, char** argv) {
   std::printf("where the time goes: hypercube 16, %u threads, against shared memory on %u threads\n", threads,
               threads);
   const std::vector<std::pair<const char*, Variant>> variants{
-      {"  as above (prefetch 1, grain 16)", {}},
+      {"  as above (affinity, hilbert, grain 16)", {}},
       {"  prefetch 0 (ask when idle)",
        [](nodes::MachineOptions& o, const tracer::DatabaseHeader&) { o.prefetch = 0; }},
       {"  cache = whole database (first-touch misses)",
        [](nodes::MachineOptions& o, const tracer::DatabaseHeader& h) { o.cache_pages = h.page_count; }},
       {"  grain 256", [](nodes::MachineOptions& o, const tracer::DatabaseHeader&) { o.grain = 256; }},
-      {"  affinity schedule",
-       [](nodes::MachineOptions& o, const tracer::DatabaseHeader&) { o.schedule = nodes::Schedule::affinity; }},
+      {"  dynamic schedule",
+       [](nodes::MachineOptions& o, const tracer::DatabaseHeader&) { o.schedule = nodes::Schedule::dynamic; }},
+      {"  scanline order",
+       [](nodes::MachineOptions& o, const tracer::DatabaseHeader&) { o.pixel_order = nodes::PixelOrder::scanline; }},
+      {"  dynamic schedule, scanline order (the paper)",
+       [](nodes::MachineOptions& o, const tracer::DatabaseHeader&) {
+         o.schedule = nodes::Schedule::dynamic;
+         o.pixel_order = nodes::PixelOrder::scanline;
+       }},
       {"  static schedule (no farming, no balancing)",
        [](nodes::MachineOptions& o, const tracer::DatabaseHeader&) { o.schedule = nodes::Schedule::static_split; }},
-      {"  hilbert order",
-       [](nodes::MachineOptions& o, const tracer::DatabaseHeader&) { o.pixel_order = nodes::PixelOrder::hilbert; }},
-      {"  hilbert order, affinity schedule",
-       [](nodes::MachineOptions& o, const tracer::DatabaseHeader&) {
-         o.pixel_order = nodes::PixelOrder::hilbert;
-         o.schedule = nodes::Schedule::affinity;
-       }},
   };
   std::vector<MachineRun> runs(variants.size());
   for (int r = 0; r < repeats; ++r)

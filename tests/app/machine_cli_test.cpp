@@ -179,10 +179,9 @@ TEST_F(MachineCli, DefaultMachineWritesImageAndJsonWithMachineFields) {
   EXPECT_GE(m["imbalance"]["pixels"].number, 1.0);
   EXPECT_GT(m["network"]["packets"].number, 0);
   EXPECT_EQ(m["serial"].type, Json::Type::null);
-  EXPECT_EQ(m["schedule"].text, "dynamic");
-  EXPECT_EQ(m["pixel_order"].text, "scanline");
+  EXPECT_EQ(m["schedule"].text, "affinity");
+  EXPECT_EQ(m["pixel_order"].text, "hilbert");
   EXPECT_EQ(m["grain"].number, 16);
-  EXPECT_EQ(m["steals"].number, 0);
   ASSERT_EQ(m["host_threads"].items.size(), 2u);
   for (const Json& t : m["host_threads"].items) {
     EXPECT_GT(t["seconds"].number, 0);
@@ -205,12 +204,14 @@ TEST_F(MachineCli, AffinityScheduleIsReportedWithItsSteals) {
   EXPECT_GT(m["steals"].number, 0);
 }
 
-TEST_F(MachineCli, HilbertPixelOrderIsReported) {
-  const Outcome r = run(std::string(kSmall) + " --pixel-order hilbert -o out.png --stats s.json");
+TEST_F(MachineCli, ThePapersFarmingIsReported) {
+  const Outcome r = run(std::string(kSmall) + " --schedule dynamic --pixel-order scanline -o out.png --stats s.json");
   ASSERT_EQ(r.exit_code, 0) << r.err;
-  EXPECT_NE(r.out.find("dynamic schedule (grain 16) in hilbert order"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("dynamic schedule (grain 16) in scanline order"), std::string::npos) << r.out;
   const Json j = JsonReader(read_file(dir_ / "s.json")).document();
-  EXPECT_EQ(j["machine"]["pixel_order"].text, "hilbert");
+  EXPECT_EQ(j["machine"]["schedule"].text, "dynamic");
+  EXPECT_EQ(j["machine"]["pixel_order"].text, "scanline");
+  EXPECT_EQ(j["machine"]["steals"].number, 0);
 }
 
 TEST_F(MachineCli, EveryMachineMakesTheSingleProcessImage) {
@@ -221,12 +222,12 @@ TEST_F(MachineCli, EveryMachineMakesTheSingleProcessImage) {
   const std::vector<std::string> machines{
       "",
       "--topology mesh:3x3 --cache-pages 1 --grain 7 --schedule static --distribution block",
-      "--topology ring --nodes 5 --workers-per-node 2 --page-size 256",
-      "--topology torus:4x2 --cache-kb 2 --grain 1 --prefetch 0",
-      "--topology hypercube:3 --grain 3 --prefetch 3",
-      "--topology ring:6 --schedule affinity --grain 2 --workers-per-node 2",
-      "--topology mesh:2x3 --pixel-order hilbert --schedule static --cache-pages 2",
-      "--topology hypercube:2 --pixel-order hilbert --grain 5 --workers-per-node 3",
+      "--topology ring --nodes 5 --workers-per-node 2 --page-size 256 --schedule dynamic",
+      "--topology torus:4x2 --cache-kb 2 --grain 1 --prefetch 0 --pixel-order scanline",
+      "--topology hypercube:3 --grain 3 --prefetch 3 --schedule dynamic --pixel-order scanline",
+      "--topology ring:6 --grain 2 --workers-per-node 2 --pixel-order scanline",
+      "--topology mesh:2x3 --schedule static --cache-pages 2",
+      "--topology hypercube:2 --grain 5 --workers-per-node 3",
       "--topology complete:1",
   };
   for (const std::string& m : machines) {
@@ -314,8 +315,8 @@ TEST(MachineOptions, DefaultIsASixteenNodeHypercubeWithTheDefaultCache) {
   EXPECT_EQ(o.machine.nodes, 16u);
   EXPECT_FALSE(o.machine.cache_pages);
   EXPECT_FALSE(o.machine.cache_kb);
-  EXPECT_EQ(o.machine.schedule, nodes::Schedule::dynamic);
-  EXPECT_EQ(o.machine.pixel_order, nodes::PixelOrder::scanline);
+  EXPECT_EQ(o.machine.schedule, nodes::Schedule::affinity);
+  EXPECT_EQ(o.machine.pixel_order, nodes::PixelOrder::hilbert);
   EXPECT_EQ(o.machine.distribution, nodes::Distribution::modulo);
 }
 
@@ -334,7 +335,8 @@ TEST(MachineOptions, ValuesReachTheMachine) {
   EXPECT_EQ(o.machine.grain, 9u);
   EXPECT_EQ(o.machine.schedule, nodes::Schedule::static_split);
   EXPECT_EQ(parse({"--schedule", "affinity"}).machine.schedule, nodes::Schedule::affinity);
-  EXPECT_EQ(parse({"--pixel-order", "hilbert"}).machine.pixel_order, nodes::PixelOrder::hilbert);
+  EXPECT_EQ(parse({"--pixel-order", "scanline"}).machine.pixel_order, nodes::PixelOrder::scanline);
+  EXPECT_EQ(parse({"--schedule", "dynamic"}).machine.schedule, nodes::Schedule::dynamic);
   EXPECT_EQ(o.machine.workers_per_node, 3);
   EXPECT_EQ(o.machine.distribution, nodes::Distribution::block);
   EXPECT_EQ(o.machine.trace_routes, 5u);
