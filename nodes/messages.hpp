@@ -61,8 +61,8 @@ struct Ports {
   }
 };
 
-// A contiguous run of work items (pixels or SPD corner samples) in scanline
-// order: items first .. first + count - 1.
+// A contiguous run of work items (pixels or SPD corner samples) in the
+// machine's pixel order: items first .. first + count - 1.
 struct Tile {
   std::uint32_t first = 0;
   std::uint32_t count = 0;

@@ -1,10 +1,10 @@
 // How the farmer cuts the frame into work: a pure, deterministic plan of
-// tiles (contiguous runs of items in scanline order), with no fibers.
+// tiles (contiguous runs of item numbers), with no fibers.
 //
-// Items are pixels, or SPD corner samples in SPD procedure mode. A tile is a
-// run along the scanline rather than a square because its result is one
-// contiguous range (a compact message) and neighbouring rays along a row
-// touch the same pages, which is what the cache needs.
+// Items are pixels, or SPD corner samples in SPD procedure mode, numbered in
+// the machine's pixel order (pixel_order.hpp). A tile is a run of numbers
+// so that its result is one contiguous range (a compact message); the order
+// decides whether that run is a piece of a row or a compact patch.
 //
 // Schedules:
 //  - dynamic: tiles of `grain` items, in frame order, to whoever asks (the
