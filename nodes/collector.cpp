@@ -1,7 +1,6 @@
 // Frame collector process (see collector.hpp).
 #include "nodes/collector.hpp"
 
-#include <algorithm>
 #include <stdexcept>
 #include <string>
 
@@ -18,7 +17,8 @@ void Collector::run() {
     const ResultView result = decode_result(packet.payload);
     frame_.add(result);
     if (owners_)
-      std::fill_n(owners_->begin() + result.tile.first, result.tile.count, static_cast<std::uint16_t>(packet.source));
+      for (std::uint32_t i = 0; i < result.tile.count; ++i)
+        (*owners_)[frame_.position(result.tile.first + i)] = static_cast<std::uint16_t>(packet.source);
     if (progress_) progress_(frame_.received(), frame_.items());
   }
 }

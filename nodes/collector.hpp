@@ -20,7 +20,8 @@ using Progress = std::function<void(std::uint64_t done, std::uint64_t total)>;
 
 class Collector {
  public:
-  // owners, if given (one entry per item, in item order), receives the node that computed each item.
+  // owners, if given (one entry per item, in scanline order like the frame), receives the node that
+  // computed each item.
   Collector(FrameAssembler& frame, csp::In<Packet> in, Progress progress, std::vector<std::uint16_t>* owners = nullptr);
   void run();
 

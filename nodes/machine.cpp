@@ -34,7 +34,7 @@ struct Host {
   std::unique_ptr<Mailbox> mailbox;
   std::unique_ptr<csp::Channel<Packet>> results;  // farmer -> collector
   FarmerCounters farmer;
-  std::vector<std::uint16_t> owners;  // per item, filled by the collector
+  std::vector<std::uint16_t> owners;  // per pixel or corner sample in scanline order, filled by the collector
 };
 
 void validate(const MachineOptions& options) {
@@ -155,18 +155,9 @@ void spawn_host(const Wiring& w, Host& host) {
   });
 }
 
-// Values per item, in item order, put back in scanline order.
-template <class T>
-std::vector<T> in_scanline_order(const ItemGrid& grid, const std::vector<T>& by_item) {
-  if (grid.positions.empty()) return by_item;
-  std::vector<T> out(by_item.size());
-  for (std::size_t k = 0; k < by_item.size(); ++k) out[grid.positions[k]] = by_item[k];
-  return out;
-}
-
+// items: every pixel or corner sample, in scanline order.
 tracer::Image assemble_image(const tracer::DatabaseHeader& header, const ItemGrid& grid,
-                             const std::vector<tracer::Color>& by_item) {
-  const std::vector<tracer::Color> items = in_scanline_order(grid, by_item);
+                             const std::vector<tracer::Color>& items) {
   const int width = header.camera.width, height = header.camera.height;
   tracer::Image image(width, height);
   for (int y = 0; y < height; ++y)
@@ -258,7 +249,7 @@ MachineResult run_machine(tracer::Database db, const MachineOptions& options) {
   Host host;
   host.plan = std::make_unique<WorkPlan>(items, options.grain, options.schedule, static_cast<int>(topology.size()),
                                          options.workers_per_node);
-  host.frame = std::make_unique<FrameAssembler>(items);
+  host.frame = std::make_unique<FrameAssembler>(items, grid.positions);
   host.owners.assign(items, 0);
   for (std::size_t n = 0; n < nodes.size(); ++n) spawn_node(wiring, static_cast<NodeId>(n), *nodes[n]);
   spawn_host(wiring, host);
@@ -289,7 +280,7 @@ MachineResult run_machine(tracer::Database db, const MachineOptions& options) {
   report.farmer = host.farmer;
   report.farmer.steals = host.plan->steals();
   report.collected = host.frame->received();
-  report.owners = in_scanline_order(grid, host.owners);
+  report.owners = std::move(host.owners);
   report.network = net.stats();
   result.image = assemble_image(header, grid, host.frame->colors());
   return result;

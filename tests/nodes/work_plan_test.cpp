@@ -132,6 +132,24 @@ TEST(FrameAssembler, StoresColoursBitExactAndRejectsDuplicates) {
   EXPECT_THROW(frame.add(nodes::decode_result(beyond)), std::logic_error);
 }
 
+TEST(FrameAssembler, PutsItemsOfAPixelOrderInTheirScanlinePlaces) {
+  const std::vector<std::uint32_t> positions{2, 0, 3, 1};  // item k lies at scanline position positions[k]
+  nodes::FrameAssembler frame(4, positions);
+  const std::vector<tracer::Color> colors{{1, 0, 0}, {0, 1, 0}, {0, 0, 1}};
+  frame.add(nodes::decode_result(nodes::encode_result(5, {0, 3}, colors)));
+  EXPECT_EQ(frame.colors()[2], colors[0]);
+  EXPECT_EQ(frame.colors()[0], colors[1]);
+  EXPECT_EQ(frame.colors()[3], colors[2]);
+  EXPECT_FALSE(frame.complete());
+  // Item 1 again: a duplicate, though scanline position 1 is still empty.
+  const std::vector<tracer::Color> one{colors[0]};
+  EXPECT_THROW(frame.add(nodes::decode_result(nodes::encode_result(5, {1, 1}, one))), std::logic_error);
+  frame.add(nodes::decode_result(nodes::encode_result(5, {3, 1}, one)));
+  EXPECT_EQ(frame.colors()[1], colors[0]);
+  EXPECT_TRUE(frame.complete());
+  EXPECT_THROW(nodes::FrameAssembler(5, positions), std::logic_error);
+}
+
 TEST(Messages, PayloadsRoundTrip) {
   const auto work_request = nodes::decode_work_request(nodes::encode_work_request({7, 3}));
   EXPECT_EQ(work_request.reply_port, 7);
