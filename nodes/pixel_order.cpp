@@ -63,7 +63,9 @@ class HilbertWalk {
   }
 
  private:
-  void emit(int x, int y) { out_.push_back(static_cast<std::uint32_t>(y) * static_cast<std::uint32_t>(width_) + static_cast<std::uint32_t>(x)); }
+  void emit(int x, int y) {
+    out_.push_back(static_cast<std::uint32_t>(y) * static_cast<std::uint32_t>(width_) + static_cast<std::uint32_t>(x));
+  }
 
   int width_;
   std::vector<std::uint32_t>& out_;
@@ -73,7 +75,8 @@ class HilbertWalk {
 
 std::vector<std::uint32_t> item_positions(int width, int height, PixelOrder order) {
   if (width <= 0 || height <= 0)
-    throw std::invalid_argument("pixel order: empty " + std::to_string(width) + "x" + std::to_string(height) + " frame");
+    throw std::invalid_argument("pixel order: empty " + std::to_string(width) + "x" + std::to_string(height) +
+                                " frame");
   std::vector<std::uint32_t> positions;
   if (order == PixelOrder::scanline) return positions;
   positions.reserve(static_cast<std::size_t>(width) * static_cast<std::size_t>(height));

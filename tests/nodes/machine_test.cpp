@@ -183,7 +183,8 @@ TEST(Machine, HilbertStaticSharesAreQuadrantsOfTheOwnersMap) {
   // The curve runs from (0, 0) to (31, 0): first quadrant, the two far ones, last quadrant.
   const auto quadrant_node = [](int x, int y) { return x < 16 ? (y < 16 ? 0 : 1) : (y < 16 ? 3 : 2); };
   for (int y = 0; y < 32; ++y)
-    for (int x = 0; x < 32; ++x) ASSERT_EQ(owners[static_cast<std::size_t>(y * 32 + x)], quadrant_node(x, y)) << x << "," << y;
+    for (int x = 0; x < 32; ++x)
+      ASSERT_EQ(owners[static_cast<std::size_t>(y * 32 + x)], quadrant_node(x, y)) << x << "," << y;
 }
 
 // Compact patches share pages: with one worker per node and a static share,
