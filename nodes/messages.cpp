@@ -5,6 +5,7 @@
 #include <cstring>
 #include <stdexcept>
 #include <string>
+#include <type_traits>
 
 namespace nodes {
 
@@ -29,6 +30,8 @@ T get(std::span<const std::byte> in, std::size_t at, const char* what) {
 constexpr std::size_t tile_bytes = 2 * sizeof(std::uint32_t);
 constexpr std::size_t result_header_bytes = sizeof(std::uint16_t) + tile_bytes;
 constexpr std::size_t color_bytes = 3 * sizeof(float);
+static_assert(sizeof(tracer::Color) == color_bytes && std::is_trivially_copyable_v<tracer::Color>,
+              "a result's colours are copied as raw r, g, b floats");
 
 }  // namespace
 
@@ -86,11 +89,9 @@ std::vector<std::byte> encode_result(std::uint16_t reply_port, Tile tile, std::s
   put(out, reply_port);
   put(out, tile.first);
   put(out, tile.count);
-  for (const auto& c : colors) {
-    put(out, c.r);
-    put(out, c.g);
-    put(out, c.b);
-  }
+  // A Color is exactly its three floats (see color_bytes), so the run copies as one block.
+  out.resize(result_header_bytes + colors.size() * color_bytes);
+  if (!colors.empty()) std::memcpy(out.data() + result_header_bytes, colors.data(), colors.size() * color_bytes);
   return out;
 }
 
