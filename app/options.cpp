@@ -62,7 +62,7 @@ po::options_description describe_machine(Options& o, Raw& raw) {
        "remote pages cached per node (default: 1/8 of the database)")
       ("cache-kb", po::value(&raw.cache_kb), "the cache per node in KB instead of pages")
       ("grain", po::value(&raw.grain)->default_value(16),
-       "pixels handed out per work request (a run of the pixel order)")
+       "pixels per tile handed out (affinity: the smallest tile), a run of the pixel order")
       ("schedule", po::value(&raw.schedule)->default_value("affinity"),
        "affinity (dynamic, each processor working through its own region first), dynamic (pixels in frame "
        "order to whoever asks, as in the paper), or static (fixed shares)")
