@@ -64,6 +64,7 @@ struct Case {
   int size = 24;
   std::uint16_t prefetch = 1;
   PixelOrder order = PixelOrder::scanline;
+  bool spd = false;  // SPD procedure: items are the (size + 1)^2 pixel corners
 };
 
 nodes::MachineResult run_case(const Case& c) {
@@ -78,6 +79,7 @@ nodes::MachineResult run_case(const Case& c) {
   options.workers_per_node = c.workers;
   options.prefetch = c.prefetch;
   options.pixel_order = c.order;
+  options.trace.spd_procedure = c.spd;
   return nodes::run_machine(std::move(db), options);
 }
 
@@ -86,7 +88,7 @@ std::string describe(const Case& c) {
          " page=" + std::to_string(c.page_size) + " grain=" + std::to_string(c.grain) +
          " " + nodes::schedule_name(c.schedule) + " k=" + std::to_string(c.workers) +
          " threads=" + std::to_string(c.threads) + " prefetch=" + std::to_string(c.prefetch) + " " + c.scene + " " +
-         nodes::pixel_order_name(c.order);
+         nodes::pixel_order_name(c.order) + (c.spd ? " spd" : "");
 }
 
 TEST(Machine, ImageIsBitIdenticalToSingleProcessRenderAcrossConfigurations) {
@@ -144,32 +146,17 @@ TEST(Machine, ImageIsBitIdenticalOn256Nodes) {
 }
 
 TEST(Machine, SpdProcedureMatchesSingleProcessSpdRender) {
-  MachineOptions options;
-  options.topology = "mesh";
-  options.nodes = 4;
-  options.threads = 1;
-  options.cache_pages = 3;
-  options.workers_per_node = 2;
-  options.trace.spd_procedure = true;
-  const auto result = nodes::run_machine(make_db("teapot:2", 1024, 20), options);
-  EXPECT_TRUE(same_bits(result.image.pixels(), cached_reference("teapot:2", 20, true)));
-  EXPECT_EQ(result.report.items, 21u * 21u);
-}
-
-TEST(Machine, SpdProcedureInHilbertOrderMatchesSingleProcessSpdRender) {
-  MachineOptions options;
-  options.topology = "ring";
-  options.nodes = 3;
-  options.threads = 1;
-  options.cache_pages = 2;
-  options.grain = 5;
-  options.schedule = Schedule::affinity;
-  options.pixel_order = PixelOrder::hilbert;
-  options.trace.spd_procedure = true;
-  const auto result = nodes::run_machine(make_db("teapot:2", 1024, 19), options);
-  EXPECT_TRUE(same_bits(result.image.pixels(), cached_reference("teapot:2", 19, true)));
-  EXPECT_EQ(result.report.items, 20u * 20u);
-  EXPECT_EQ(result.report.pixel_order, PixelOrder::hilbert);
+  const std::vector<Case> cases{
+      {"mesh", 4, 3, 1024, 16, Schedule::dynamic, 2, 1, "teapot:2", 20, 1, PixelOrder::scanline, true},
+      {"ring", 3, 2, 1024, 5, Schedule::affinity, 1, 1, "teapot:2", 19, 1, PixelOrder::hilbert, true},
+  };
+  for (const Case& c : cases) {
+    const auto result = run_case(c);
+    EXPECT_TRUE(same_bits(result.image.pixels(), cached_reference(c.scene, c.size, true))) << describe(c);
+    const auto corners = static_cast<std::uint64_t>(c.size + 1) * static_cast<std::uint64_t>(c.size + 1);
+    EXPECT_EQ(result.report.items, corners) << describe(c);
+    EXPECT_EQ(result.report.pixel_order, c.order) << describe(c);
+  }
 }
 
 // Static shares of a Hilbert order on a 2^k square frame are its quadrants,
