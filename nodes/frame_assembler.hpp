@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "nodes/messages.hpp"
+#include "nodes/pixel_order.hpp"
 #include "tracer/vec.hpp"
 
 namespace nodes {
@@ -28,7 +29,7 @@ class FrameAssembler {
   std::uint32_t received() const { return received_; }
   bool complete() const { return received_ == colors_.size(); }
   const std::vector<tracer::Color>& colors() const { return colors_; }
-  std::uint32_t position(std::uint32_t item) const { return positions_.empty() ? item : positions_[item]; }
+  std::uint32_t position(std::uint32_t item) const { return scanline_position(positions_, item); }
 
  private:
   std::span<const std::uint32_t> positions_;

@@ -34,6 +34,7 @@
 
 #include "csp/csp.hpp"
 #include "nodes/messages.hpp"
+#include "nodes/pixel_order.hpp"
 #include "nodes/svm.hpp"
 #include "tracer/render.hpp"
 
@@ -52,7 +53,7 @@ struct ItemGrid {
   bool corners = false;
   std::span<const std::uint32_t> positions;  // item -> scanline position; empty: scanline order
 
-  std::uint32_t position(std::uint32_t item) const { return positions.empty() ? item : positions[item]; }
+  std::uint32_t position(std::uint32_t item) const { return scanline_position(positions, item); }
 };
 
 // A worker's network port, shared by its two readers: the work loop (work

@@ -17,6 +17,7 @@
 #pragma once
 
 #include <cstdint>
+#include <span>
 #include <vector>
 
 namespace nodes {
@@ -29,5 +30,10 @@ const char* pixel_order_name(PixelOrder order);
 // Item k's scanline position (y * width + x), for every item of a
 // width x height grid. Empty for scanline order, where the position is k.
 std::vector<std::uint32_t> item_positions(int width, int height, PixelOrder order);
+
+// Item `item`'s scanline position, given item_positions()'s table.
+inline std::uint32_t scanline_position(std::span<const std::uint32_t> positions, std::uint32_t item) {
+  return positions.empty() ? item : positions[item];
+}
 
 }  // namespace nodes
