@@ -5,9 +5,12 @@
 
 #include <filesystem>
 #include <fstream>
+#include <initializer_list>
 #include <regex>
 #include <set>
 #include <sstream>
+#include <utility>
+#include <vector>
 
 #include "app/options.hpp"
 #include "app/sweep.hpp"
@@ -39,6 +42,14 @@ std::vector<std::vector<std::string>> csv_rows(const std::string& text) {
     rows.push_back(cells);
   }
   return rows;
+}
+
+// The same sweep run without and with `extra` options.
+std::pair<app::SweepTable, app::SweepTable> without_and_with(const std::vector<const char*>& args,
+                                                              std::initializer_list<const char*> extra) {
+  std::vector<const char*> more = args;
+  more.insert(more.end(), extra);
+  return {app::run_sweep(parse(args), nullptr), app::run_sweep(parse(more), nullptr)};
 }
 
 fs::path fresh_dir(const std::string& name) {
@@ -129,10 +140,8 @@ TEST(Sweep, ShadowRaysToAllLightsCountMoreRaysAndTakeLonger) {
 // The affinity schedule reaches the runs: the same rays, fewer farming
 // messages (its early tiles are larger than the grain).
 TEST(Sweep, AffinityScheduleReachesTheRuns) {
-  auto o = parse({"nodes", "teapot:2", "--size", "24", "--nodes", "4", "--grain", "1"});
-  const app::SweepTable dynamic = app::run_sweep(o, nullptr);
-  o = parse({"nodes", "teapot:2", "--size", "24", "--nodes", "4", "--grain", "1", "--schedule", "affinity"});
-  const app::SweepTable affinity = app::run_sweep(o, nullptr);
+  const auto [dynamic, affinity] = without_and_with(
+      {"nodes", "teapot:2", "--size", "24", "--nodes", "4", "--grain", "1"}, {"--schedule", "affinity"});
   ASSERT_EQ(affinity.points.size(), 1u);
   EXPECT_EQ(affinity.points[0].rays, dynamic.points[0].rays);
   EXPECT_LT(affinity.points[0].messages, dynamic.points[0].messages);
@@ -142,14 +151,9 @@ TEST(Sweep, AffinityScheduleReachesTheRuns) {
 // The Hilbert order reaches the runs: the same rays, and static shares that
 // are compact patches miss less than bands of rows.
 TEST(Sweep, HilbertOrderReachesTheRuns) {
-  const std::vector<const char*> args{"nodes", "teapot:3", "--size", "32", "--nodes", "16", "--cache-pages", "12",
-                                      "--schedule", "static"};
-  auto o = parse(args);
-  const app::SweepTable scanline = app::run_sweep(o, nullptr);
-  auto hilbert_args = args;
-  hilbert_args.insert(hilbert_args.end(), {"--pixel-order", "hilbert"});
-  o = parse(hilbert_args);
-  const app::SweepTable hilbert = app::run_sweep(o, nullptr);
+  const auto [scanline, hilbert] = without_and_with(
+      {"nodes", "teapot:3", "--size", "32", "--nodes", "16", "--cache-pages", "12", "--schedule", "static"},
+      {"--pixel-order", "hilbert"});
   ASSERT_EQ(hilbert.points.size(), 1u);
   EXPECT_EQ(hilbert.points[0].rays, scanline.points[0].rays);
   EXPECT_LT(hilbert.points[0].misses, scanline.points[0].misses);
