@@ -1,7 +1,8 @@
 // machine_bench: wall time of the VM_pRAY machine (shared virtual memory,
-// farming with the machine's defaults, hypercube network) against the same renderer over one
-// shared in-memory database with plain std::threads pulling rows, measured
-// side by side on the same threads; and the speedup of T threads over 1.
+// farming with the machine's defaults, hypercube network) against the same
+// renderer over one shared in-memory database with plain std::threads
+// pulling rows, measured side by side on the same threads; and the speedup
+// of T threads over 1.
 // Then where the machine's time goes, on 16 nodes and T threads: the same
 // run with the paper's ask-when-idle protocol (prefetch 0), with every cache
 // holding the whole database (no page traffic), with tiles of 256 pixels
