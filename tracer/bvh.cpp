@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <deque>
 
 namespace tracer {
 namespace {
@@ -205,6 +206,69 @@ void set_lane_box(BvhNode& node, int lane, const Box3f& b) {
 
 BvhBuild build_bvh(const BuildRefs& refs, int max_leaf) {
   return Builder(refs.bounds, refs.triangle, max_leaf).run();
+}
+
+namespace {
+
+bool is_inner(const BvhNode& node, int lane) { return node.count[lane] == 0 && node.child[lane] != 0; }
+
+// Half the surface area of the box around a node's lanes: how likely a ray
+// that reaches its parent is to visit it.
+float node_area(const BvhNode& node) {
+  Box3f box;
+  for (int lane = 0; lane < 4; ++lane) {
+    Box3f b;
+    for (int a = 0; a < 3; ++a) {
+      b.lo[a] = node.lo[a][lane];
+      b.hi[a] = node.hi[a][lane];
+    }
+    if (!b.empty()) box.extend(b);
+  }
+  return box.empty() ? 0.0f : box.half_area();
+}
+
+}  // namespace
+
+void lay_out_treelets(BvhBuild& bvh, std::uint32_t nodes_per_page) {
+  const auto n = static_cast<std::uint32_t>(bvh.nodes.size());
+  if (nodes_per_page < 2 || n <= 1) return;
+  std::vector<float> area(n);
+  for (std::uint32_t i = 0; i < n; ++i) area[i] = node_area(bvh.nodes[i]);
+  // Heap order: largest area on top, ties to the lower old index, so the layout is deterministic.
+  const auto below = [&](std::uint32_t a, std::uint32_t b) { return area[a] != area[b] ? area[a] < area[b] : a > b; };
+  std::vector<std::uint32_t> placed;  // old indices in their new order
+  placed.reserve(n);
+  std::deque<std::uint32_t> roots{0};  // treelets still to lay out, in the order they were cut off
+  std::vector<std::uint32_t> frontier;  // heap of the current treelet's candidates
+  while (!roots.empty() || !frontier.empty()) {
+    if (frontier.empty()) {  // the treelet is whole but its page has room: the next one goes on
+      frontier.push_back(roots.front());
+      roots.pop_front();
+    }
+    std::pop_heap(frontier.begin(), frontier.end(), below);
+    const std::uint32_t k = frontier.back();
+    frontier.pop_back();
+    placed.push_back(k);
+    for (int lane = 0; lane < 4; ++lane)
+      if (is_inner(bvh.nodes[k], lane)) {
+        frontier.push_back(bvh.nodes[k].child[lane]);
+        std::push_heap(frontier.begin(), frontier.end(), below);
+      }
+    if (placed.size() % nodes_per_page == 0) {  // page full: the candidates left out root treelets of their own
+      std::sort_heap(frontier.begin(), frontier.end(), below);
+      roots.insert(roots.end(), frontier.rbegin(), frontier.rend());
+      frontier.clear();
+    }
+  }
+  std::vector<std::uint32_t> new_index(n);
+  for (std::uint32_t i = 0; i < n; ++i) new_index[placed[i]] = i;
+  std::vector<BvhNode> nodes(n);
+  for (std::uint32_t i = 0; i < n; ++i) {
+    nodes[i] = bvh.nodes[placed[i]];
+    for (int lane = 0; lane < 4; ++lane)
+      if (is_inner(nodes[i], lane)) nodes[i].child[lane] = new_index[nodes[i].child[lane]];
+  }
+  bvh.nodes = std::move(nodes);
 }
 
 namespace {

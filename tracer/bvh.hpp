@@ -5,7 +5,8 @@
 // it the order in which a ray meets primitives, does not depend on how it is
 // later packed into pages.
 // Output invariants: nodes[0] is the root; an inner lane's node index is
-// greater than its parent's, and a node's inner children are consecutive;
+// greater than its parent's, and a node's inner children are consecutive
+// (nodes in depth-first order of their sibling groups);
 // leaves hold 1..max_leaf references, consecutive in `order` (order[k] is the
 // reference index of the k-th leaf entry). With no references, nodes[0] has
 // four empty lanes.
@@ -36,6 +37,17 @@ struct BuildRefs {
 };
 
 BvhBuild build_bvh(const BuildRefs& refs, int max_leaf);
+
+// Renumbers the nodes so that each page holds a treelet: starting from a
+// root, the candidate a ray is most likely to visit next (the largest
+// surface area among the children of nodes already placed) joins the page
+// until it is full; the candidates left out become roots of later treelets,
+// and a treelet that ends before its page does is followed on the same page
+// by the next one. A ray going down the tree then changes page about every
+// two levels rather than at every level. The tree itself, and so every ray's
+// path, is unchanged; node 0 stays the root and children still follow their
+// parents, but inner siblings are no longer consecutive.
+void lay_out_treelets(BvhBuild& bvh, std::uint32_t nodes_per_page);
 
 // Early split clipping: a triangle whose box is much larger than the average
 // box is cut in halves of its box (recursively, at most 2^max_depth pieces),

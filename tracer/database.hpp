@@ -16,7 +16,8 @@
 //    pointers; record i of a section lives in page first_page + i*size/page_size
 //    at offset (i*size) % page_size.
 //  - Packing is deterministic and the acceleration structure is built before
-//    packing, so the floats the tracer computes with do not depend on page size.
+//    packing, so the floats the tracer computes with do not depend on page size
+//    (the treelet layout numbers BVH nodes by pages, but the tree is the same).
 //
 // PageSource contract: the pointer returned by page(id) is valid only until
 // the next call to page() on the same source; readers copy out (memcpy) what
@@ -55,8 +56,14 @@ class DatabaseError : public std::runtime_error {
 
 enum class Accel : std::uint32_t { bvh, grid };
 
+// How BVH nodes are laid out in their pages (bvh.hpp): by treelets, each
+// page a piece of the tree a ray goes down, or siblings together in
+// depth-first order. Only page numbers differ, never the tree or the image.
+enum class BvhLayout : std::uint32_t { treelet, depth_first };
+
 struct BuildOptions {
   Accel accel = Accel::bvh;
+  BvhLayout bvh_layout = BvhLayout::treelet;
   std::uint32_t page_size = 1024;  // bytes; a power of two in [256, 65536]
   int bvh_max_leaf = 4;            // primitives per BVH leaf at most
   int bvh_split_depth = 3;         // large triangles split into <= 2^depth references (0: none)

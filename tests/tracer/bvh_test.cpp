@@ -1,10 +1,12 @@
-// The BVH and the grid find the same closest hits as testing every primitive.
+// The BVH and the grid find the same closest hits as testing every primitive;
+// the treelet layout renumbers the same tree.
 #include <gtest/gtest.h>
 
 #include <cstring>
 #include <random>
 
 #include "test_scenes.hpp"
+#include "tracer/bvh.hpp"
 #include "tracer/database.hpp"
 #include "tracer/render.hpp"
 
@@ -116,6 +118,100 @@ TEST(Bvh, EmptySceneHasNoHits) {
   Tracer tracer(db.header, pages);
   RayStats stats;
   EXPECT_FALSE(tracer.closest_hit({{0, 0, -5}, {0, 0, 1}}, 0.0f, 1e30f, stats));
+}
+
+}  // namespace
+}  // namespace tracer
+
+namespace tracer {
+namespace {
+
+BuildRefs random_boxes(unsigned seed, int count) {
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<float> at(-10.0f, 10.0f), size(0.01f, 1.0f);
+  BuildRefs refs;
+  for (int i = 0; i < count; ++i) {
+    const Vec3f lo{at(rng), at(rng), at(rng)};
+    refs.bounds.push_back({lo, lo + Vec3f{size(rng), size(rng), size(rng)}});
+    refs.prim.push_back(static_cast<std::uint32_t>(i));
+    refs.triangle.push_back(false);
+  }
+  return refs;
+}
+
+bool is_inner(const BvhNode& node, int lane) { return node.count[lane] == 0 && node.child[lane] != 0; }
+
+// Walks both trees from their roots in step: the same lanes everywhere, every
+// node of `relaid` reached once, each after its parent.
+void expect_same_tree(const BvhBuild& original, const BvhBuild& relaid, std::uint32_t a, std::uint32_t b,
+                      std::vector<int>& visits) {
+  ++visits[b];
+  const BvhNode& x = original.nodes[a];
+  const BvhNode& y = relaid.nodes[b];
+  EXPECT_EQ(0, std::memcmp(x.lo, y.lo, sizeof x.lo));
+  EXPECT_EQ(0, std::memcmp(x.hi, y.hi, sizeof x.hi));
+  for (int lane = 0; lane < 4; ++lane) {
+    ASSERT_EQ(x.count[lane], y.count[lane]);
+    ASSERT_EQ(is_inner(x, lane), is_inner(y, lane));
+    if (!is_inner(x, lane)) {
+      EXPECT_EQ(x.child[lane], y.child[lane]);  // a leaf's first primitive, or an unused lane
+      continue;
+    }
+    ASSERT_LT(y.child[lane], relaid.nodes.size());
+    EXPECT_GT(y.child[lane], b);
+    expect_same_tree(original, relaid, x.child[lane], y.child[lane], visits);
+  }
+}
+
+TEST(BvhLayout, TreeletsRenumberTheSameTree) {
+  const BuildRefs refs = random_boxes(3, 3000);
+  const BvhBuild original = build_bvh(refs, 4);
+  ASSERT_GT(original.nodes.size(), 100u);
+  for (std::uint32_t per_page : {2u, 8u, 32u}) {
+    BvhBuild relaid = original;
+    lay_out_treelets(relaid, per_page);
+    ASSERT_EQ(relaid.nodes.size(), original.nodes.size());
+    EXPECT_EQ(relaid.order, original.order);
+    std::vector<int> visits(relaid.nodes.size(), 0);
+    expect_same_tree(original, relaid, 0, 0, visits);
+    EXPECT_EQ(std::count(visits.begin(), visits.end(), 1), static_cast<long>(visits.size())) << per_page;
+  }
+}
+
+float area_of(const BvhNode& node) {
+  Box3f box;
+  for (int lane = 0; lane < 4; ++lane)
+    if (node.lo[0][lane] <= node.hi[0][lane])
+      box.extend(Box3f{{node.lo[0][lane], node.lo[1][lane], node.lo[2][lane]},
+                       {node.hi[0][lane], node.hi[1][lane], node.hi[2][lane]}});
+  return box.half_area();
+}
+
+// A page is a treelet: on the first page every node but the root hangs from
+// a node of that page, and each node was the largest on offer when it was
+// placed, so no child left off the page (except the last node's, offered
+// after the page was full) is larger than the page's last node.
+void expect_first_page_is_a_treelet(const BvhBuild& bvh, std::uint32_t per_page) {
+  std::vector<std::uint32_t> parent(bvh.nodes.size(), ~0u);
+  for (std::uint32_t i = 0; i < bvh.nodes.size(); ++i)
+    for (int lane = 0; lane < 4; ++lane)
+      if (is_inner(bvh.nodes[i], lane)) parent[bvh.nodes[i].child[lane]] = i;
+  const float last = area_of(bvh.nodes[per_page - 1]);
+  for (std::uint32_t i = 1; i < per_page; ++i) EXPECT_LT(parent[i], per_page) << "node " << i;
+  for (std::uint32_t i = per_page; i < bvh.nodes.size(); ++i) {
+    if (parent[i] < per_page - 1) {
+      EXPECT_LE(area_of(bvh.nodes[i]), last) << "node " << i;
+    }
+  }
+}
+
+TEST(BvhLayout, FirstPageIsTheLargestTopOfTheTree) {
+  BvhBuild bvh = build_bvh(random_boxes(5, 3000), 4);
+  for (std::uint32_t per_page : {4u, 8u, 16u}) {
+    BvhBuild relaid = bvh;
+    lay_out_treelets(relaid, per_page);
+    expect_first_page_is_a_treelet(relaid, per_page);
+  }
 }
 
 }  // namespace

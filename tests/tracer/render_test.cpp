@@ -7,6 +7,7 @@
 #include <cstring>
 
 #include "test_scenes.hpp"
+#include "tracer/generators.hpp"
 
 namespace tracer {
 namespace {
@@ -43,6 +44,25 @@ TEST(Render, ImageIsBitIdenticalForEveryPageSize) {
   const auto reference = render(scene, {.page_size = 65536});
   EXPECT_EQ(render(scene, {.page_size = 256}), reference);
   EXPECT_EQ(render(scene, {.page_size = 1024}), reference);
+}
+
+// The treelet layout renumbers the same tree: every ray meets the same boxes
+// and primitives in the same order, but goes down it over fewer pages.
+TEST(Render, TreeletLayoutGivesTheSameImageOverFewerPages) {
+  Scene scene = generate_scene("teapot:3");
+  scene.camera.width = scene.camera.height = 96;
+  for (std::uint32_t page_size : {256u, 1024u, 4096u}) {
+    RayStats depth_first, treelet;
+    const auto reference = render(scene, {.bvh_layout = BvhLayout::depth_first, .page_size = page_size}, {},
+                                  &depth_first);
+    EXPECT_EQ(render(scene, {.bvh_layout = BvhLayout::treelet, .page_size = page_size}, {}, &treelet), reference)
+        << page_size;
+    EXPECT_EQ(treelet.box_tests, depth_first.box_tests) << page_size;
+    EXPECT_EQ(treelet.prim_tests, depth_first.prim_tests) << page_size;
+    EXPECT_EQ(treelet.record_reads, depth_first.record_reads) << page_size;
+    EXPECT_LT(treelet.page_calls, depth_first.page_calls) << page_size;
+    EXPECT_LT(treelet.distinct_pages, depth_first.distinct_pages) << page_size;
+  }
 }
 
 TEST(Render, OnePageCacheGivesTheSameImage) {
