@@ -15,7 +15,7 @@ namespace {
 
 // Values that need checking or converting before they reach Options.
 struct Raw {
-  std::string accel, shadow_rays;
+  std::string accel, bvh_layout, shadow_rays;
   std::int64_t page_size = 0;
   std::string topology, schedule, pixel_order, distribution;
   std::int64_t nodes = 0, threads = 0, cache_pages = 0, cache_kb = 0, grain = 0, workers = 0,
@@ -33,6 +33,9 @@ po::options_description describe_render(Options& o, Raw& raw) {
       ("spd-procedure", po::bool_switch(&o.spd_procedure),
        "SPD testing procedure: pixel-corner eye rays, depth 5, no adaptive cut-off")
       ("accel", po::value(&raw.accel)->default_value("bvh"), "acceleration structure: bvh or grid")
+      ("bvh-layout", po::value(&raw.bvh_layout)->default_value("treelet"),
+       "how BVH nodes fill pages: treelet (each page a piece of the tree a ray goes down, so fewer pages "
+       "per pixel) or depth-first (siblings together)")
       ("shadow-rays", po::value(&raw.shadow_rays)->default_value("facing"),
        "facing: a shadow ray only to lights in front of the surface (SPD); all: one to every "
        "light at every hit, as VM_pRAY counted them (same image, more rays)")
@@ -93,6 +96,7 @@ T in_range(std::int64_t v, std::int64_t lo, std::int64_t hi, const char* option)
 
 void check_render(Options& o, const Raw& raw) {
   o.accel = parse_accel(raw.accel);
+  o.bvh_layout = parse_bvh_layout(raw.bvh_layout);
   o.shadow_rays_all = parse_shadow_rays(raw.shadow_rays);
   try {
     tracer::validate_page_size(static_cast<std::uint64_t>(std::max<std::int64_t>(raw.page_size, 0)));
@@ -177,6 +181,16 @@ nodes::PixelOrder parse_pixel_order(const std::string& name) {
 }
 
 const char* accel_name(tracer::Accel accel) { return accel == tracer::Accel::bvh ? "bvh" : "grid"; }
+
+tracer::BvhLayout parse_bvh_layout(const std::string& name) {
+  for (auto layout : {tracer::BvhLayout::treelet, tracer::BvhLayout::depth_first})
+    if (name == bvh_layout_name(layout)) return layout;
+  throw UsageError("--bvh-layout: expected treelet or depth-first, got '" + name + "'");
+}
+
+const char* bvh_layout_name(tracer::BvhLayout layout) {
+  return layout == tracer::BvhLayout::treelet ? "treelet" : "depth-first";
+}
 
 std::string default_output(const std::string& scene) {
   if (scene == "-") return "stdin.png";

@@ -29,6 +29,7 @@ struct Options {
   bool spd_procedure = false;
   bool shadow_rays_all = false;  // --shadow-rays all: one per light at every hit
   tracer::Accel accel = tracer::Accel::bvh;
+  tracer::BvhLayout bvh_layout = tracer::BvhLayout::treelet;
   std::uint32_t page_size = 1024;
   int max_depth = 5;
   int width = 0;       // 0: the scene's resolution
@@ -52,6 +53,9 @@ bool parse_shadow_rays(const std::string& policy);
 // --accel: "bvh" or "grid"; UsageError otherwise. accel_name() is the inverse.
 tracer::Accel parse_accel(const std::string& name);
 const char* accel_name(tracer::Accel accel);
+// --bvh-layout: "treelet" or "depth-first"; UsageError otherwise. bvh_layout_name() is the inverse.
+tracer::BvhLayout parse_bvh_layout(const std::string& name);
+const char* bvh_layout_name(tracer::BvhLayout layout);
 // --schedule: "dynamic", "static" or "affinity"; UsageError otherwise.
 nodes::Schedule parse_schedule(const std::string& name);
 // --pixel-order: "scanline" or "hilbert"; UsageError otherwise.

@@ -31,7 +31,9 @@ void print_report(std::ostream& out, const RunReport& r) {
       << "image          " << r.output << " (" << r.width << "x" << r.height
       << (r.spd_procedure ? ", SPD procedure" : "") << ")\n"
       << "database       " << r.pages << " pages of " << r.page_size << " bytes = "
-      << r.database_bytes / 1024.0 << " KB (" << accel_name(r.accel) << ", built in "
+      << r.database_bytes / 1024.0 << " KB (" << accel_name(r.accel)
+      << (r.accel == tracer::Accel::bvh ? std::string(", ") + bvh_layout_name(r.bvh_layout) + " layout" : "")
+      << ", built in "
       << r.build.accel_seconds << " s)\n"
       << "rays           " << s.rays() << ": primary " << s.primary << " (hit " << s.primary_hits
       << "), shadow " << s.shadow << ", reflected " << s.reflected << ", refracted "
@@ -59,7 +61,8 @@ void write_stats_json(const std::string& path, const RunReport& r) {
     << "  \"shadow_rays\": \"" << (r.shadow_rays_all ? "all" : "facing") << "\",\n"
     << "  \"polygons\": " << r.polygons << ", \"objects\": " << r.objects
     << ", \"primitives\": " << r.primitives << ",\n"
-    << "  \"database\": {\"accel\": \"" << accel_name(r.accel) << "\", \"page_size\": "
+    << "  \"database\": {\"accel\": \"" << accel_name(r.accel) << "\", \"bvh_layout\": \""
+    << bvh_layout_name(r.bvh_layout) << "\", \"page_size\": "
     << r.page_size << ", \"pages\": " << r.pages << ", \"bytes\": " << r.database_bytes
     << ", \"payload_bytes\": " << r.build.payload_bytes << ", \"bvh_nodes\": "
     << r.build.bvh_nodes << ", \"grid_cells\": " << r.build.grid_cells << "},\n"

@@ -24,6 +24,7 @@ struct RunReport {
   std::uint64_t objects = 0;
   std::uint64_t primitives = 0;  // after triangulation
   tracer::Accel accel = tracer::Accel::bvh;
+  tracer::BvhLayout bvh_layout = tracer::BvhLayout::treelet;  // meaningful for the BVH only
   std::uint32_t page_size = 0;
   std::uint32_t pages = 0;
   std::uint64_t database_bytes = 0;  // pages * page_size

@@ -21,6 +21,7 @@ RunReport describe_run(const Options& o, const tracer::Database& db) {
   r.objects = h.object_count;
   r.primitives = h.primitive_count;
   r.accel = h.accel;
+  r.bvh_layout = o.bvh_layout;
   r.page_size = h.page_size;
   r.pages = h.page_count;
   r.database_bytes = h.bytes();
@@ -29,7 +30,8 @@ RunReport describe_run(const Options& o, const tracer::Database& db) {
 }
 
 RenderResult render_single(const Options& o, const tracer::Scene& scene) {
-  const tracer::Database db = build_database(scene, {.accel = o.accel, .page_size = o.page_size});
+  const tracer::Database db =
+      build_database(scene, {.accel = o.accel, .bvh_layout = o.bvh_layout, .page_size = o.page_size});
   RenderResult out{tracer::Image(scene.camera.width, scene.camera.height), describe_run(o, db)};
   tracer::InMemoryPageSource pages(db);
   const tracer::TraceOptions trace{.max_depth = o.max_depth,

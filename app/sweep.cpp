@@ -46,7 +46,8 @@ std::vector<std::string> split(const std::string& text) {
 
 struct RawSweep {
   std::string kind, topologies = "hypercube", nodes, cache, profile = "ipsc2", costs, out;
-  std::string accel = "bvh", shadow_rays = "facing", schedule = "dynamic", pixel_order = "scanline";
+  std::string accel = "bvh", bvh_layout = "treelet", shadow_rays = "facing";
+  std::string schedule = "dynamic", pixel_order = "scanline";
 };
 
 po::options_description describe(SweepOptions& o, RawSweep& raw) {
@@ -64,6 +65,7 @@ po::options_description describe(SweepOptions& o, RawSweep& raw) {
       ("schedule", po::value(&raw.schedule), "dynamic (default, as in the paper), static or affinity")
       ("pixel-order", po::value(&raw.pixel_order), "scanline (default, as in the paper) or hilbert")
       ("accel", po::value(&raw.accel), "acceleration structure: bvh (default) or grid")
+      ("bvh-layout", po::value(&raw.bvh_layout), "BVH nodes in pages: treelet (default) or depth-first")
       ("shadow-rays", po::value(&raw.shadow_rays),
        "facing (default): shadow rays only to lights in front of the surface; all: to every light")
       ("profile", po::value(&raw.profile), "machine profile: ipsc2, native, or a key = value file")
@@ -91,6 +93,7 @@ void check_sweep(SweepOptions& o, const RawSweep& raw) {
   else if (o.kind == SweepOptions::Kind::cache) o.cache_pages = {8, 16, 32, 64, 128, 256, 512};
   o.out_dir = raw.out.empty() ? "sweep-" + raw.kind : raw.out;
   o.accel = parse_accel(raw.accel);
+  o.bvh_layout = parse_bvh_layout(raw.bvh_layout);
   o.schedule = parse_schedule(raw.schedule);
   o.pixel_order = parse_pixel_order(raw.pixel_order);
   o.trace.shadow_rays_to_all_lights = parse_shadow_rays(raw.shadow_rays);
@@ -102,7 +105,8 @@ tracer::Database load_database(const SweepOptions& o) {
   render.width = o.size;
   render.height = o.size;
   render.page_size = o.page_size;
-  return tracer::build_database(load_scene(render), {.accel = o.accel, .page_size = o.page_size});
+  return tracer::build_database(load_scene(render),
+                                {.accel = o.accel, .bvh_layout = o.bvh_layout, .page_size = o.page_size});
 }
 
 std::string fixed(double v, int digits) {
@@ -153,7 +157,9 @@ SweepTable run_sweep(const SweepOptions& o, std::ostream* progress) {
   table.width = db.header.camera.width;
   table.height = db.header.camera.height;
   table.page_count = db.header.page_count;
-  table.tracing = std::string(accel_name(o.accel)) + ", shadow rays " +
+  table.tracing = std::string(accel_name(o.accel)) +
+                  (o.accel == tracer::Accel::bvh ? std::string(", ") + bvh_layout_name(o.bvh_layout) + " layout" : "") +
+                  ", shadow rays " +
                   (o.trace.shadow_rays_to_all_lights ? "all" : "facing");
   table.farming = std::string(nodes::schedule_name(o.schedule)) + " schedule, grain " + std::to_string(o.grain) +
                   ", prefetch " + std::to_string(o.prefetch) + ", " + nodes::pixel_order_name(o.pixel_order) +

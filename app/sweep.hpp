@@ -34,6 +34,7 @@ struct SweepOptions {
   nodes::PixelOrder pixel_order = nodes::PixelOrder::scanline;
   nodes::CostModel model = nodes::ipsc2_profile();
   tracer::Accel accel = tracer::Accel::bvh;
+  tracer::BvhLayout bvh_layout = tracer::BvhLayout::treelet;
   tracer::TraceOptions trace;             // --shadow-rays
   double fit_seconds = 0;                 // > 0: fit model.unit so T1 takes this long
   std::filesystem::path out_dir;          // default: sweep-<kind>

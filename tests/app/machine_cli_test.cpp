@@ -214,6 +214,16 @@ TEST_F(MachineCli, ThePapersFarmingIsReported) {
   EXPECT_EQ(j["machine"]["steals"].number, 0);
 }
 
+TEST_F(MachineCli, BvhLayoutIsReported) {
+  for (const char* layout : {"treelet", "depth-first"}) {
+    const Outcome r = run(std::string(kSmall) + " --bvh-layout " + layout + " -o out.png --stats s.json");
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    EXPECT_NE(r.out.find(std::string("(bvh, ") + layout + " layout, built in"), std::string::npos) << r.out;
+    const Json j = JsonReader(read_file(dir_ / "s.json")).document();
+    EXPECT_EQ(j["database"]["bvh_layout"].text, layout);
+  }
+}
+
 TEST_F(MachineCli, EveryMachineMakesTheSingleProcessImage) {
   const std::string scene = "teapot:2 --width 24 --height 20 --threads 2 -q";
   ASSERT_EQ(run(scene + " --single -o single.ppm").exit_code, 0);
@@ -229,6 +239,7 @@ TEST_F(MachineCli, EveryMachineMakesTheSingleProcessImage) {
       "--topology mesh:2x3 --schedule static --cache-pages 2",
       "--topology hypercube:2 --grain 5 --workers-per-node 3",
       "--topology complete:1",
+      "--topology hypercube:3 --bvh-layout depth-first --cache-pages 3",
   };
   for (const std::string& m : machines) {
     const Outcome r = run(scene + " " + m + " -o machine.ppm");

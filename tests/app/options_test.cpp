@@ -28,19 +28,21 @@ TEST(Options, DefaultsRenderTheTeapotToTeapotPng) {
   EXPECT_EQ(o.output, "teapot.png");
   EXPECT_EQ(o.page_size, 1024u);
   EXPECT_EQ(o.accel, tracer::Accel::bvh);
+  EXPECT_EQ(o.bvh_layout, tracer::BvhLayout::treelet);
   EXPECT_EQ(o.max_depth, 5);
   EXPECT_FALSE(o.spd_procedure);
 }
 
 TEST(Options, ParsesEveryValue) {
   const Options o = parse({"scene.nff", "-o", "x.ppm", "--stats", "s.json", "--spd-procedure",
-                           "--accel", "grid", "--page-size", "4096", "--max-depth", "3",
+                           "--accel", "grid", "--bvh-layout", "depth-first", "--page-size", "4096", "--max-depth", "3",
                            "--width", "64", "--height", "32", "--tessellate", "2", "--quiet"});
   EXPECT_EQ(o.scene, "scene.nff");
   EXPECT_EQ(o.output, "x.ppm");
   EXPECT_EQ(o.stats_path, "s.json");
   EXPECT_TRUE(o.spd_procedure);
   EXPECT_EQ(o.accel, tracer::Accel::grid);
+  EXPECT_EQ(o.bvh_layout, tracer::BvhLayout::depth_first);
   EXPECT_EQ(o.page_size, 4096u);
   EXPECT_EQ(o.max_depth, 3);
   EXPECT_EQ(o.width, 64);
@@ -51,6 +53,7 @@ TEST(Options, ParsesEveryValue) {
 
 TEST(Options, BadValuesNameTheOption) {
   EXPECT_NE(error_of({"--accel", "kdtree"}).find("--accel"), std::string::npos);
+  EXPECT_NE(error_of({"--bvh-layout", "veb"}).find("--bvh-layout"), std::string::npos);
   EXPECT_NE(error_of({"--page-size", "1000"}).find("--page-size"), std::string::npos);
   EXPECT_NE(error_of({"--page-size", "128"}).find("--page-size"), std::string::npos);
   EXPECT_NE(error_of({"--max-depth", "0"}).find("--max-depth"), std::string::npos);

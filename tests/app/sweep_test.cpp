@@ -67,6 +67,7 @@ TEST(SweepOptions, BadValuesNameTheOption) {
       {{"nodes", "--size", "0"}, "--size"},
       {{"nodes", "--shadow-rays", "some"}, "--shadow-rays"},
       {{"nodes", "--accel", "kd"}, "--accel"},
+      {{"nodes", "--bvh-layout", "veb"}, "--bvh-layout"},
       {{"nodes", "--prefetch", "4"}, "--prefetch"},
       {{"nodes", "--schedule", "guided"}, "--schedule"},
       {{"nodes", "--pixel-order", "zorder"}, "--pixel-order"},
@@ -113,7 +114,7 @@ TEST(Sweep, NodesSweepWritesWellFormedTablesAndPlots) {
   EXPECT_EQ(std::count(json.begin(), json.end(), '{'), std::count(json.begin(), json.end(), '}'));
   EXPECT_EQ(std::count(json.begin(), json.end(), '['), std::count(json.begin(), json.end(), ']'));
   EXPECT_NE(json.find("\"efficiency\": 1,"), std::string::npos);
-  EXPECT_NE(json.find("\"tracing\": \"bvh, shadow rays facing\""), std::string::npos);
+  EXPECT_NE(json.find("\"tracing\": \"bvh, treelet layout, shadow rays facing\""), std::string::npos);
   EXPECT_NE(json.find("\"farming\": \"dynamic schedule, grain 4, prefetch 0, scanline order\""), std::string::npos);
   EXPECT_EQ(json.find("nan"), std::string::npos);
 
@@ -134,7 +135,7 @@ TEST(Sweep, ShadowRaysToAllLightsCountMoreRaysAndTakeLonger) {
   ASSERT_EQ(all.points.size(), 1u);
   EXPECT_GT(all.points[0].rays, facing.points[0].rays);
   EXPECT_GT(all.serial_seconds, facing.serial_seconds);
-  EXPECT_EQ(all.tracing, "bvh, shadow rays all");
+  EXPECT_EQ(all.tracing, "bvh, treelet layout, shadow rays all");
 }
 
 // The affinity schedule reaches the runs: the same rays, fewer farming
@@ -158,6 +159,17 @@ TEST(Sweep, HilbertOrderReachesTheRuns) {
   EXPECT_EQ(hilbert.points[0].rays, scanline.points[0].rays);
   EXPECT_LT(hilbert.points[0].misses, scanline.points[0].misses);
   EXPECT_EQ(hilbert.farming, "static schedule, grain 4, prefetch 0, hilbert order");
+}
+
+// The BVH layout reaches the runs: the same rays, and more page accesses
+// when siblings rather than treelets share pages.
+TEST(Sweep, BvhLayoutReachesTheRuns) {
+  const auto [treelet, depth_first] = without_and_with(
+      {"cache", "teapot:3", "--size", "32", "--nodes", "4", "--cache-pages", "8"}, {"--bvh-layout", "depth-first"});
+  ASSERT_EQ(depth_first.points.size(), 1u);
+  EXPECT_EQ(depth_first.points[0].rays, treelet.points[0].rays);
+  EXPECT_GT(depth_first.points[0].page_accesses, treelet.points[0].page_accesses);
+  EXPECT_EQ(depth_first.tracing, "bvh, depth-first layout, shadow rays facing");
 }
 
 TEST(Sweep, CacheSweepCountsFewerMissesWithMoreCache) {
