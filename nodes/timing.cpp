@@ -25,7 +25,7 @@ using Seconds = std::chrono::duration<double>;
 constexpr double ipsc2_box = 1.0, ipsc2_prim = 2.0, ipsc2_shade = 5.0, ipsc2_page = 0.2;
 // Fitted by `vmpray sweep nodes teapot --size 512 --nodes 1 --cache-pages 3072
 // --fit-seconds 11522` (Teapot, 3h12mn2s on one node; see app/experiments.hpp).
-constexpr double ipsc2_unit = 368.823e-6;
+constexpr double ipsc2_unit = 371.437e-6;
 // The virtual clock counts picoseconds in 64 bits: about 106 days.
 constexpr double max_virtual_seconds = 9e6;
 
