@@ -4,7 +4,8 @@
 // pulling rows, measured side by side on the same threads; and the speedup
 // of T threads over 1.
 // Then where the machine's time goes, on 16 nodes and T threads: the same
-// run with the paper's ask-when-idle protocol (prefetch 0), with every cache
+// run with the BVH's nodes in depth-first layout rather than in treelets,
+// with the paper's ask-when-idle protocol (prefetch 0), with every cache
 // holding the whole database (no page traffic), with tiles of 256 pixels
 // (little farming traffic), and with other schedules and pixel orders, down
 // to the paper's farming (dynamic, in scanline order).
@@ -32,11 +33,11 @@ namespace {
 
 using Clock = std::chrono::steady_clock;
 
-tracer::Database make_db(const std::string& spec, int size) {
+tracer::Database make_db(const std::string& spec, int size, const tracer::BuildOptions& build = {}) {
   tracer::Scene scene = tracer::generate_scene(spec);
   scene.camera.width = size;
   scene.camera.height = size;
-  return tracer::build_database(scene);
+  return tracer::build_database(scene, build);
 }
 
 // Rows pulled from a shared counter by plain threads over one database.
@@ -84,10 +85,11 @@ using Variant = std::function<void(nodes::MachineOptions&, const tracer::Databas
 
 // One more run of a configuration, added to `run`.
 void run_machine_once(MachineRun& run, const std::string& spec, int size, int nodes, unsigned threads,
-                      const std::vector<tracer::Color>& reference, const Variant& variant = {}) {
+                      const std::vector<tracer::Color>& reference, const Variant& variant = {},
+                      const tracer::BuildOptions& build = {}) {
   if (!run.error.empty()) return;
   try {
-    auto db = make_db(spec, size);
+    auto db = make_db(spec, size, build);
     nodes::MachineOptions options;
     options.topology = "hypercube";
     options.nodes = static_cast<std::size_t>(nodes);
@@ -156,8 +158,14 @@ int main(int argc, char** argv) {
 
   std::printf("where the time goes: hypercube 16, %u threads, against shared memory on %u threads\n", threads,
               threads);
-  const std::vector<std::pair<const char*, Variant>> variants{
+  struct Line {
+    const char* label;
+    Variant machine;
+    tracer::BuildOptions build = {};
+  };
+  const std::vector<Line> variants{
       {"  as above (affinity, hilbert, grain 16)", {}},
+      {"  BVH nodes in depth-first layout", {}, {.bvh_layout = tracer::BvhLayout::depth_first}},
       {"  prefetch 0 (ask when idle)",
        [](nodes::MachineOptions& o, const tracer::DatabaseHeader&) { o.prefetch = 0; }},
       {"  cache = whole database (first-touch misses)",
@@ -178,7 +186,7 @@ int main(int argc, char** argv) {
   std::vector<MachineRun> runs(variants.size());
   for (int r = 0; r < repeats; ++r)
     for (std::size_t v = 0; v < variants.size(); ++v)
-      run_machine_once(runs[v], spec, size, 16, threads, image, variants[v].second);
-  for (std::size_t v = 0; v < variants.size(); ++v) print_run(variants[v].first, runs[v], shared_t.median());
+      run_machine_once(runs[v], spec, size, 16, threads, image, variants[v].machine, variants[v].build);
+  for (std::size_t v = 0; v < variants.size(); ++v) print_run(variants[v].label, runs[v], shared_t.median());
   return 0;
 }
