@@ -46,8 +46,10 @@ enum class Priority { high, low };
 
 class ProcessProps : public boost::fibers::fiber_properties {
  public:
-  explicit ProcessProps(boost::fibers::context* ctx) : fiber_properties(ctx) {}
+  explicit ProcessProps(boost::fibers::context* ctx, bool virtual_time = false)
+      : fiber_properties(ctx), virtual_time(virtual_time) {}
   detail::Process* process = nullptr;  // null for fibers that are not csp processes
+  const bool virtual_time;             // these are VirtualProps (virtual_time.hpp)
 };
 
 using Scheduler = boost::fibers::algo::algorithm_with_properties<ProcessProps>;

@@ -1,9 +1,11 @@
 // VirtualTimeScheduler and the this_process clock API (see virtual_time.hpp).
 #include "csp/virtual_time.hpp"
 
+#include "csp/detail/process.hpp"
 #include "csp/runtime.hpp"
 
 #include <algorithm>
+#include <utility>
 #include <boost/fiber/operations.hpp>
 #include <stdexcept>
 
@@ -11,9 +13,17 @@ namespace csp {
 
 namespace {
 
+// Every fiber of a runtime thread has ProcessProps (scheduler.hpp).
 VirtualProps* props_of(boost::fibers::context* ctx) {
-  if (!ctx) return nullptr;
-  return dynamic_cast<VirtualProps*>(ctx->get_properties());
+  if (!ctx || !detail::thread_scheduler()) return nullptr;
+  auto* props = static_cast<ProcessProps*>(ctx->get_properties());
+  return props && props->virtual_time ? static_cast<VirtualProps*>(props) : nullptr;
+}
+
+// Heap order: the entry that runs later sinks (std heaps keep the largest on top).
+bool runs_later(const std::tuple<std::int64_t, std::uint64_t, boost::fibers::context*>& a,
+                const std::tuple<std::int64_t, std::uint64_t, boost::fibers::context*>& b) {
+  return std::get<0>(a) != std::get<0>(b) ? std::get<0>(a) > std::get<0>(b) : std::get<1>(a) > std::get<1>(b);
 }
 
 }  // namespace
@@ -25,7 +35,16 @@ boost::fibers::fiber_properties* VirtualTimeScheduler::new_properties(boost::fib
   return new VirtualProps(ctx, *this);
 }
 
+void VirtualTimeScheduler::push(std::int64_t key, boost::fibers::context* ctx) {
+  ready_.emplace_back(key, arrivals_++, ctx);
+  std::push_heap(ready_.begin(), ready_.end(), runs_later);
+}
+
 void VirtualTimeScheduler::awakened(boost::fibers::context* ctx, ProcessProps& props) noexcept {
+  if (ctx->is_context(boost::fibers::type::dispatcher_context)) {
+    dispatcher_ = ctx;
+    return;
+  }
   auto& self = static_cast<VirtualProps&>(props);
   if (self.queued) {  // pass_to() has queued it already, at its own time
     self.queued = false;
@@ -35,17 +54,17 @@ void VirtualTimeScheduler::awakened(boost::fibers::context* ctx, ProcessProps& p
   // than the waker's now.
   const VirtualProps* waker = props_of(boost::fibers::context::active());
   const VirtualDuration key = std::max(self.clock, waker ? waker->clock : self.clock);
-  ready_.emplace(key.count(), arrivals_++, ctx);
+  push(key.count(), ctx);
 }
 
 void VirtualTimeScheduler::pass_to(boost::fibers::context* self, VirtualProps& props, VirtualDuration until) {
-  if (ready_.empty() || std::get<0>(*ready_.begin()) > until.count()) {
+  if (ready_.empty() || std::get<0>(ready_.front()) > until.count()) {
     props.clock = until;
     note_time(until.count());
     return;
   }
   props.queued = true;
-  ready_.emplace(until.count(), arrivals_++, self);
+  push(until.count(), self);
   boost::this_fiber::yield();
 }
 
@@ -54,15 +73,20 @@ void VirtualTimeScheduler::note_time(std::int64_t t) {
 }
 
 boost::fibers::context* VirtualTimeScheduler::pick_next() noexcept {
+  if (dispatcher_ && (ready_.empty() || ++picks_since_dispatch_ >= dispatch_period)) {
+    picks_since_dispatch_ = 0;
+    return std::exchange(dispatcher_, nullptr);
+  }
   if (ready_.empty()) return nullptr;
-  const auto [key, arrival, ctx] = *ready_.begin();
-  ready_.erase(ready_.begin());
+  std::pop_heap(ready_.begin(), ready_.end(), runs_later);
+  const auto [key, arrival, ctx] = ready_.back();
+  ready_.pop_back();
   if (VirtualProps* p = props_of(ctx)) p->clock = VirtualDuration(key);
   note_time(key);
   return ctx;
 }
 
-bool VirtualTimeScheduler::has_ready_fibers() const noexcept { return !ready_.empty(); }
+bool VirtualTimeScheduler::has_ready_fibers() const noexcept { return dispatcher_ || !ready_.empty(); }
 
 void VirtualTimeScheduler::suspend_until(std::chrono::steady_clock::time_point const& when) noexcept {
   std::unique_lock<std::mutex> lk(mutex_);
