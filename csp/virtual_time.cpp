@@ -21,10 +21,12 @@ VirtualProps* props_of(boost::fibers::context* ctx) {
 }
 
 // Heap order: the entry that runs later sinks (std heaps keep the largest on top).
-bool runs_later(const std::tuple<std::int64_t, std::uint64_t, boost::fibers::context*>& a,
-                const std::tuple<std::int64_t, std::uint64_t, boost::fibers::context*>& b) {
-  return std::get<0>(a) != std::get<0>(b) ? std::get<0>(a) > std::get<0>(b) : std::get<1>(a) > std::get<1>(b);
-}
+struct RunsLater {
+  bool operator()(const std::tuple<std::int64_t, std::uint64_t, boost::fibers::context*>& a,
+                  const std::tuple<std::int64_t, std::uint64_t, boost::fibers::context*>& b) const {
+    return std::get<0>(a) != std::get<0>(b) ? std::get<0>(a) > std::get<0>(b) : std::get<1>(a) > std::get<1>(b);
+  }
+};
 
 }  // namespace
 
@@ -37,7 +39,7 @@ boost::fibers::fiber_properties* VirtualTimeScheduler::new_properties(boost::fib
 
 void VirtualTimeScheduler::push(std::int64_t key, boost::fibers::context* ctx) {
   ready_.emplace_back(key, arrivals_++, ctx);
-  std::push_heap(ready_.begin(), ready_.end(), runs_later);
+  std::push_heap(ready_.begin(), ready_.end(), RunsLater{});
 }
 
 void VirtualTimeScheduler::awakened(boost::fibers::context* ctx, ProcessProps& props) noexcept {
@@ -78,7 +80,7 @@ boost::fibers::context* VirtualTimeScheduler::pick_next() noexcept {
     return std::exchange(dispatcher_, nullptr);
   }
   if (ready_.empty()) return nullptr;
-  std::pop_heap(ready_.begin(), ready_.end(), runs_later);
+  std::pop_heap(ready_.begin(), ready_.end(), RunsLater{});
   const auto [key, arrival, ctx] = ready_.back();
   ready_.pop_back();
   if (VirtualProps* p = props_of(ctx)) p->clock = VirtualDuration(key);
