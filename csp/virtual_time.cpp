@@ -38,8 +38,12 @@ boost::fibers::fiber_properties* VirtualTimeScheduler::new_properties(boost::fib
 }
 
 void VirtualTimeScheduler::push(std::int64_t key, boost::fibers::context* ctx) {
-  ready_.emplace_back(key, arrivals_++, ctx);
-  std::push_heap(ready_.begin(), ready_.end(), RunsLater{});
+  if (key == now_) {
+    current_.push_back(ctx);
+    return;
+  }
+  later_.emplace_back(key, arrivals_++, ctx);
+  std::push_heap(later_.begin(), later_.end(), RunsLater{});
 }
 
 void VirtualTimeScheduler::awakened(boost::fibers::context* ctx, ProcessProps& props) noexcept {
@@ -60,7 +64,7 @@ void VirtualTimeScheduler::awakened(boost::fibers::context* ctx, ProcessProps& p
 }
 
 void VirtualTimeScheduler::pass_to(boost::fibers::context* self, VirtualProps& props, VirtualDuration until) {
-  if (ready_.empty() || std::get<0>(ready_.front()) > until.count()) {
+  if (current_.empty() && (later_.empty() || std::get<0>(later_.front()) > until.count())) {
     props.clock = until;
     note_time(until.count());
     return;
@@ -75,20 +79,32 @@ void VirtualTimeScheduler::note_time(std::int64_t t) {
 }
 
 boost::fibers::context* VirtualTimeScheduler::pick_next() noexcept {
-  if (dispatcher_ && (ready_.empty() || ++picks_since_dispatch_ >= dispatch_period)) {
+  const bool none_ready = current_.empty() && later_.empty();
+  if (dispatcher_ && (none_ready || ++picks_since_dispatch_ >= dispatch_period)) {
     picks_since_dispatch_ = 0;
     return std::exchange(dispatcher_, nullptr);
   }
-  if (ready_.empty()) return nullptr;
-  std::pop_heap(ready_.begin(), ready_.end(), RunsLater{});
-  const auto [key, arrival, ctx] = ready_.back();
-  ready_.pop_back();
+  if (none_ready) return nullptr;
+  std::int64_t key = now_;
+  boost::fibers::context* ctx = nullptr;
+  if (!later_.empty() && (current_.empty() || std::get<0>(later_.front()) <= now_)) {
+    std::pop_heap(later_.begin(), later_.end(), RunsLater{});
+    key = std::get<0>(later_.back());
+    ctx = std::get<2>(later_.back());
+    later_.pop_back();
+  } else {
+    ctx = current_.front();
+    current_.pop_front();
+  }
+  now_ = std::max(now_, key);
   if (VirtualProps* p = props_of(ctx)) p->clock = VirtualDuration(key);
   note_time(key);
   return ctx;
 }
 
-bool VirtualTimeScheduler::has_ready_fibers() const noexcept { return dispatcher_ || !ready_.empty(); }
+bool VirtualTimeScheduler::has_ready_fibers() const noexcept {
+  return dispatcher_ || !current_.empty() || !later_.empty();
+}
 
 void VirtualTimeScheduler::suspend_until(std::chrono::steady_clock::time_point const& when) noexcept {
   std::unique_lock<std::mutex> lk(mutex_);

@@ -35,6 +35,7 @@
 #include <atomic>
 #include <chrono>
 #include <cstdint>
+#include <deque>
 #include <memory>
 #include <tuple>
 #include <vector>
@@ -84,11 +85,17 @@ class VirtualTimeScheduler final : public Scheduler {
  private:
   void note_time(std::int64_t t);
 
-  // (key, arrival, fiber): the smallest key first, FIFO among equal keys.
-  // A heap in a vector: no allocation per wake once it has grown.
+  // Ready fibers: the smallest key first, FIFO among equal keys. A fiber
+  // ready at the current time `now_` (woken, or passing at zero cost) joins
+  // the FIFO `current_`; one ready later joins the heap `later_` of
+  // (key, arrival, fiber). Among equal keys the heap's entries came first:
+  // `now_` moves on only when `current_` is empty, so whatever the heap holds
+  // at the new `now_` was queued before anything `current_` gets.
   using Entry = std::tuple<std::int64_t, std::uint64_t, boost::fibers::context*>;
   void push(std::int64_t key, boost::fibers::context* ctx);
-  std::vector<Entry> ready_;
+  std::deque<boost::fibers::context*> current_;
+  std::vector<Entry> later_;  // a heap in a vector: no allocation per push once it has grown
+  std::int64_t now_ = 0;      // the key of the fiber picked last
   std::uint64_t arrivals_ = 0;
   // Boost's dispatcher fiber, kept aside while it is ready and run when no
   // process is or after every dispatch_period picks (it frees finished
