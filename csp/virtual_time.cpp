@@ -58,7 +58,7 @@ void VirtualTimeScheduler::awakened(boost::fibers::context* ctx, ProcessProps& p
   }
   // Woken by the running fiber (a channel, an ALT, a PAR's end): no earlier
   // than the waker's now.
-  const VirtualProps* waker = props_of(boost::fibers::context::active());
+  const VirtualProps* waker = running_;
   const VirtualDuration key = std::max(self.clock, waker ? waker->clock : self.clock);
   push(key.count(), ctx);
 }
@@ -82,6 +82,8 @@ boost::fibers::context* VirtualTimeScheduler::pick_next() noexcept {
   const bool none_ready = current_.empty() && later_.empty();
   if (dispatcher_ && (none_ready || ++picks_since_dispatch_ >= dispatch_period)) {
     picks_since_dispatch_ = 0;
+    running_ = props_of(dispatcher_);
+    if (running_) running_->clock = VirtualDuration(now_);  // what it wakes, it wakes now
     return std::exchange(dispatcher_, nullptr);
   }
   if (none_ready) return nullptr;
@@ -97,7 +99,8 @@ boost::fibers::context* VirtualTimeScheduler::pick_next() noexcept {
     current_.pop_front();
   }
   now_ = std::max(now_, key);
-  if (VirtualProps* p = props_of(ctx)) p->clock = VirtualDuration(key);
+  running_ = props_of(ctx);
+  if (running_) running_->clock = VirtualDuration(key);
   note_time(key);
   return ctx;
 }

@@ -96,6 +96,9 @@ class VirtualTimeScheduler final : public Scheduler {
   std::deque<boost::fibers::context*> current_;
   std::vector<Entry> later_;  // a heap in a vector: no allocation per push once it has grown
   std::int64_t now_ = 0;      // the key of the fiber picked last
+  // The properties of the fiber picked last, which is the running fiber
+  // (Boost resumes what pick_next returns), or null before the first pick.
+  VirtualProps* running_ = nullptr;
   std::uint64_t arrivals_ = 0;
   // Boost's dispatcher fiber, kept aside while it is ready and run when no
   // process is or after every dispatch_period picks (it frees finished
