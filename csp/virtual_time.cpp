@@ -20,6 +20,12 @@ VirtualProps* props_of(boost::fibers::context* ctx) {
   return props && props->virtual_time ? static_cast<VirtualProps*>(props) : nullptr;
 }
 
+// The scheduler of this thread, if it keeps virtual time.
+thread_local VirtualTimeScheduler* thread_clock = nullptr;
+
+// The calling fiber's properties, if it runs in virtual time.
+VirtualProps* running_props() { return thread_clock ? thread_clock->running() : nullptr; }
+
 // Heap order: the entry that runs later sinks (std heaps keep the largest on top).
 struct RunsLater {
   bool operator()(const std::tuple<std::int64_t, std::uint64_t, boost::fibers::context*>& a,
@@ -31,7 +37,13 @@ struct RunsLater {
 }  // namespace
 
 VirtualTimeScheduler::VirtualTimeScheduler(std::shared_ptr<VirtualTimeRecord> record)
-    : record_(record ? std::move(record) : std::make_shared<VirtualTimeRecord>()) {}
+    : record_(record ? std::move(record) : std::make_shared<VirtualTimeRecord>()) {
+  thread_clock = this;
+}
+
+VirtualTimeScheduler::~VirtualTimeScheduler() {
+  if (thread_clock == this) thread_clock = nullptr;
+}
 
 boost::fibers::fiber_properties* VirtualTimeScheduler::new_properties(boost::fibers::context* ctx) {
   return new VirtualProps(ctx, *this);
@@ -134,22 +146,20 @@ SchedulerFactory virtual_time_scheduler(std::shared_ptr<VirtualTimeRecord> recor
 
 namespace this_process {
 
-bool in_virtual_time() { return props_of(boost::fibers::context::active()) != nullptr; }
+bool in_virtual_time() { return running_props() != nullptr; }
 
 VirtualDuration now() {
-  const VirtualProps* p = props_of(boost::fibers::context::active());
+  const VirtualProps* p = running_props();
   return p ? p->clock : VirtualDuration{0};
 }
 
 void advance(VirtualDuration d) {
   if (d.count() < 0) throw std::invalid_argument("csp::this_process::advance: negative duration");
-  boost::fibers::context* self = boost::fibers::context::active();
-  if (VirtualProps* p = props_of(self)) p->scheduler.pass_to(self, *p, p->clock + d);
+  if (VirtualProps* p = running_props()) p->scheduler.pass_to(p->fiber(), *p, p->clock + d);
 }
 
 void sync() {
-  boost::fibers::context* self = boost::fibers::context::active();
-  if (VirtualProps* p = props_of(self)) p->scheduler.pass_to(self, *p, p->clock);
+  if (VirtualProps* p = running_props()) p->scheduler.pass_to(p->fiber(), *p, p->clock);
 }
 
 void delay(std::chrono::nanoseconds d) {

@@ -54,6 +54,7 @@ class VirtualProps final : public ProcessProps {
  public:
   VirtualProps(boost::fibers::context* ctx, VirtualTimeScheduler& scheduler)
       : ProcessProps(ctx, true), scheduler(scheduler) {}
+  boost::fibers::context* fiber() const { return ctx_; }
   VirtualTimeScheduler& scheduler;  // of the fiber's thread
   VirtualDuration clock{0};         // the fiber's virtual time: "now" while it runs
   bool queued = false;              // put in the ready set by pass_to(): skip the next awakened()
@@ -67,7 +68,9 @@ struct VirtualTimeRecord {
 
 class VirtualTimeScheduler final : public Scheduler {
  public:
+  // Made on the runtime thread it schedules, which it marks as keeping virtual time.
   explicit VirtualTimeScheduler(std::shared_ptr<VirtualTimeRecord> record = {});
+  ~VirtualTimeScheduler() override;
 
   boost::fibers::fiber_properties* new_properties(boost::fibers::context* ctx) override;
   void awakened(boost::fibers::context* ctx, ProcessProps& props) noexcept override;
@@ -81,6 +84,9 @@ class VirtualTimeScheduler final : public Scheduler {
   // it joins the ready set at `until` and yields. (Boost.Fiber picks the next
   // fiber before it re-queues a yielding one, so the yielder queues itself.)
   void pass_to(boost::fibers::context* self, VirtualProps& props, VirtualDuration until);
+
+  // The running fiber's properties (null before the first pick).
+  VirtualProps* running() const { return running_; }
 
  private:
   void note_time(std::int64_t t);
