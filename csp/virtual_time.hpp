@@ -101,7 +101,7 @@ class VirtualTimeScheduler final : public Scheduler {
   void push(std::int64_t key, boost::fibers::context* ctx);
   std::deque<boost::fibers::context*> current_;
   std::vector<Entry> later_;  // a heap in a vector: no allocation per push once it has grown
-  std::int64_t now_ = 0;      // the key of the fiber picked last
+  std::int64_t now_ = 0;      // the largest key picked yet: the current virtual time
   // The properties of the fiber picked last, which is the running fiber
   // (Boost resumes what pick_next returns), or null before the first pick.
   VirtualProps* running_ = nullptr;
