@@ -42,6 +42,33 @@ TEST(VirtualTime, ProcessesRunInOrderOfTheirClocks) {
   EXPECT_EQ(order, (std::vector<std::pair<char, std::int64_t>>{{'f', 3}, {'s', 5}}));
 }
 
+// At equal times fibers run in the order they became ready: those that
+// advanced to the time before those woken at it, and a sync() goes behind
+// both.
+TEST(VirtualTime, EqualTimesRunInTheOrderTheyBecameReady) {
+  csp::Runtime rt(virtual_options());
+  csp::Channel<int> wake("wake");
+  std::vector<std::pair<std::string, std::int64_t>> order;
+  rt.spawn("writer", 0, [&] {
+    csp::this_process::advance(10ns);
+    order.emplace_back("writer", now_ns());
+    wake.writer().write(1);  // the reader becomes ready at 10, after "other"
+    csp::this_process::sync();
+    order.emplace_back("writer again", now_ns());
+  });
+  rt.spawn("reader", 0, [&] {
+    wake.reader().read();
+    order.emplace_back("reader", now_ns());
+  });
+  rt.spawn("other", 0, [&] {
+    csp::this_process::advance(10ns);
+    order.emplace_back("other", now_ns());
+  });
+  rt.run();
+  EXPECT_EQ(order, (std::vector<std::pair<std::string, std::int64_t>>{
+                       {"writer", 10}, {"other", 10}, {"reader", 10}, {"writer again", 10}}));
+}
+
 TEST(VirtualTime, ReceiveCompletesAtTheLaterOfSenderAndReceiver) {
   csp::Runtime rt(virtual_options());
   csp::Channel<int> early("early"), late("late");
