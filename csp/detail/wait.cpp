@@ -2,11 +2,25 @@
 #include "csp/detail/wait.hpp"
 
 #include <cstdint>
+#include <thread>
+
+#include <boost/fiber/detail/cpu_relax.hpp>
 
 #include "csp/detail/process.hpp"
 #include "csp/scheduler.hpp"
 
 namespace csp::detail {
+
+void Spinlock::wait_until_free() noexcept {
+  constexpr int spins_before_yield = 64;
+  for (int spins = 0; locked_.load(std::memory_order_relaxed); ++spins) {
+    if (spins < spins_before_yield) {
+      cpu_relax();  // Boost.Fiber's spin-wait hint (a macro)
+    } else {
+      std::this_thread::yield();
+    }
+  }
+}
 
 namespace {
 

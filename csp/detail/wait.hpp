@@ -23,16 +23,33 @@
 #include <atomic>
 #include <chrono>
 #include <cstddef>
+#include <mutex>
 #include <string>
 #include <vector>
 
 #include <boost/fiber/context.hpp>
-#include <boost/fiber/detail/spinlock.hpp>
 
 namespace csp::detail {
 
-using Spinlock = boost::fibers::detail::spinlock;
-using SpinlockLock = boost::fibers::detail::spinlock_lock;
+// A test-and-test-and-set lock guarding a channel (or a bell, or a small
+// piece of runtime state) for a few instructions at a time. Taking it free
+// costs one exchange; a thread that finds it taken watches it with the CPU's
+// spin-wait hint and, after a while, gives up its time slice, so that a
+// holder the OS has preempted can finish.
+class Spinlock {
+ public:
+  void lock() noexcept {
+    while (locked_.exchange(true, std::memory_order_acquire)) wait_until_free();
+  }
+  bool try_lock() noexcept { return !locked_.exchange(true, std::memory_order_acquire); }
+  void unlock() noexcept { locked_.store(false, std::memory_order_release); }
+
+ private:
+  void wait_until_free() noexcept;
+  std::atomic<bool> locked_{false};
+};
+
+using SpinlockLock = std::unique_lock<Spinlock>;
 using Clock = std::chrono::steady_clock;
 
 struct Process;
