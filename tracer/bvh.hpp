@@ -43,8 +43,8 @@ BvhBuild build_bvh(const BuildRefs& refs, int max_leaf);
 // surface area among the children of nodes already placed) joins the page
 // until it is full; the candidates left out become roots of later treelets,
 // and a treelet that ends before its page does is followed on the same page
-// by the next one. A ray going down the tree then changes page about every
-// two levels rather than at every level. The tree itself, and so every ray's
+// by the next one. A ray going down the tree then changes page less often
+// than when only siblings share a page. The tree itself, and so every ray's
 // path, is unchanged; node 0 stays the root and children still follow their
 // parents, but inner siblings are no longer consecutive.
 void lay_out_treelets(BvhBuild& bvh, std::uint32_t nodes_per_page);
