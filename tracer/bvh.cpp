@@ -204,24 +204,27 @@ void set_lane_box(BvhNode& node, int lane, const Box3f& b) {
   if (b.empty()) node.child[lane] = node.count[lane] = 0;
 }
 
+Box3f lane_box(const BvhNode& node, int lane) {
+  Box3f b;
+  for (int a = 0; a < 3; ++a) {
+    b.lo[a] = node.lo[a][lane];
+    b.hi[a] = node.hi[a][lane];
+  }
+  return b;
+}
+
 BvhBuild build_bvh(const BuildRefs& refs, int max_leaf) {
   return Builder(refs.bounds, refs.triangle, max_leaf).run();
 }
 
 namespace {
 
-bool is_inner(const BvhNode& node, int lane) { return node.count[lane] == 0 && node.child[lane] != 0; }
-
 // Half the surface area of the box around a node's lanes: how likely a ray
 // that reaches its parent is to visit it.
 float node_area(const BvhNode& node) {
   Box3f box;
   for (int lane = 0; lane < 4; ++lane) {
-    Box3f b;
-    for (int a = 0; a < 3; ++a) {
-      b.lo[a] = node.lo[a][lane];
-      b.hi[a] = node.hi[a][lane];
-    }
+    const Box3f b = lane_box(node, lane);
     if (!b.empty()) box.extend(b);
   }
   return box.empty() ? 0.0f : box.half_area();
@@ -250,7 +253,7 @@ void lay_out_treelets(BvhBuild& bvh, std::uint32_t nodes_per_page) {
     frontier.pop_back();
     placed.push_back(k);
     for (int lane = 0; lane < 4; ++lane)
-      if (is_inner(bvh.nodes[k], lane)) {
+      if (is_inner_lane(bvh.nodes[k], lane)) {
         frontier.push_back(bvh.nodes[k].child[lane]);
         std::push_heap(frontier.begin(), frontier.end(), below);
       }
@@ -266,7 +269,7 @@ void lay_out_treelets(BvhBuild& bvh, std::uint32_t nodes_per_page) {
   for (std::uint32_t i = 0; i < n; ++i) {
     nodes[i] = bvh.nodes[placed[i]];
     for (int lane = 0; lane < 4; ++lane)
-      if (is_inner(nodes[i], lane)) nodes[i].child[lane] = new_index[nodes[i].child[lane]];
+      if (is_inner_lane(nodes[i], lane)) nodes[i].child[lane] = new_index[nodes[i].child[lane]];
   }
   bvh.nodes = std::move(nodes);
 }

@@ -59,5 +59,9 @@ BuildRefs split_large_triangles(const std::vector<PrimRecord>& prims,
 
 // Sets lane i of a node to box b (an empty Box3f makes the lane unused).
 void set_lane_box(BvhNode& node, int lane, const Box3f& b);
+// Lane i's box (empty for an unused lane): the inverse of set_lane_box.
+Box3f lane_box(const BvhNode& node, int lane);
+// Whether lane i leads to an inner node (rather than to primitives, or nowhere).
+inline bool is_inner_lane(const BvhNode& node, int lane) { return node.count[lane] == 0 && node.child[lane] != 0; }
 
 }  // namespace tracer

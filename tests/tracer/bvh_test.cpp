@@ -139,8 +139,6 @@ BuildRefs random_boxes(unsigned seed, int count) {
   return refs;
 }
 
-bool is_inner(const BvhNode& node, int lane) { return node.count[lane] == 0 && node.child[lane] != 0; }
-
 // Walks both trees from their roots in step: the same lanes everywhere, every
 // node of `relaid` reached once, each after its parent.
 void expect_same_tree(const BvhBuild& original, const BvhBuild& relaid, std::uint32_t a, std::uint32_t b,
@@ -152,8 +150,8 @@ void expect_same_tree(const BvhBuild& original, const BvhBuild& relaid, std::uin
   EXPECT_EQ(0, std::memcmp(x.hi, y.hi, sizeof x.hi));
   for (int lane = 0; lane < 4; ++lane) {
     ASSERT_EQ(x.count[lane], y.count[lane]);
-    ASSERT_EQ(is_inner(x, lane), is_inner(y, lane));
-    if (!is_inner(x, lane)) {
+    ASSERT_EQ(is_inner_lane(x, lane), is_inner_lane(y, lane));
+    if (!is_inner_lane(x, lane)) {
       EXPECT_EQ(x.child[lane], y.child[lane]);  // a leaf's first primitive, or an unused lane
       continue;
     }
@@ -181,9 +179,7 @@ TEST(BvhLayout, TreeletsRenumberTheSameTree) {
 float area_of(const BvhNode& node) {
   Box3f box;
   for (int lane = 0; lane < 4; ++lane)
-    if (node.lo[0][lane] <= node.hi[0][lane])
-      box.extend(Box3f{{node.lo[0][lane], node.lo[1][lane], node.lo[2][lane]},
-                       {node.hi[0][lane], node.hi[1][lane], node.hi[2][lane]}});
+    if (const Box3f b = lane_box(node, lane); !b.empty()) box.extend(b);
   return box.half_area();
 }
 
@@ -195,7 +191,7 @@ void expect_first_page_is_a_treelet(const BvhBuild& bvh, std::uint32_t per_page)
   std::vector<std::uint32_t> parent(bvh.nodes.size(), ~0u);
   for (std::uint32_t i = 0; i < bvh.nodes.size(); ++i)
     for (int lane = 0; lane < 4; ++lane)
-      if (is_inner(bvh.nodes[i], lane)) parent[bvh.nodes[i].child[lane]] = i;
+      if (is_inner_lane(bvh.nodes[i], lane)) parent[bvh.nodes[i].child[lane]] = i;
   const float last = area_of(bvh.nodes[per_page - 1]);
   for (std::uint32_t i = 1; i < per_page; ++i) EXPECT_LT(parent[i], per_page) << "node " << i;
   for (std::uint32_t i = per_page; i < bvh.nodes.size(); ++i) {
