@@ -33,8 +33,7 @@ SerialComparison run_serial(const tracer::Database& db, const nodes::MachineOpti
 }  // namespace
 
 RenderResult render_machine(const Options& o, const tracer::Scene& scene) {
-  tracer::Database db =
-      build_database(scene, {.accel = o.accel, .bvh_layout = o.bvh_layout, .page_size = o.page_size});
+  tracer::Database db = build_database(scene, build_options(o));
   RenderResult out{tracer::Image(scene.camera.width, scene.camera.height), describe_run(o, db)};
   nodes::MachineOptions machine = o.machine;
   machine.trace = {.max_depth = o.max_depth,

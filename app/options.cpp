@@ -192,6 +192,15 @@ const char* bvh_layout_name(tracer::BvhLayout layout) {
   return layout == tracer::BvhLayout::treelet ? "treelet" : "depth-first";
 }
 
+std::string accel_description(tracer::Accel accel, tracer::BvhLayout layout) {
+  if (accel != tracer::Accel::bvh) return accel_name(accel);
+  return std::string(accel_name(accel)) + ", " + bvh_layout_name(layout) + " layout";
+}
+
+tracer::BuildOptions build_options(const Options& o) {
+  return {.accel = o.accel, .bvh_layout = o.bvh_layout, .page_size = o.page_size};
+}
+
 std::string default_output(const std::string& scene) {
   if (scene == "-") return "stdin.png";
   std::string base = scene.substr(scene.find_last_of('/') + 1);

@@ -56,6 +56,10 @@ const char* accel_name(tracer::Accel accel);
 // --bvh-layout: "treelet" or "depth-first"; UsageError otherwise. bvh_layout_name() is the inverse.
 tracer::BvhLayout parse_bvh_layout(const std::string& name);
 const char* bvh_layout_name(tracer::BvhLayout layout);
+// "bvh, treelet layout", "bvh, depth-first layout" or "grid", for reports.
+std::string accel_description(tracer::Accel accel, tracer::BvhLayout layout);
+// The database build the options ask for.
+tracer::BuildOptions build_options(const Options& o);
 // --schedule: "dynamic", "static" or "affinity"; UsageError otherwise.
 nodes::Schedule parse_schedule(const std::string& name);
 // --pixel-order: "scanline" or "hilbert"; UsageError otherwise.

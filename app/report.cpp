@@ -31,9 +31,7 @@ void print_report(std::ostream& out, const RunReport& r) {
       << "image          " << r.output << " (" << r.width << "x" << r.height
       << (r.spd_procedure ? ", SPD procedure" : "") << ")\n"
       << "database       " << r.pages << " pages of " << r.page_size << " bytes = "
-      << r.database_bytes / 1024.0 << " KB (" << accel_name(r.accel)
-      << (r.accel == tracer::Accel::bvh ? std::string(", ") + bvh_layout_name(r.bvh_layout) + " layout" : "")
-      << ", built in "
+      << r.database_bytes / 1024.0 << " KB (" << accel_description(r.accel, r.bvh_layout) << ", built in "
       << r.build.accel_seconds << " s)\n"
       << "rays           " << s.rays() << ": primary " << s.primary << " (hit " << s.primary_hits
       << "), shadow " << s.shadow << ", reflected " << s.reflected << ", refracted "

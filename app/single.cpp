@@ -30,8 +30,7 @@ RunReport describe_run(const Options& o, const tracer::Database& db) {
 }
 
 RenderResult render_single(const Options& o, const tracer::Scene& scene) {
-  const tracer::Database db =
-      build_database(scene, {.accel = o.accel, .bvh_layout = o.bvh_layout, .page_size = o.page_size});
+  const tracer::Database db = build_database(scene, build_options(o));
   RenderResult out{tracer::Image(scene.camera.width, scene.camera.height), describe_run(o, db)};
   tracer::InMemoryPageSource pages(db);
   const tracer::TraceOptions trace{.max_depth = o.max_depth,

@@ -105,8 +105,9 @@ tracer::Database load_database(const SweepOptions& o) {
   render.width = o.size;
   render.height = o.size;
   render.page_size = o.page_size;
-  return tracer::build_database(load_scene(render),
-                                {.accel = o.accel, .bvh_layout = o.bvh_layout, .page_size = o.page_size});
+  render.accel = o.accel;
+  render.bvh_layout = o.bvh_layout;
+  return tracer::build_database(load_scene(render), build_options(render));
 }
 
 std::string fixed(double v, int digits) {
@@ -157,9 +158,7 @@ SweepTable run_sweep(const SweepOptions& o, std::ostream* progress) {
   table.width = db.header.camera.width;
   table.height = db.header.camera.height;
   table.page_count = db.header.page_count;
-  table.tracing = std::string(accel_name(o.accel)) +
-                  (o.accel == tracer::Accel::bvh ? std::string(", ") + bvh_layout_name(o.bvh_layout) + " layout" : "") +
-                  ", shadow rays " +
+  table.tracing = accel_description(o.accel, o.bvh_layout) + ", shadow rays " +
                   (o.trace.shadow_rays_to_all_lights ? "all" : "facing");
   table.farming = std::string(nodes::schedule_name(o.schedule)) + " schedule, grain " + std::to_string(o.grain) +
                   ", prefetch " + std::to_string(o.prefetch) + ", " + nodes::pixel_order_name(o.pixel_order) +
