@@ -26,15 +26,14 @@ thread_local VirtualTimeScheduler* thread_clock = nullptr;
 // The calling fiber's properties, if it runs in virtual time.
 VirtualProps* running_props() { return thread_clock ? thread_clock->running() : nullptr; }
 
+}  // namespace
+
 // Heap order: the entry that runs later sinks (std heaps keep the largest on top).
-struct RunsLater {
-  bool operator()(const std::tuple<std::int64_t, std::uint64_t, boost::fibers::context*>& a,
-                  const std::tuple<std::int64_t, std::uint64_t, boost::fibers::context*>& b) const {
+struct VirtualTimeScheduler::RunsLater {
+  bool operator()(const Entry& a, const Entry& b) const {
     return std::get<0>(a) != std::get<0>(b) ? std::get<0>(a) > std::get<0>(b) : std::get<1>(a) > std::get<1>(b);
   }
 };
-
-}  // namespace
 
 VirtualTimeScheduler::VirtualTimeScheduler(std::shared_ptr<VirtualTimeRecord> record)
     : record_(record ? std::move(record) : std::make_shared<VirtualTimeRecord>()) {

@@ -98,6 +98,7 @@ class VirtualTimeScheduler final : public Scheduler {
   // `now_` moves on only when `current_` is empty, so whatever the heap holds
   // at the new `now_` was queued before anything `current_` gets.
   using Entry = std::tuple<std::int64_t, std::uint64_t, boost::fibers::context*>;
+  struct RunsLater;  // the heap's order
   void push(std::int64_t key, boost::fibers::context* ctx);
   std::deque<boost::fibers::context*> current_;
   std::vector<Entry> later_;  // a heap in a vector: no allocation per push once it has grown
