@@ -2,6 +2,7 @@
 #include "csp/alt.hpp"
 
 #include <algorithm>
+#include <bit>
 #include <functional>
 #include <stdexcept>
 #include <string>
@@ -20,21 +21,21 @@ Alt::Alt(Waiting waiting) {
 Alt::~Alt() {
   if (!bell_) return;
   for (const Guard& g : guards_)
-    if (on_channel(g.kind)) watch(g, nullptr);
+    if (on_channel(g.kind)) watch(g, {});
 }
 
-// Registers (or with null, unregisters) the bell a channel guard's channel
-// rings for this ALT.
-void Alt::watch(const Guard& g, detail::Bell* bell) {
+// Registers (or with an empty mark, unregisters) the bell and mark a
+// channel guard's channel rings for this ALT.
+void Alt::watch(const Guard& g, detail::BellMark mark) {
   detail::ChannelLock lk(g.channel->lock_);
-  detail::Bell*& slot = g.kind == Kind::room ? g.channel->room_bell_ : g.channel->data_bell_;
-  if (bell && slot)
+  detail::BellMark& slot = g.kind == Kind::room ? g.channel->room_bell_ : g.channel->data_bell_;
+  if (mark.bell && slot.bell)
     throw std::logic_error("Alt: '" + g.channel->name() + "' is already watched by another doorbell ALT");
-  slot = bell;
+  slot = mark;
 }
 
 std::size_t Alt::add(Guard g) {
-  if (bell_ && on_channel(g.kind)) watch(g, bell_.get());
+  if (bell_ && on_channel(g.kind)) watch(g, bell_->mark(guards_.size()));
   guards_.push_back(std::move(g));
   dirty_ = true;
   return guards_.size() - 1;
@@ -84,13 +85,17 @@ void Alt::prepare() {
   channels_.clear();
   timeout_guard_ = none;
   has_skip_ = false;
-  pollable_.clear();
-  for (std::size_t i = 0; bell_ && i < guards_.size(); ++i) {
-    const Guard& g = guards_[i];
-    if (!g.enabled) continue;
-    if (on_channel(g.kind)) pollable_.push_back({i, g.channel.get(), g.kind == Kind::room});
-    if (g.kind == Kind::skip || (g.kind == Kind::timeout && g.after <= Clock::duration::zero()))
-      pollable_.push_back({i, nullptr, false});
+  if (bell_) {
+    enabled_.assign((guards_.size() + 63) / 64, 0);
+    always_.assign(enabled_.size(), 0);
+    for (std::size_t i = 0; i < guards_.size(); ++i) {
+      const Guard& g = guards_[i];
+      const std::uint64_t bit = std::uint64_t{1} << (i % 64);
+      if (g.enabled && on_channel(g.kind)) enabled_[i / 64] |= bit;
+      if (g.enabled &&
+          (g.kind == Kind::skip || (g.kind == Kind::timeout && g.after <= Clock::duration::zero())))
+        always_[i / 64] |= bit;
+    }
   }
   for (std::size_t i : by_address_) {
     const Guard& g = guards_[i];
@@ -162,19 +167,32 @@ std::size_t Alt::select_by_bell(std::size_t first) {
   }
 }
 
-// The first ready guard from guard `first` on, over the guards prepare()
-// listed as possibly ready: SKIP, an expired timeout, or a channel whose
-// hint says ready, confirmed under its lock alone.
+// The first ready guard from guard `first` on, in rotation, among the
+// enabled guards that are always ready (SKIP, an expired timeout) or whose
+// channel rang the bell since it was last found not ready (see Bell): each
+// such channel's mark is cleared, and its hint confirmed under its lock alone.
 std::size_t Alt::poll_each(std::size_t first) const {
-  const std::size_t n = pollable_.size();
-  std::size_t start = 0;
-  while (start < n && pollable_[start].guard < first) ++start;
-  for (std::size_t k = 0; k < n; ++k) {
-    const Pollable& p = pollable_[(start + k) % n];
-    if (!p.channel) return p.guard;
-    if (!(p.room ? p.channel->room_hint() : p.channel->ready_hint())) continue;
-    detail::ChannelLock lk(p.channel->lock_);
-    if (p.room ? p.channel->room_locked() : p.channel->ready_locked()) return p.guard;
+  const std::size_t words = enabled_.size();
+  const std::size_t first_word = first / 64;
+  const std::uint64_t from_first = ~std::uint64_t{0} << (first % 64);
+  // Word first_word twice: guards from `first` on, then, last, those before it.
+  for (std::size_t k = 0; k <= words; ++k) {
+    const std::size_t w = (first_word + k) % words;
+    std::uint64_t candidates = (bell_->marks(w) & enabled_[w]) | always_[w];
+    if (k == 0) candidates &= from_first;
+    if (k == words) candidates &= ~from_first;
+    for (; candidates; candidates &= candidates - 1) {
+      const std::size_t i = w * 64 + static_cast<std::size_t>(std::countr_zero(candidates));
+      const Guard& g = guards_[i];
+      if (!on_channel(g.kind)) return i;
+      bell_->clear_mark(i);
+      if (!hinted(g)) continue;
+      detail::ChannelLock lk(g.channel->lock_);
+      if (ready_locked(g)) {
+        bell_->keep_mark(i);
+        return i;
+      }
+    }
   }
   return none;
 }

@@ -19,19 +19,22 @@
 // A poisoned channel counts as ready; the read or write throws Poisoned.
 //
 // Waiting::doorbell trades that linking for a bell: each channel guard
-// registers this ALT's bell with its channel once, and the channel rings it
-// (detail/wait.hpp) when it may have become ready for this ALT; a select
-// polls the guards, and if none is ready parks on the bell alone, then polls
-// again. That makes a park cost one lock instead of two locks and a record
-// link per channel, and the channels' other ends one bell ring per write or
-// freed slot. For a process that selects over several busy channels and
-// often finds none ready, such as a router. A channel has one reader and
+// registers this ALT's bell, and its own mark bit in it, with its channel
+// once, and the channel rings it (detail/wait.hpp) when it may have become
+// ready for this ALT; a select polls only the guards whose channels rang
+// since they were last found not ready, and if none is ready parks on the
+// bell alone, then polls again. That makes a park cost one lock instead of
+// two locks and a record link per channel, a poll cost what rang rather than
+// how many guards there are, and the channels' other ends one bell ring per
+// write or freed slot. For a process that selects over many busy channels
+// and often finds none ready, such as a router. A channel has one reader and
 // one writer, so at most one doorbell ALT per end may watch it; the ALT
 // unregisters when destroyed.
 #pragma once
 
 #include <chrono>
 #include <cstddef>
+#include <cstdint>
 #include <memory>
 #include <stdexcept>
 #include <vector>
@@ -82,7 +85,7 @@ class Alt {
   std::size_t select_from(std::size_t first);
   std::size_t select_by_bell(std::size_t first);
   std::size_t poll_each(std::size_t first) const;
-  void watch(const Guard& g, detail::Bell* bell);
+  void watch(const Guard& g, detail::BellMark mark);
   void prepare();
   void sort_by_address();
   std::size_t poll_hints(std::size_t first) const;
@@ -106,12 +109,9 @@ class Alt {
   std::size_t timeout_guard_ = none;            // earliest enabled timeout
   bool has_skip_ = false;
   std::vector<detail::Record> records_;         // scratch: one per enabled input
-  struct Pollable {
-    std::size_t guard;
-    detail::ChannelBase* channel;  // null: SKIP or an expired timeout, always ready
-    bool room;
-  };
-  std::vector<Pollable> pollable_;              // doorbell only: enabled guards that may be ready, by index
+  // Doorbell only, one bit per guard (64 to a word, as the bell's marks):
+  std::vector<std::uint64_t> enabled_;  // enabled input and room guards
+  std::vector<std::uint64_t> always_;   // enabled SKIP and expired timeouts
   std::unique_ptr<detail::Bell> bell_;          // doorbell waiting only
 };
 

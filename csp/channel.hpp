@@ -114,7 +114,7 @@ class ChannelState final : public ChannelBase {
     rec.slot = &value;
     writers_.push_back(rec);
     publish_hints_locked();
-    if (data_bell_) data_bell_->ring();
+    data_bell_.ring();
     finish_wait(park(w, lk.get()), rec, writers_);
   }
 
@@ -144,7 +144,7 @@ class ChannelState final : public ChannelBase {
       }
       if (Record* alt = claim_front_locked(room_waiters_)) complete(*alt->waiter, WaitState::data, alt->guard);
       publish_hints_locked();
-      if (room_bell_) room_bell_->ring();
+      room_bell_.ring();
       return v;
     }
     if (Record* r = claim_front_locked(writers_)) {
@@ -173,7 +173,7 @@ class ChannelState final : public ChannelBase {
     }
     if (count_ == capacity_) return false;
     push_locked(std::move(value));
-    if (data_bell_) data_bell_->ring();
+    data_bell_.ring();
     return true;
   }
 

@@ -68,16 +68,22 @@ void ChannelBase::poison() {
   wake_all_locked(readers_, WaitState::poisoned);
   wake_all_locked(writers_, WaitState::poisoned);
   wake_all_locked(room_waiters_, WaitState::poisoned);
-  if (data_bell_) data_bell_->ring();
-  if (room_bell_) room_bell_->ring();
+  data_bell_.ring();
+  room_bell_.ring();
 }
 
 // Called with a channel's lock held, whose release flushes any cross-thread
 // wake this queues.
-void Bell::ring() {
-  if (rung_.exchange(true, std::memory_order_acq_rel)) return;  // already rung, not yet seen
+void Bell::wake() {
   SpinlockLock lk(lock_);
   if (Record* r = claim_front_locked(readers_)) complete(*r->waiter, WaitState::data, 0);
+}
+
+BellMark Bell::mark(std::size_t guard) {
+  while (marks_.size() <= guard / 64) marks_.push_back(std::make_unique<std::atomic<std::uint64_t>>(0));
+  std::atomic<std::uint64_t>& word = *marks_[guard / 64];
+  word.fetch_or(mark_bit(guard), std::memory_order_relaxed);
+  return BellMark{this, &word, mark_bit(guard)};
 }
 
 WaitState Bell::wait(Waiter& w, Clock::time_point deadline) {

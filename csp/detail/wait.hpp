@@ -23,6 +23,8 @@
 #include <atomic>
 #include <chrono>
 #include <cstddef>
+#include <cstdint>
+#include <memory>
 #include <mutex>
 #include <string>
 #include <vector>
@@ -55,6 +57,16 @@ using Clock = std::chrono::steady_clock;
 struct Process;
 class ChannelBase;
 class Bell;
+
+// Where a channel rings a doorbell ALT: the ALT's bell, and the mark bit of
+// the guard that watches the channel (see Bell). No bell: nobody watches.
+struct BellMark {
+  Bell* bell = nullptr;
+  std::atomic<std::uint64_t>* word = nullptr;
+  std::uint64_t bit = 0;
+
+  void ring() const;
+};
 
 // How a wait ended. `claiming` is transient: held by a claimer between its CAS
 // and complete(), always under a channel lock.
@@ -129,8 +141,8 @@ class ChannelBase {
   // read without blocking (a value buffered, a writer parked, poison),
   // room_bell_ after every change that frees a slot for its writer (and by
   // poison). Rung with lock_ held: the lock order is channel, then bell.
-  Bell* data_bell_ = nullptr;
-  Bell* room_bell_ = nullptr;
+  BellMark data_bell_;
+  BellMark room_bell_;
 
  protected:
   // Lock must be held. Claims and completes the first live record of q with
@@ -150,20 +162,31 @@ class ChannelBase {
 };
 
 // The bell of a doorbell ALT: a one-bit event with one waiter, the ALT's
-// owner, who clears it before each poll of its channels and then waits.
-// ring() sets it and, if it was clear, wakes the waiter when parked; wait()
-// returns at once if it was rung since the last clear, else parks until the
-// next ring or the deadline. Every ring is a release on rung_ (an exchange,
-// so a run of rings forms one release sequence) and every clear an acquire,
-// so a channel change made before a ring is visible to the poll that follows
-// the clear or the wait that sees it.
+// owner, who clears it before each poll of its channels and then waits, and
+// one mark bit per guard, which says which channels rang.
+// ring() sets the ringing guard's mark, then the bell, and if the bell was
+// clear wakes the waiter when parked; wait() returns at once if it was rung
+// since the last clear, else parks until the next ring or the deadline.
+// Every ring is a release on its mark word and on rung_ (exchanges, so runs
+// of rings form release sequences), and the owner clears both with acquire
+// exchanges, so a channel change made before a ring is visible to the poll
+// that clears its mark, and to the poll that follows the clear of the bell
+// or the wait that sees it.
+// Marks: only the owner clears a mark, and only just before it looks at the
+// channel, so a mark is clear only while its channel has not rung since a
+// look that found it not ready. A poll may therefore skip every guard whose
+// mark is clear. Mark words are allocated by the owner as guards are added
+// and never move, so channels ring them without a lock.
 class Bell final : public ChannelBase {
  public:
   explicit Bell(std::string name) : ChannelBase(std::move(name), 0) {}
   bool ready_locked() const override { return rung_.load(std::memory_order_relaxed); }
   bool room_locked() const override { return true; }
 
-  void ring();
+  void ring(std::atomic<std::uint64_t>& word, std::uint64_t bit) {
+    word.fetch_or(bit, std::memory_order_release);
+    if (!rung_.exchange(true, std::memory_order_acq_rel)) wake();  // else already rung, not yet seen
+  }
   void clear() {
     if (rung_.load(std::memory_order_relaxed)) rung_.exchange(false, std::memory_order_acq_rel);
   }
@@ -171,11 +194,34 @@ class Bell final : public ChannelBase {
   // timed_out (deadline first) or aborted (deadlocked run: unwind).
   WaitState wait(Waiter& w, Clock::time_point deadline);
 
+  // Owner only. The mark of guard `guard`, set (so that the first poll looks
+  // at its channel); allocated on first use.
+  BellMark mark(std::size_t guard);
+  // Owner only: the 64 marks of guards 64 w .. 64 w + 63 (0 if none added).
+  std::uint64_t marks(std::size_t w) const {
+    return w < marks_.size() ? marks_[w]->load(std::memory_order_relaxed) : 0;
+  }
+  // Owner only, before it looks at guard's channel: clears its mark.
+  void clear_mark(std::size_t guard) {
+    marks_[guard / 64]->fetch_and(~mark_bit(guard), std::memory_order_acq_rel);
+  }
+  // Owner only, after finding guard's channel ready: keeps it marked, since
+  // it may stay ready after the owner acts on it.
+  void keep_mark(std::size_t guard) { marks_[guard / 64]->fetch_or(mark_bit(guard), std::memory_order_relaxed); }
+
  private:
+  static std::uint64_t mark_bit(std::size_t guard) { return std::uint64_t{1} << (guard % 64); }
+  void wake();
+
   // Set only by ring(), cleared only by the waiter. Once a ring finds it
   // clear, that ring wakes the waiter if it is parked (under lock_).
   std::atomic<bool> rung_{false};
+  std::vector<std::unique_ptr<std::atomic<std::uint64_t>>> marks_;  // stable addresses
 };
+
+inline void BellMark::ring() const {
+  if (bell) bell->ring(*word, bit);
+}
 
 // Claiming: try_claim() wins the waiter or reports a lost race; complete()
 // (winner only, under the channel lock) publishes the outcome and wakes it.

@@ -81,6 +81,45 @@ TEST_P(Alt, FairSelectStarvesNoGuard) {
   for (int c : chosen) EXPECT_EQ(c, selections / n);
 }
 
+// More guards than fit one word of the doorbell's marks: with every guard
+// ready, fair selects take them in turn, across the word boundaries.
+TEST_P(Alt, FairSelectTakesManyReadyGuardsInTurn) {
+  constexpr int n = 130;
+  std::vector<csp::Channel<int>> chans;
+  for (int i = 0; i < n; ++i) chans.emplace_back("in" + std::to_string(i), 2);
+  csp::Alt alt(GetParam());
+  std::vector<csp::In<int>> ins;
+  for (int i = 0; i < n; ++i) {
+    chans[i].writer().write(i);
+    chans[i].writer().write(i);
+    ins.push_back(chans[i].reader());
+    alt.add_input(ins.back());
+  }
+  for (int s = 0; s < 2 * n; ++s) {
+    const std::size_t i = alt.select();
+    ASSERT_EQ(i, static_cast<std::size_t>(s % n)) << "select " << s;
+    EXPECT_EQ(ins[i].read(), s % n);
+  }
+}
+
+// A guard found not ready, then disabled while its channel becomes ready, is
+// chosen once enabled again, with nothing more written.
+TEST_P(Alt, InputThatBecameReadyWhileDisabledIsChosenOnceEnabled) {
+  csp::Channel<int> c("c", 1);
+  csp::Alt alt(GetParam());
+  auto in = c.reader();
+  const std::size_t input = alt.add_input(in);
+  const std::size_t skip = alt.add_skip();
+  EXPECT_EQ(alt.pri_select(), skip);  // c looked at and found empty
+  alt.enable(input, false);
+  c.writer().write(7);
+  EXPECT_EQ(alt.pri_select(), skip);
+  alt.enable(input, true);
+  EXPECT_EQ(alt.pri_select(), input);
+  EXPECT_EQ(in.read(), 7);
+  EXPECT_EQ(alt.pri_select(), skip);
+}
+
 TEST_P(Alt, PriSelectPrefersLowestReadyIndex) {
   const csp::Alt::Waiting waiting = GetParam();
   csp::Runtime rt(1);
