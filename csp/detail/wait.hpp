@@ -167,11 +167,11 @@ class ChannelBase {
 // ring() sets the ringing guard's mark, then the bell, and if the bell was
 // clear wakes the waiter when parked; wait() returns at once if it was rung
 // since the last clear, else parks until the next ring or the deadline.
-// Every ring is a release on its mark word and on rung_ (exchanges, so runs
-// of rings form release sequences), and the owner clears both with acquire
-// exchanges, so a channel change made before a ring is visible to the poll
-// that clears its mark, and to the poll that follows the clear of the bell
-// or the wait that sees it.
+// Every ring is a release on its mark word and on rung_ (read-modify-writes,
+// so runs of rings form release sequences), and the owner clears both with
+// acquire read-modify-writes, so a channel change made before a ring is
+// visible to the poll that clears its mark, and to the poll that follows the
+// clear of the bell or the wait that sees it.
 // Marks: only the owner clears a mark, and only just before it looks at the
 // channel, so a mark is clear only while its channel has not rung since a
 // look that found it not ready. A poll may therefore skip every guard whose
