@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <cstring>
+#include <limits>
 #include <stdexcept>
 #include <string>
 
@@ -56,31 +57,9 @@ NodeMemory::NodeMemory(const PagePlacement& placement, int node, std::size_t pag
   // More slots than remote pages could never be filled.
   capacity_ = std::min(cache_pages, placement.page_count() - own);
   slots_.reserve(capacity_);
-  prev_.assign(capacity_, -1);
-  next_.assign(capacity_, -1);
+  last_use_.assign(capacity_, 0);
   pins_.assign(capacity_, 0);
   slot_page_.assign(capacity_, 0);
-}
-
-void NodeMemory::unlink(int slot) {
-  const auto s = static_cast<std::size_t>(slot);
-  (prev_[s] >= 0 ? next_[static_cast<std::size_t>(prev_[s])] : head_) = next_[s];
-  (next_[s] >= 0 ? prev_[static_cast<std::size_t>(next_[s])] : tail_) = prev_[s];
-  prev_[s] = next_[s] = -1;
-}
-
-void NodeMemory::push_front(int slot) {
-  const auto s = static_cast<std::size_t>(slot);
-  prev_[s] = -1;
-  next_[s] = head_;
-  (head_ >= 0 ? prev_[static_cast<std::size_t>(head_)] : tail_) = slot;
-  head_ = slot;
-}
-
-void NodeMemory::touch(int slot) {
-  if (slot == head_) return;
-  unlink(slot);
-  push_front(slot);
 }
 
 int NodeMemory::take_slot() {
@@ -88,10 +67,14 @@ int NodeMemory::take_slot() {
     slots_.push_back(std::make_unique<std::byte[]>(page_size_));
     return static_cast<int>(slots_.size() - 1);
   }
-  int victim = tail_;
-  while (victim >= 0 && pins_[static_cast<std::size_t>(victim)] > 0) victim = prev_[static_cast<std::size_t>(victim)];
+  int victim = -1;
+  std::uint64_t oldest = std::numeric_limits<std::uint64_t>::max();
+  for (std::size_t s = 0; s < slots_.size(); ++s)
+    if (last_use_[s] < oldest && pins_[s] == 0) {
+      oldest = last_use_[s];
+      victim = static_cast<int>(s);
+    }
   if (victim < 0) throw std::logic_error("page cache: every slot is pinned");
-  unlink(victim);
   entry_[slot_page_[static_cast<std::size_t>(victim)]] = -1;
   ++evictions_;
   return victim;
@@ -105,7 +88,7 @@ int NodeMemory::install(std::uint32_t page, std::span<const std::byte> bytes) {
   std::memcpy(slots_[static_cast<std::size_t>(slot)].get(), bytes.data(), page_size_);
   slot_page_[static_cast<std::size_t>(slot)] = page;
   entry_[page] = -2 - slot;
-  push_front(slot);
+  touch(slot);
   return slot;
 }
 

@@ -10,9 +10,11 @@
 //  - entry_[p] says where page p lives on this node, so one array load
 //    answers every access: >= 0 own page (its index in own_), -1 not here,
 //    <= -2 cache slot (-2 - entry).
-//  - the LRU list holds exactly the occupied slots, most recent at the head;
-//    touching, installing and evicting are O(1) (eviction skips pinned
-//    slots, of which there are at most one per worker).
+//  - each occupied slot carries the time of its last use, a counter that
+//    every touch and install advances, so stamps are distinct and order the
+//    slots exactly as an LRU list would. A touch is one store, which keeps
+//    the hit path short; only an install into a full cache pays, scanning
+//    the slots for the oldest unpinned one (O(capacity), once per miss).
 //  - a pinned slot is never evicted: a worker pins the slot whose bytes it
 //    is using, so another worker of the node cannot pull them away.
 //  - resident bytes = own pages + occupied slots; slots are allocated on
@@ -66,7 +68,7 @@ class NodeMemory {
   const std::byte* own_page(std::int32_t index) const { return own_[static_cast<std::size_t>(index)].data(); }
   const std::byte* slot_bytes(int slot) const { return slots_[static_cast<std::size_t>(slot)].get(); }
 
-  void touch(int slot);  // make most recently used
+  void touch(int slot) { last_use_[static_cast<std::size_t>(slot)] = ++clock_; }  // make most recently used
   void pin(int slot) { ++pins_[static_cast<std::size_t>(slot)]; }
   void unpin(int slot) { --pins_[static_cast<std::size_t>(slot)]; }
 
@@ -90,8 +92,6 @@ class NodeMemory {
 
  private:
   int take_slot();
-  void unlink(int slot);
-  void push_front(int slot);
 
   std::size_t page_size_;
   std::uint32_t capacity_;
@@ -99,8 +99,9 @@ class NodeMemory {
   std::vector<std::int32_t> entry_;
   std::vector<std::unique_ptr<std::byte[]>> slots_;  // stable addresses
   std::vector<std::uint32_t> slot_page_;
-  std::vector<int> prev_, next_, pins_;
-  int head_ = -1, tail_ = -1;  // most / least recently used occupied slot
+  std::vector<std::uint64_t> last_use_;  // per slot: clock_ at its last touch or install
+  std::vector<int> pins_;
+  std::uint64_t clock_ = 0;
   std::uint64_t evictions_ = 0;
   std::unordered_map<std::uint32_t, std::vector<int>> pending_;  // page -> waiting workers
 };

@@ -5,6 +5,9 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <list>
+#include <random>
 #include <set>
 #include <vector>
 
@@ -99,6 +102,46 @@ TEST(NodeMemory, PinnedSlotIsNeverEvicted) {
   memory.unpin(old_slot);
   memory.install(9, page_bytes(9));
   EXPECT_EQ(memory.entry(1), -1);
+}
+
+// A long random run of installs, touches and pins against a plain list kept
+// in recency order: the cache must hold exactly the pages the list says.
+TEST(NodeMemory, MatchesAListKeptInRecencyOrder) {
+  constexpr std::uint32_t pages = 200, capacity = 7;
+  const PagePlacement placement(Distribution::modulo, 2, pages);
+  NodeMemory memory(placement, 0, page_size, own_pages(placement, 0), capacity);
+  std::list<std::uint32_t> recency;  // cached pages, most recent first
+  std::vector<int> pins(capacity, 0);
+  std::mt19937 random(5);
+  for (int step = 0; step < 20000; ++step) {
+    const std::uint32_t page = 2 * (random() % (pages / 2)) + 1;  // node 1's pages
+    const std::int32_t entry = memory.entry(page);
+    if (NodeMemory::is_slot(entry)) {
+      const int slot = NodeMemory::slot_of_entry(entry);
+      memory.touch(slot);
+      recency.remove(page);
+      recency.push_front(page);
+      if (random() % 4 == 0) {  // pin or unpin, keeping one slot free to evict
+        const bool may_pin = std::count_if(pins.begin(), pins.end(), [](int n) { return n > 0; }) + 1 < int{capacity};
+        if (pins[slot] > 0) memory.unpin(slot), --pins[slot];
+        else if (may_pin) memory.pin(slot), ++pins[slot];
+      }
+      continue;
+    }
+    ASSERT_EQ(entry, -1);
+    if (recency.size() == capacity) {
+      auto victim = recency.end();
+      do --victim;
+      while (pins[NodeMemory::slot_of_entry(memory.entry(*victim))] > 0);
+      recency.erase(victim);
+    }
+    memory.install(page, page_bytes(page));
+    recency.push_front(page);
+    for (std::uint32_t p = 1; p < pages; p += 2)
+      ASSERT_EQ(NodeMemory::is_slot(memory.entry(p)), std::find(recency.begin(), recency.end(), p) != recency.end())
+          << "page " << p << " after step " << step;
+  }
+  EXPECT_GT(memory.evictions(), 1000u);
 }
 
 TEST(NodeMemory, AllSlotsPinnedIsAnError) {
