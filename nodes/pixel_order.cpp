@@ -6,9 +6,16 @@
 // parts join end to start. Halves are rounded so that the parts keep an
 // even length where possible, which keeps every step a unit step except in
 // the odd cases the header names.
+//
+// A walk's steps depend only on its axes, not on its corner, and the halving
+// meets the same small rectangles over and over; so the steps of every small
+// walk are kept, as offsets from its corner, and replayed when its axes come
+// again. The order is the plain recursion's, item for item.
 #include "nodes/pixel_order.hpp"
 
+#include <array>
 #include <cstdlib>
+#include <map>
 #include <stdexcept>
 #include <string>
 
@@ -37,6 +44,27 @@ class HilbertWalk {
   // axis (bx, by); each axis is along x or y, its length the rectangle's side.
   void walk(int x, int y, int ax, int ay, int bx, int by) {
     const int w = std::abs(ax + ay), h = std::abs(bx + by);
+    if (std::int64_t{w} * h > replay_area) return split(x, y, ax, ay, bx, by);
+    const std::uint32_t corner = position(x, y);
+    const Axes axes{ax, ay, bx, by};
+    if (const auto kept = steps_.find(axes); kept != steps_.end()) {
+      for (const std::uint32_t offset : kept->second) out_.push_back(corner + offset);
+      return;
+    }
+    const std::size_t first = out_.size();
+    split(x, y, ax, ay, bx, by);
+    std::vector<std::uint32_t> offsets(out_.begin() + static_cast<std::ptrdiff_t>(first), out_.end());
+    for (std::uint32_t& offset : offsets) offset -= corner;  // modulo 2^32, undone by the addition above
+    steps_.emplace(axes, std::move(offsets));
+  }
+
+ private:
+  using Axes = std::array<int, 4>;
+  // Walks of at most this many cells are kept for replay.
+  static constexpr int replay_area = 4096;
+
+  void split(int x, int y, int ax, int ay, int bx, int by) {
+    const int w = std::abs(ax + ay), h = std::abs(bx + by);
     const int dax = sign(ax), day = sign(ay), dbx = sign(bx), dby = sign(by);
     if (h == 1) {
       for (int i = 0; i < w; ++i, x += dax, y += day) emit(x, y);
@@ -62,13 +90,14 @@ class HilbertWalk {
          -(ay - ay2));  // back down, beside the first part
   }
 
- private:
-  void emit(int x, int y) {
-    out_.push_back(static_cast<std::uint32_t>(y) * static_cast<std::uint32_t>(width_) + static_cast<std::uint32_t>(x));
+  std::uint32_t position(int x, int y) const {
+    return static_cast<std::uint32_t>(y) * static_cast<std::uint32_t>(width_) + static_cast<std::uint32_t>(x);
   }
+  void emit(int x, int y) { out_.push_back(position(x, y)); }
 
   int width_;
   std::vector<std::uint32_t>& out_;
+  std::map<Axes, std::vector<std::uint32_t>> steps_;  // offsets from the corner, by axes
 };
 
 }  // namespace
