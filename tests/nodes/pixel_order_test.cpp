@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <cstdlib>
 #include <stdexcept>
+#include <utility>
 #include <vector>
 
 namespace {
@@ -27,25 +28,35 @@ TEST(PixelOrder, ScanlineIsTheIdentityAndNeedsNoTable) {
   EXPECT_TRUE(item_positions(7, 5, PixelOrder::scanline).empty());
 }
 
+// Every cell exactly once, each step to a neighbour (diagonal only where a side is odd).
+void expect_every_cell_once_in_single_steps(int width, int height) {
+  const auto positions = item_positions(width, height, PixelOrder::hilbert);
+  ASSERT_EQ(positions.size(), static_cast<std::size_t>(width) * static_cast<std::size_t>(height))
+      << width << "x" << height;
+  std::vector<int> seen(positions.size(), 0);
+  for (std::size_t k = 0; k < positions.size(); ++k) {
+    ASSERT_LT(positions[k], positions.size()) << width << "x" << height;
+    ASSERT_EQ(++seen[positions[k]], 1) << width << "x" << height << " position " << positions[k];
+    if (k == 0) continue;
+    const Cell a = cell(positions[k - 1], width), b = cell(positions[k], width);
+    const int dx = std::abs(a.x - b.x), dy = std::abs(a.y - b.y);
+    ASSERT_LE(std::max(dx, dy), 1) << width << "x" << height << " item " << k;
+    if (dx + dy == 2) {
+      ASSERT_TRUE(width % 2 != 0 || height % 2 != 0) << width << "x" << height << " item " << k;
+    }
+  }
+}
+
 TEST(PixelOrder, HilbertVisitsEveryCellOnceInSingleSteps) {
   for (int width = 1; width <= 40; ++width)
-    for (int height = 1; height <= 40; ++height) {
-      const auto positions = item_positions(width, height, PixelOrder::hilbert);
-      ASSERT_EQ(positions.size(), static_cast<std::size_t>(width * height)) << width << "x" << height;
-      std::vector<int> seen(positions.size(), 0);
-      for (std::size_t k = 0; k < positions.size(); ++k) {
-        ASSERT_LT(positions[k], positions.size()) << width << "x" << height;
-        ASSERT_EQ(++seen[positions[k]], 1) << width << "x" << height << " position " << positions[k];
-        if (k == 0) continue;
-        const Cell a = cell(positions[k - 1], width), b = cell(positions[k], width);
-        const int dx = std::abs(a.x - b.x), dy = std::abs(a.y - b.y);
-        ASSERT_LE(std::max(dx, dy), 1) << width << "x" << height << " item " << k;
-        // A diagonal step only where a side is odd.
-        if (dx + dy == 2) {
-          ASSERT_TRUE(width % 2 != 0 || height % 2 != 0) << width << "x" << height << " item " << k;
-        }
-      }
-    }
+    for (int height = 1; height <= 40; ++height) expect_every_cell_once_in_single_steps(width, height);
+}
+
+// Frames far larger than the walks the order keeps and replays, so that
+// replayed pieces are joined by the recursion above them.
+TEST(PixelOrder, HilbertOnLargeFramesVisitsEveryCellOnceInSingleSteps) {
+  for (const auto& [width, height] : {std::pair{512, 512}, {300, 200}, {257, 131}, {131, 257}, {1000, 3}, {97, 4099}})
+    expect_every_cell_once_in_single_steps(width, height);
 }
 
 TEST(PixelOrder, HilbertOnAPowerOfTwoSquareIsTheClassicCurve) {
