@@ -90,10 +90,10 @@ void Alt::prepare() {
     always_.assign(enabled_.size(), 0);
     for (std::size_t i = 0; i < guards_.size(); ++i) {
       const Guard& g = guards_[i];
+      if (!g.enabled) continue;
       const std::uint64_t bit = std::uint64_t{1} << (i % 64);
-      if (g.enabled && on_channel(g.kind)) enabled_[i / 64] |= bit;
-      if (g.enabled &&
-          (g.kind == Kind::skip || (g.kind == Kind::timeout && g.after <= Clock::duration::zero())))
+      if (on_channel(g.kind)) enabled_[i / 64] |= bit;
+      if (g.kind == Kind::skip || (g.kind == Kind::timeout && g.after <= Clock::duration::zero()))
         always_[i / 64] |= bit;
     }
   }
