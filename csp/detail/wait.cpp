@@ -1,6 +1,8 @@
 // Waiter claiming, parking and the channel queues (see wait.hpp).
 #include "csp/detail/wait.hpp"
 
+#include <array>
+#include <cstddef>
 #include <cstdint>
 #include <thread>
 
@@ -29,9 +31,13 @@ namespace {
 // the two reschedules the fiber (the same protocol as Boost's own channels).
 std::intptr_t timed_token(const Waiter& w) { return reinterpret_cast<std::intptr_t>(&w); }
 
-// Contexts on other threads, claimed under a lock still held. Emptied before
-// the fiber suspends, so it never carries over to another fiber.
-thread_local std::vector<boost::fibers::context*> deferred_wakes;
+// Contexts on other threads, claimed under a lock still held: the first
+// deferred_wake_count entries. Emptied before the fiber suspends, so it
+// never carries over to another fiber. A lock rarely completes more than
+// one waiter; when the buffer is full the wakes are issued at once, under
+// the lock, which is correct, only slower.
+constexpr std::size_t deferred_wake_capacity = 64;
+constinit thread_local std::array<boost::fibers::context*, deferred_wake_capacity> deferred_wakes{};
 
 // Cached here because context::active() is a costly TLS lookup in Boost's
 // shared library, and a thread's scheduler never changes.
@@ -138,15 +144,18 @@ void complete(Waiter& w, WaitState outcome, std::size_t fired) {
     if (ctx->get_scheduler() == local) {
       local->schedule(ctx);
     } else {
-      deferred_wakes.push_back(ctx);
+      if (deferred_wake_count == deferred_wake_capacity) issue_deferred_wakes();
+      deferred_wakes[deferred_wake_count++] = ctx;
     }
   }
 }
 
-void flush_wakes() {
-  if (deferred_wakes.empty()) return;
-  for (boost::fibers::context* ctx : deferred_wakes) ctx->get_scheduler()->schedule_from_remote(ctx);
-  deferred_wakes.clear();
+constinit thread_local std::size_t deferred_wake_count = 0;
+
+void issue_deferred_wakes() {
+  for (std::size_t i = 0; i < deferred_wake_count; ++i)
+    deferred_wakes[i]->get_scheduler()->schedule_from_remote(deferred_wakes[i]);
+  deferred_wake_count = 0;
 }
 
 boost::fibers::scheduler* thread_scheduler() { return runtime_scheduler; }

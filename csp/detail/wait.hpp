@@ -231,7 +231,15 @@ inline void BellMark::ring() const {
 // the woken thread spins on that very lock.
 bool try_claim(Waiter& w);
 void complete(Waiter& w, WaitState outcome, std::size_t fired);
-void flush_wakes();
+
+// Cross-thread wakes deferred on this thread and not yet issued. Every
+// channel unlock reads it, so it is a constant-initialised thread_local
+// that the inline test below reaches without a call.
+extern constinit thread_local std::size_t deferred_wake_count;
+void issue_deferred_wakes();
+inline void flush_wakes() {
+  if (deferred_wake_count != 0) issue_deferred_wakes();
+}
 
 // A held channel lock that issues the deferred cross-thread wakes when it is
 // released (by the destructor, or by sleep() just before the fiber suspends).
