@@ -93,8 +93,7 @@ void Alt::prepare() {
       if (!g.enabled) continue;
       const std::uint64_t bit = std::uint64_t{1} << (i % 64);
       if (on_channel(g.kind)) enabled_[i / 64] |= bit;
-      if (g.kind == Kind::skip || (g.kind == Kind::timeout && g.after <= Clock::duration::zero()))
-        always_[i / 64] |= bit;
+      if (always_ready(g)) always_[i / 64] |= bit;
     }
   }
   for (std::size_t i : by_address_) {
@@ -142,8 +141,7 @@ std::size_t Alt::poll_locked(std::size_t first) const {
     const std::size_t i = (first + k) % n;
     const Guard& g = guards_[i];
     if (!g.enabled) continue;
-    const bool ready = g.kind == Kind::skip || (on_channel(g.kind) && ready_locked(g)) ||
-                       (g.kind == Kind::timeout && g.after <= Clock::duration::zero());
+    const bool ready = always_ready(g) || (on_channel(g.kind) && ready_locked(g));
     if (ready) return i;
   }
   return none;
@@ -251,6 +249,11 @@ void Alt::unlink_records() {
   for (const Guard& g : guards_) {
     if (g.enabled && on_channel(g.kind)) queue_of(g).erase(*record++);
   }
+}
+
+// Ready without a channel: SKIP, and a timeout already expired.
+bool Alt::always_ready(const Guard& g) {
+  return g.kind == Kind::skip || (g.kind == Kind::timeout && g.after <= Clock::duration::zero());
 }
 
 // A channel guard's readiness: data (or poison) for an input, a free slot

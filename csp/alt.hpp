@@ -92,6 +92,7 @@ class Alt {
   std::size_t poll_locked(std::size_t first) const;
   std::size_t wait_locked(std::size_t timeout_guard, detail::Clock::time_point deadline);
   void unlink_records();
+  static bool always_ready(const Guard& g);
   static bool hinted(const Guard& g);
   static bool ready_locked(const Guard& g);
   static detail::RecordQueue& queue_of(const Guard& g);
