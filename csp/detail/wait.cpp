@@ -45,6 +45,8 @@ thread_local boost::fibers::scheduler* runtime_scheduler = nullptr;
 
 }  // namespace
 
+constinit thread_local std::size_t deferred_wake_count = 0;
+
 void RecordQueue::push_back(Record& r) {
   r.prev = tail_;
   r.next = nullptr;
@@ -149,8 +151,6 @@ void complete(Waiter& w, WaitState outcome, std::size_t fired) {
     }
   }
 }
-
-constinit thread_local std::size_t deferred_wake_count = 0;
 
 void issue_deferred_wakes() {
   for (std::size_t i = 0; i < deferred_wake_count; ++i)
