@@ -1,8 +1,13 @@
-// Human-readable and JSON forms of MachineSummary; see machine_report.hpp.
+// Human-readable and JSON forms of MachineSummary, and the tile timeline as
+// CSV; see machine_report.hpp.
 #include "app/machine_report.hpp"
 
 #include <algorithm>
+#include <fstream>
 #include <iomanip>
+#include <stdexcept>
+#include <tuple>
+#include <vector>
 
 #include "app/report.hpp"
 #include "nodes/messages.hpp"
@@ -184,6 +189,28 @@ void write_machine_json(std::ostream& out, const MachineSummary& m, const std::s
         << ", \"speedup\": " << m.speedup() << ", \"efficiency\": " << m.efficiency() << "}";
   else out << "null";
   out << "\n" << indent << "}";
+}
+
+void write_tiles_csv(const std::string& path, const nodes::MachineReport& report) {
+  struct Row {
+    std::size_t node;
+    const nodes::TileSpan* span;
+  };
+  std::vector<Row> rows;
+  for (std::size_t n = 0; n < report.per_node.size(); ++n)
+    for (const nodes::TileSpan& span : report.per_node[n].work.spans) rows.push_back({n, &span});
+  std::stable_sort(rows.begin(), rows.end(), [](const Row& a, const Row& b) {
+    return std::tie(a.span->start, a.node, a.span->worker) < std::tie(b.span->start, b.node, b.span->worker);
+  });
+  std::ofstream f(path);
+  if (!f) throw std::runtime_error(path + ": cannot open for writing");
+  f << std::setprecision(9) << "node,worker,first_item,items,start_s,end_s,page_requests,rays\n";
+  for (const Row& r : rows) {
+    const nodes::TileSpan& s = *r.span;
+    f << r.node << ',' << s.worker << ',' << s.tile.first << ',' << s.tile.count << ',' << s.start << ',' << s.end
+      << ',' << s.page_requests << ',' << s.rays << '\n';
+  }
+  if (!f.flush()) throw std::runtime_error(path + ": cannot write");
 }
 
 }  // namespace app

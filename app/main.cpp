@@ -31,6 +31,8 @@ int run(const app::Options& o) {
   if (!o.quiet) app::print_report(std::cout, result.report);
   // Asked for by name, so printed even when --quiet.
   if (result.report.machine) std::cout << nodes::format_routes(result.report.machine->report);
+  if (result.report.machine && !o.tiles_csv.empty())
+    app::write_tiles_csv(o.tiles_csv, result.report.machine->report);
   if (result.report.machine)
     app::write_machine_pictures({o.pictures.machine_svg, o.pictures.ownership_png, o.pictures.report_html},
                                 result.report.scene, result.image, result.report.machine->report);

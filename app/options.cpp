@@ -80,6 +80,9 @@ po::options_description describe_machine(Options& o, Raw& raw) {
        "page p on node p mod N (modulo), or consecutive runs of pages (block)")
       ("trace-routes", po::value(&raw.trace_routes)->default_value(0),
        "print the routes of the first N packets hop by hop")
+      ("tiles", po::value(&o.tiles_csv),
+       "write a CSV row per tile: node, worker, first item, items, start and end seconds (wall, or virtual "
+       "with --timing virtual), page requests and rays")
       ("compare-serial", po::bool_switch(&o.compare_serial),
        "also run the 1-node machine; report speedup and efficiency T1/(N*TN)");
   add_timing_options(d, raw.timing, o.pictures);
@@ -152,6 +155,10 @@ void check_machine(Options& o, const Raw& raw, const po::variables_map& vm) {
   else if (raw.distribution == "block") m.distribution = nodes::Distribution::block;
   else throw UsageError("--distribution: expected modulo or block, got '" + raw.distribution + "'");
   m.timing = timing_from(raw.timing);
+  if (!o.tiles_csv.empty()) {
+    if (o.single) throw UsageError("--tiles: --single renders without a machine, so without tiles");
+    m.record_tiles = true;
+  }
 }
 
 }  // namespace

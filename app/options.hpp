@@ -43,6 +43,7 @@ struct Options {
   // distribution and route tracing; trace and progress are filled in at run time.
   nodes::MachineOptions machine;
   PicturePaths pictures;  // written after a machine render (timing_options.hpp)
+  std::string tiles_csv;  // the machine's tile timeline (machine_report.hpp), none when empty
 };
 
 // Throws UsageError. argv[0] is the program name.

@@ -85,6 +85,7 @@ struct Wiring {
   ItemGrid grid;
   std::uint64_t processes;  // sending processes, for packet ids
   MachineTiming* timing;    // null unless in virtual time
+  RunClock tile_clock;      // empty unless tiles are recorded
 
   Outbox outbox(NodeId n, std::uint16_t port) const {
     const std::uint64_t ports = Ports::count(options.workers_per_node);
@@ -128,7 +129,7 @@ void spawn_node(const Wiring& w, NodeId n, NodeState& node) {
         name + " pixel computer " + std::to_string(i), thread,
         [&w, port, &source, &in, &out, &counters, charge, timeslice] {
           PixelComputer(port, w.options.prefetch, source, w.header, w.options.trace, w.grid, in, out, counters, charge,
-                        timeslice)
+                        timeslice, w.tile_clock)
               .run();
         },
         prioritised ? csp::Priority::low : csp::Priority::high);
@@ -178,6 +179,7 @@ NodeReport node_report(const NodeState& node) {
     r.work.items += w.items;
     r.work.tiles += w.tiles;
     r.work.rays += w.rays;
+    r.work.spans.insert(r.work.spans.end(), w.spans.begin(), w.spans.end());
   }
   const NodeMemory& memory = node.svm->memory();
   r.own_bytes = memory.own_bytes();
@@ -185,6 +187,12 @@ NodeReport node_report(const NodeState& node) {
   r.cache_capacity = memory.cache_capacity();
   r.evictions = memory.evictions();
   return r;
+}
+
+// Seconds since `started` on the wall clock, or the calling process's virtual clock.
+RunClock run_clock(std::chrono::steady_clock::time_point started, bool virtual_time) {
+  if (virtual_time) return [] { return std::chrono::duration<double>(csp::this_process::now()).count(); };
+  return [started] { return std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count(); };
 }
 
 double imbalance(const std::vector<double>& values) {
@@ -244,8 +252,15 @@ MachineResult run_machine(tracer::Database db, const MachineOptions& options) {
   const std::vector<std::uint32_t> positions = item_positions(grid.width, rows, options.pixel_order);
   grid.positions = positions;
   const auto items = static_cast<std::uint32_t>(grid.width) * static_cast<std::uint32_t>(rows);
-  const Wiring wiring{runtime, net, placement, header, options, grid, topology.size() * net_options.ports_per_node,
-                      timing ? &*timing : nullptr};
+  const Wiring wiring{runtime,
+                      net,
+                      placement,
+                      header,
+                      options,
+                      grid,
+                      topology.size() * net_options.ports_per_node,
+                      timing ? &*timing : nullptr,
+                      options.record_tiles ? run_clock(started, timing.has_value()) : RunClock{}};
   Host host;
   host.plan = std::make_unique<WorkPlan>(items, options.grain, options.schedule, static_cast<int>(topology.size()),
                                          options.workers_per_node);

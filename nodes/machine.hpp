@@ -75,6 +75,7 @@ struct MachineOptions {
   std::uint16_t prefetch = 1;          // tiles a worker has asked for beyond the one it traces
   Distribution distribution = Distribution::modulo;
   std::uint64_t trace_routes = 0;      // record the routes of the first N packets
+  bool record_tiles = false;           // a TileSpan per tile in each NodeReport's work.spans
   std::size_t buffer_capacity = 4;     // packets per network queue
   tracer::TraceOptions trace;
   std::optional<CostModel> timing;     // virtual time under this model (the run takes one thread)
@@ -90,7 +91,7 @@ inline std::uint16_t max_prefetch(const MachineOptions& options) {
 struct NodeReport {
   SvmStats svm;
   ServerCounters served;
-  WorkerCounters work;          // summed over the node's workers
+  WorkerCounters work;          // summed over the node's workers; spans of all, worker by worker
   std::size_t own_bytes = 0;    // scene bytes the node owns
   std::size_t peak_resident_bytes = 0;  // own pages + cache slots ever used
   std::uint32_t cache_capacity = 0;     // pages

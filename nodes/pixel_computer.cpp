@@ -3,6 +3,7 @@
 
 #include <stdexcept>
 #include <string>
+#include <utility>
 
 namespace nodes {
 
@@ -42,7 +43,7 @@ Packet WorkerPort::page_reply() {
 PixelComputer::PixelComputer(std::uint16_t port, std::uint16_t prefetch, SvmSource& source,
                              const tracer::DatabaseHeader& header, tracer::TraceOptions options, ItemGrid grid,
                              WorkerPort& in, Outbox& out, WorkerCounters& counters, std::function<void()> after_tile,
-                             std::uint32_t timeslice)
+                             std::uint32_t timeslice, RunClock clock)
     : port_(port),
       prefetch_(prefetch),
       source_(source),
@@ -52,7 +53,8 @@ PixelComputer::PixelComputer(std::uint16_t port, std::uint16_t prefetch, SvmSour
       out_(out),
       counters_(counters),
       after_tile_(std::move(after_tile)),
-      timeslice_(timeslice) {}
+      timeslice_(timeslice),
+      clock_(std::move(clock)) {}
 
 void PixelComputer::run() {
   std::uint32_t owed = prefetch_ + 1u;  // answers the farmer still has to send
@@ -64,9 +66,15 @@ void PixelComputer::run() {
     --owed;
     if (static_cast<MessageKind>(answer.kind) == MessageKind::stop) continue;
     const Tile tile = decode_tile(answer.payload);
+    const double start = clock_ ? clock_() : 0.0;
+    const std::uint64_t requests_before = source_.stats().misses;
+    const std::uint64_t rays_before = counters_.rays.rays();
     compute(tile);
     source_.release();  // before the hook too: it may suspend this fiber
     if (after_tile_) after_tile_();
+    if (clock_)
+      counters_.spans.push_back({port_ - Ports::first_worker, tile, start, clock_(),
+                                 source_.stats().misses - requests_before, counters_.rays.rays() - rays_before});
     out_.send(make_packet(0, Ports::farmer, MessageKind::result, encode_result(port_, tile, colors_)));
     ++owed;
   }

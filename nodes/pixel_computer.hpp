@@ -31,6 +31,7 @@
 #include <deque>
 #include <functional>
 #include <span>
+#include <vector>
 
 #include "csp/csp.hpp"
 #include "nodes/messages.hpp"
@@ -40,10 +41,27 @@
 
 namespace nodes {
 
+// Seconds since the run began: wall time, or the calling process's virtual
+// clock under virtual time.
+using RunClock = std::function<double()>;
+
+// One tile as its worker traced it, for timelines of the farming: from the
+// tile's first item to its result leaving (virtual time: after its work was
+// charged), and the page requests and rays it took.
+struct TileSpan {
+  int worker = 0;  // on its node
+  Tile tile;
+  double start = 0;
+  double end = 0;
+  std::uint64_t page_requests = 0;
+  std::uint64_t rays = 0;
+};
+
 struct WorkerCounters {
   std::uint64_t items = 0;  // pixels (or SPD corner samples) computed
   std::uint64_t tiles = 0;
   tracer::RayStats rays;
+  std::vector<TileSpan> spans;  // one per tile, in order, when the machine records them
 };
 
 // What a work item is: a pixel (x, y), or an SPD corner sample on the
@@ -73,7 +91,7 @@ class PixelComputer {
  public:
   PixelComputer(std::uint16_t port, std::uint16_t prefetch, SvmSource& source, const tracer::DatabaseHeader& header,
                 tracer::TraceOptions options, ItemGrid grid, WorkerPort& in, Outbox& out, WorkerCounters& counters,
-                std::function<void()> after_tile = {}, std::uint32_t timeslice = 0);
+                std::function<void()> after_tile = {}, std::uint32_t timeslice = 0, RunClock clock = {});
   void run();
 
  private:
@@ -90,6 +108,7 @@ class PixelComputer {
   std::vector<tracer::Color> colors_;
   std::function<void()> after_tile_;  // before the result is sent: virtual time charges the work here
   std::uint32_t timeslice_;           // items traced between two csp::yield()s; 0: never yield
+  RunClock clock_;                    // set: record a TileSpan per tile
 };
 
 // The miss path of a worker's SvmSource: page_request to the owner, then

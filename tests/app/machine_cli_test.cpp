@@ -292,6 +292,44 @@ TEST_F(MachineCli, TraceRoutesPrintsThatManyRouteLines) {
   }
 }
 
+// One row per tile, in order of start, covering every pixel once; --tiles
+// needs a machine.
+TEST_F(MachineCli, TilesWritesOneCsvRowPerTile) {
+  const Outcome r = run(std::string(kSmall) + " -q --grain 5 -o out.png --tiles tiles.csv --stats s.json");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  std::istringstream in(read_file(dir_ / "tiles.csv"));
+  std::string line;
+  std::getline(in, line);
+  EXPECT_EQ(line, "node,worker,first_item,items,start_s,end_s,page_requests,rays");
+  std::vector<int> computed(32 * 32, 0);
+  std::size_t rows = 0;
+  double previous_start = 0;
+  std::uint64_t requests = 0;
+  while (std::getline(in, line)) {
+    ++rows;
+    std::istringstream row(line);
+    std::vector<double> f;
+    for (std::string field; std::getline(row, field, ',');) f.push_back(std::stod(field));
+    ASSERT_EQ(f.size(), 8u) << line;
+    EXPECT_GE(f[4], previous_start) << line;
+    EXPECT_LE(f[4], f[5]) << line;
+    previous_start = f[4];
+    for (auto i = static_cast<std::size_t>(f[2]); i < static_cast<std::size_t>(f[2] + f[3]); ++i) ++computed.at(i);
+    requests += static_cast<std::uint64_t>(f[6]);
+  }
+  const Json doc = JsonReader(read_file(dir_ / "s.json")).document();
+  double tiles = 0;
+  for (const Json& node : doc["machine"]["per_node"].items) tiles += node["tiles"].number;
+  EXPECT_EQ(rows, static_cast<std::size_t>(tiles));
+  EXPECT_EQ(requests, static_cast<std::uint64_t>(doc["machine"]["svm"]["misses"].number));
+  EXPECT_EQ(std::count(computed.begin(), computed.end(), 1), 32 * 32);
+
+  const Outcome single = run(std::string(kSmall) + " --single -o single.png --tiles t.csv");
+  EXPECT_EQ(single.exit_code, 2);
+  EXPECT_NE(single.err.find("--tiles"), std::string::npos) << single.err;
+  EXPECT_FALSE(fs::exists(dir_ / "t.csv"));
+}
+
 TEST_F(MachineCli, CompareSerialReportsSpeedupAndEfficiency) {
   const Outcome r = run(std::string(kSmall) + " --nodes 4 --compare-serial -o out.png --stats s.json");
   ASSERT_EQ(r.exit_code, 0) << r.err;

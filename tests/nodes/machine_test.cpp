@@ -8,6 +8,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cstring>
 #include <map>
 #include <string>
@@ -197,6 +198,46 @@ TEST(Machine, EveryPixelIsComputedExactlyOnce) {
   EXPECT_EQ(r.farmer.stops, 16u * 2u * 2u);
   EXPECT_EQ(r.farmer.results, r.farmer.tiles);
   EXPECT_EQ(r.rays().samples, pixels);
+}
+
+// The tile timeline accounts for the whole run: each item in exactly one
+// tile, and per node the tiles' items, page requests and rays add up to the
+// node's counts; no tile ends before it starts. Off by default.
+TEST(Machine, RecordedTilesCoverEveryItemOnceAndAddUpPerNode) {
+  const Case c{"hypercube", 8, 2, 256, 3, Schedule::affinity, 2, 2};
+  EXPECT_TRUE(run_case(c).report.per_node[0].work.spans.empty());
+  MachineOptions options;
+  options.topology = c.topology;
+  options.nodes = c.nodes;
+  options.threads = c.threads;
+  options.cache_pages = c.cache_pages;
+  options.grain = c.grain;
+  options.schedule = c.schedule;
+  options.workers_per_node = c.workers;
+  options.record_tiles = true;
+  const auto result = nodes::run_machine(make_db(c.scene, c.page_size, c.size), options);
+  const auto& r = result.report;
+  EXPECT_TRUE(same_bits(result.image.pixels(), cached_reference(c.scene, c.size)));
+  std::vector<int> times_computed(r.items, 0);
+  for (const nodes::NodeReport& node : r.per_node) {
+    std::uint64_t items = 0, requests = 0, rays = 0;
+    for (const nodes::TileSpan& s : node.work.spans) {
+      EXPECT_GE(s.worker, 0);
+      EXPECT_LT(s.worker, c.workers);
+      EXPECT_LE(s.start, s.end);
+      EXPECT_GE(s.start, 0.0);
+      EXPECT_LE(s.end, r.wall_seconds);
+      for (std::uint32_t i = s.tile.first; i < s.tile.first + s.tile.count; ++i) ++times_computed.at(i);
+      items += s.tile.count;
+      requests += s.page_requests;
+      rays += s.rays;
+    }
+    EXPECT_EQ(node.work.spans.size(), node.work.tiles);
+    EXPECT_EQ(items, node.work.items);
+    EXPECT_EQ(requests, node.svm.misses);
+    EXPECT_EQ(rays, node.work.rays.rays());
+  }
+  EXPECT_EQ(std::count(times_computed.begin(), times_computed.end(), 1), static_cast<long>(r.items));
 }
 
 // Prefetch changes only when work arrives: the same image, every item once,

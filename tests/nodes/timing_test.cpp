@@ -4,6 +4,7 @@
 // parsers' errors.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cstdio>
 #include <fstream>
 #include <string>
@@ -96,8 +97,9 @@ TEST(Timing, MessageSoftwareCostsBothProcessorsTwoMessagesPerPageRequest) {
 }
 
 nodes::MachineResult run_timed(const std::string& topology, std::size_t n, unsigned threads,
-                               const CostModel& model) {
+                               const CostModel& model, bool record_tiles = false) {
   nodes::MachineOptions options;
+  options.record_tiles = record_tiles;
   options.topology = topology;
   options.nodes = n;
   options.threads = threads;
@@ -120,6 +122,33 @@ TEST(Timing, SameRunGivesSamePredictionOnAnyThreadCount) {
     for (std::size_t n = 0; n < a.report.per_node.size(); ++n)
       EXPECT_EQ(r->report.per_node[n].work.items, a.report.per_node[n].work.items) << "node " << n;
   }
+}
+
+// Under virtual time a tile's start and end are virtual clock readings: the
+// same on every run, and within the predicted synthesis time.
+TEST(Timing, TileTimelineIsVirtualAndTheSameOnAnyThreadCount) {
+  const CostModel model = nodes::ipsc2_profile();
+  const auto a = run_timed("hypercube", 8, 1, model, true);
+  const auto b = run_timed("hypercube", 8, 2, model, true);
+  double last_end = 0;
+  for (std::size_t n = 0; n < a.report.per_node.size(); ++n) {
+    const auto& sa = a.report.per_node[n].work.spans;
+    const auto& sb = b.report.per_node[n].work.spans;
+    ASSERT_EQ(sa.size(), sb.size()) << "node " << n;
+    ASSERT_FALSE(sa.empty()) << "node " << n;
+    for (std::size_t i = 0; i < sa.size(); ++i) {
+      EXPECT_EQ(sa[i].tile.first, sb[i].tile.first) << "node " << n << " tile " << i;
+      EXPECT_EQ(sa[i].start, sb[i].start) << "node " << n << " tile " << i;
+      EXPECT_EQ(sa[i].end, sb[i].end) << "node " << n << " tile " << i;
+      EXPECT_LT(sa[i].start, sa[i].end) << "node " << n << " tile " << i;
+      if (i > 0) {
+        EXPECT_LE(sa[i - 1].end, sa[i].start) << "node " << n << " tile " << i;  // one worker: one tile at a time
+      }
+      last_end = std::max(last_end, sa[i].end);
+    }
+  }
+  EXPECT_LE(last_end, a.report.predicted_seconds);
+  EXPECT_GT(last_end, 0.9 * a.report.predicted_seconds);
 }
 
 TEST(Timing, MoreHopsCostMore) {
