@@ -9,8 +9,8 @@
 #include <stdexcept>
 
 #include "app/viz/colour.hpp"
+#include "app/viz/legend.hpp"
 #include "app/viz/svg.hpp"
-#include "app/viz/ticks.hpp"
 
 namespace viz {
 namespace {
@@ -210,33 +210,16 @@ void draw_node(SvgDocument& doc, int id, const NodeWork& w, Vec2 centre, const V
   doc.close();
 }
 
-void gradient(SvgDocument& doc, const std::string& id, Rgb8 (*scale)(double)) {
-  doc.open("linearGradient", {{"id", id}});
-  for (int i = 0; i <= 10; ++i)
-    doc.leaf("stop", {{"offset", num(i / 10.0)}, {"stop-color", hex(scale(i / 10.0))}});
-  doc.close();
-}
-
-void colour_bar(SvgDocument& doc, double x, double y, const std::string& id, const std::string& caption,
-                std::uint64_t max) {
-  doc.text(caption, {{"x", num(x)}, {"y", num(y)}, {"font-size", "12"}});
-  doc.leaf("rect", {{"x", num(x)}, {"y", num(y + 6)}, {"width", "160"}, {"height", "10"},
-                    {"fill", "url(#" + id + ")"}, {"stroke", "#333333"}});
-  doc.text("0", {{"x", num(x)}, {"y", num(y + 30)}, {"font-size", "11"}});
-  doc.text(format_number(static_cast<double>(max)),
-           {{"x", num(x + 160)}, {"y", num(y + 30)}, {"font-size", "11"}, {"text-anchor", "end"}});
-}
-
 void draw_legend(SvgDocument& doc, double y, const Scales& s) {
   doc.open("g", {{"class", "legend"}});
   doc.open("defs", {});
   // Fixed ids with fixed content: duplicates across inlined SVGs are harmless.
-  gradient(doc, "viz-work-scale", work_scale);
-  gradient(doc, "viz-traffic-scale", traffic_scale);
+  scale_gradient(doc, "viz-work-scale", work_scale);
+  scale_gradient(doc, "viz-traffic-scale", traffic_scale);
   doc.close();
-  colour_bar(doc, 20, y, "viz-work-scale", "node fill: pixels computed", s.max_pixels);
+  colour_bar(doc, 20, y, "viz-work-scale", "node fill: pixels computed", static_cast<double>(s.max_pixels));
   colour_bar(doc, 220, y, "viz-traffic-scale", s.by_bytes ? "link: bytes carried" : "link: packets carried",
-             s.max_link);
+             static_cast<double>(s.max_link));
   doc.text("ring width: page requests served (max " + std::to_string(s.max_requests) + ")",
            {{"x", "420"}, {"y", num(y)}, {"font-size", "12"}});
   doc.text("each direction drawn on its right-hand side", {{"x", "420"}, {"y", num(y + 18)}, {"font-size", "11"}});
