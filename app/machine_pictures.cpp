@@ -1,4 +1,5 @@
-// Machine drawing, pixel ownership and the run's HTML page (see machine_pictures.hpp).
+// Machine drawing, pixel ownership, the tile timeline and the run's HTML page
+// (see machine_pictures.hpp).
 #include "app/machine_pictures.hpp"
 
 #include <fstream>
@@ -68,6 +69,18 @@ std::vector<std::uint16_t> pixel_owners(const nodes::MachineReport& report, int 
   return owners;
 }
 
+viz::Timeline timeline(const nodes::MachineReport& report) {
+  viz::Timeline t;
+  t.title = report.topology + ", " + std::to_string(report.threads) + " thread(s): tiles over time";
+  t.time_axis = report.cost_model.empty() ? "wall time (s)" : "virtual time (s)";
+  t.nodes = report.nodes;
+  t.workers_per_node = report.workers_per_node;
+  for (std::size_t n = 0; n < report.per_node.size(); ++n)
+    for (const nodes::TileSpan& s : report.per_node[n].work.spans)
+      t.tiles.push_back({static_cast<int>(n), s.worker, s.tile.first, s.tile.count, s.start, s.end, s.page_requests});
+  return t;
+}
+
 viz::KeyValueTable machine_statistics(const nodes::MachineReport& r) {
   const tracer::RayStats rays = r.rays();
   const nodes::SvmStats svm = r.svm();
@@ -95,8 +108,18 @@ std::vector<std::filesystem::path> write_machine_pictures(const PictureFiles& fi
                                                           const tracer::Image& image,
                                                           const nodes::MachineReport& report) {
   std::vector<std::filesystem::path> written;
-  if (files.machine_svg.empty() && files.ownership_png.empty() && files.report_html.empty()) return written;
+  if (files.machine_svg.empty() && files.ownership_png.empty() && files.report_html.empty() &&
+      files.timeline_svg.empty())
+    return written;
   const std::string machine = viz::machine_svg(machine_drawing(report));
+  std::string tiles;
+  if (!files.timeline_svg.empty() || !files.report_html.empty()) {
+    const viz::Timeline t = timeline(report);
+    if (t.tiles.size() != report.farmer.tiles)
+      throw std::invalid_argument("tile timeline: the run recorded " + std::to_string(t.tiles.size()) + " of its " +
+                                  std::to_string(report.farmer.tiles) + " tiles");
+    tiles = viz::timeline_svg(t);
+  }
   const tracer::Image ownership =
       viz::ownership_image(image.width(), image.height(), pixel_owners(report, image.width(), image.height()));
   if (!files.machine_svg.empty()) {
@@ -107,12 +130,17 @@ std::vector<std::filesystem::path> write_machine_pictures(const PictureFiles& fi
     ownership.write_image(files.ownership_png.string());
     written.push_back(files.ownership_png);
   }
+  if (!files.timeline_svg.empty()) {
+    write_file(files.timeline_svg, tiles);
+    written.push_back(files.timeline_svg);
+  }
   if (!files.report_html.empty()) {
     viz::Section run{.heading = title};
     run.blocks.push_back(viz::ImageFigure{.caption = "rendered image", .image = image});
     run.blocks.push_back(machine_statistics(report));
     run.blocks.push_back(viz::SvgFigure{.caption = "the machine after the run", .svg = machine});
     run.blocks.push_back(viz::ImageFigure{.caption = "which processor computed each pixel", .image = ownership});
+    run.blocks.push_back(viz::SvgFigure{.caption = "when each processor traced each tile", .svg = tiles});
     for (const auto& f : viz::write_html_report(files.report_html, viz::Report{.title = title, .sections = {run}}))
       written.push_back(f);
   }

@@ -1,6 +1,7 @@
 // Pictures of a machine run: the topology with its link traffic and node work
-// (SVG), which processor computed each pixel (PNG), and one HTML page with
-// the image, the statistics, the machine picture and the ownership image.
+// (SVG), which processor computed each pixel (PNG), when each processor
+// traced each tile (SVG, from a run that recorded its tiles), and one HTML
+// page with the image, the statistics and those pictures.
 // Pure functions of a finished run's report; nothing here runs the machine.
 #pragma once
 
@@ -10,6 +11,7 @@
 
 #include "app/viz/machine.hpp"
 #include "app/viz/report.hpp"
+#include "app/viz/timeline.hpp"
 #include "nodes/machine.hpp"
 #include "tracer/image.hpp"
 
@@ -22,6 +24,9 @@ viz::MachineDrawing machine_drawing(const nodes::MachineReport& report);
 // corner samples ((W+1) x (H+1) items) a pixel belongs to its top-left corner.
 std::vector<std::uint16_t> pixel_owners(const nodes::MachineReport& report, int width, int height);
 
+// Every recorded tile on a time axis, wall or virtual as the run was.
+viz::Timeline timeline(const nodes::MachineReport& report);
+
 // The statistics of a run as rows for the HTML page.
 viz::KeyValueTable machine_statistics(const nodes::MachineReport& report);
 
@@ -29,10 +34,13 @@ struct PictureFiles {
   std::filesystem::path machine_svg;    // empty: not written
   std::filesystem::path ownership_png;  // empty: not written
   std::filesystem::path report_html;    // empty: not written
+  std::filesystem::path timeline_svg;   // empty: not written
 };
 
-// Writes the pictures asked for (none: nothing to do); returns every file written. Throws
-// std::runtime_error naming the path if one cannot be written.
+// Writes the pictures asked for (none: nothing to do); returns every file written. The
+// timeline, alone or in the page, needs a run that recorded its tiles
+// (std::invalid_argument otherwise). Throws std::runtime_error naming the path if one
+// cannot be written.
 std::vector<std::filesystem::path> write_machine_pictures(const PictureFiles& files, const std::string& title,
                                                           const tracer::Image& image,
                                                           const nodes::MachineReport& report);

@@ -34,7 +34,8 @@ int run(const app::Options& o) {
   if (result.report.machine && !o.tiles_csv.empty())
     app::write_tiles_csv(o.tiles_csv, result.report.machine->report);
   if (result.report.machine)
-    app::write_machine_pictures({o.pictures.machine_svg, o.pictures.ownership_png, o.pictures.report_html},
+    app::write_machine_pictures(
+        {o.pictures.machine_svg, o.pictures.ownership_png, o.pictures.report_html, o.pictures.timeline_svg},
                                 result.report.scene, result.image, result.report.machine->report);
   return 0;
 }

@@ -155,10 +155,12 @@ void check_machine(Options& o, const Raw& raw, const po::variables_map& vm) {
   else if (raw.distribution == "block") m.distribution = nodes::Distribution::block;
   else throw UsageError("--distribution: expected modulo or block, got '" + raw.distribution + "'");
   m.timing = timing_from(raw.timing);
-  if (!o.tiles_csv.empty()) {
-    if (o.single) throw UsageError("--tiles: --single renders without a machine, so without tiles");
+  for (const auto& [option, path] : {std::pair{"--tiles", &o.tiles_csv}, {"--timeline", &o.pictures.timeline_svg}}) {
+    if (path->empty()) continue;
+    if (o.single) throw UsageError(std::string(option) + ": --single renders without a machine, so without tiles");
     m.record_tiles = true;
   }
+  if (!o.pictures.report_html.empty()) m.record_tiles = true;
 }
 
 }  // namespace

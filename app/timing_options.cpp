@@ -20,6 +20,8 @@ void add_timing_options(po::options_description& d, TimingChoice& timing, Pictur
        "costs over the profile: box=,prim=,shade=,page=,serve=,msg=,hop= (s, ms, us, ns), bw= (B/s, KB/s, MB/s)")
       ("machine-svg", po::value(&pictures.machine_svg), "after a machine render: the machine with its traffic, SVG")
       ("ownership", po::value(&pictures.ownership_png), "after a machine render: which node computed each pixel, PNG")
+      ("timeline", po::value(&pictures.timeline_svg),
+       "after a machine render: when each processor traced each tile, coloured by its page requests, SVG")
       ("report", po::value(&pictures.report_html),
        "after a machine render: HTML page with the image, statistics and pictures");
 }

@@ -1,6 +1,6 @@
 // The command-line face of virtual time and of the pictures of a machine run:
 // --timing real|virtual, --profile NAME|FILE, --cost key=value,...,
-// --machine-svg, --ownership, --report. Kept apart from options.cpp so the
+// --machine-svg, --ownership, --timeline, --report. Kept apart from options.cpp so the
 // sweep subcommand parses machine models the same way.
 #pragma once
 
@@ -22,7 +22,8 @@ struct TimingChoice {
 struct PicturePaths {
   std::string machine_svg;    // the machine with its traffic, after a machine render
   std::string ownership_png;  // which processor computed each pixel
-  std::string report_html;    // image, statistics, machine picture and ownership together
+  std::string report_html;    // image, statistics, machine picture, ownership and timeline together
+  std::string timeline_svg;   // when each processor traced each tile
 };
 
 void add_timing_options(boost::program_options::options_description& d, TimingChoice& timing,

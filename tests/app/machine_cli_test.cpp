@@ -330,6 +330,22 @@ TEST_F(MachineCli, TilesWritesOneCsvRowPerTile) {
   EXPECT_FALSE(fs::exists(dir_ / "t.csv"));
 }
 
+TEST_F(MachineCli, TimelineDrawsARowPerNode) {
+  const Outcome r = run(std::string(kSmall) + " -q --nodes 8 -o out.png --timeline tiles.svg");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const std::string svg = read_file(dir_ / "tiles.svg");
+  EXPECT_TRUE(svg.starts_with("<svg")) << svg.substr(0, 40);
+  std::size_t rows = 0;
+  for (std::size_t at = svg.find("class=\"row\""); at != std::string::npos; at = svg.find("class=\"row\"", at + 1))
+    ++rows;
+  EXPECT_EQ(rows, 8u);
+  EXPECT_NE(svg.find("wall time (s)"), std::string::npos);
+
+  const Outcome single = run(std::string(kSmall) + " --single -o single.png --timeline t.svg");
+  EXPECT_EQ(single.exit_code, 2);
+  EXPECT_NE(single.err.find("--timeline"), std::string::npos) << single.err;
+}
+
 TEST_F(MachineCli, CompareSerialReportsSpeedupAndEfficiency) {
   const Outcome r = run(std::string(kSmall) + " --nodes 4 --compare-serial -o out.png --stats s.json");
   ASSERT_EQ(r.exit_code, 0) << r.err;

@@ -17,7 +17,7 @@ namespace {
 
 namespace fs = std::filesystem;
 
-nodes::MachineResult small_run(bool corners) {
+nodes::MachineResult small_run(bool corners, bool record_tiles = true) {
   tracer::Scene scene = tracer::generate_scene("teapot:2");
   scene.camera.width = 12;
   scene.camera.height = 10;
@@ -27,6 +27,7 @@ nodes::MachineResult small_run(bool corners) {
   options.threads = 1;
   options.trace.spd_procedure = corners;
   options.timing = nodes::ipsc2_profile();
+  options.record_tiles = record_tiles;
   return nodes::run_machine(tracer::build_database(scene, {}), options);
 }
 
@@ -58,13 +59,17 @@ TEST(MachinePictures, WritesWellFormedSvgAndAPageLinkingOnlyItsFiles) {
   fs::remove_all(dir);
   fs::create_directories(dir);
   const auto run = small_run(false);
-  const app::PictureFiles files{dir / "machine.svg", dir / "owners.png", dir / "run.html"};
+  const app::PictureFiles files{dir / "machine.svg", dir / "owners.png", dir / "run.html", dir / "tiles.svg"};
   const auto written = app::write_machine_pictures(files, "teapot on a 2x2 mesh", run.image, run.report);
 
   const auto svg = viz::test::check_xml(read(files.machine_svg));
   ASSERT_TRUE(svg.ok) << svg.error;
   EXPECT_EQ(viz::test::count_class(svg, "node"), 4u);
   EXPECT_EQ(tracer::read_png(files.ownership_png.string()).width, 12);
+  const auto tiles = viz::test::check_xml(read(files.timeline_svg));
+  ASSERT_TRUE(tiles.ok) << tiles.error;
+  EXPECT_EQ(viz::test::count_class(tiles, "row"), 4u);
+  EXPECT_EQ(viz::test::count_class(tiles, "tile"), run.report.farmer.tiles);  // few tiles: none narrower than a pixel
 
   std::set<std::string> names;
   for (const auto& f : written) names.insert(f.filename().string());
@@ -76,6 +81,18 @@ TEST(MachinePictures, WritesWellFormedSvgAndAPageLinkingOnlyItsFiles) {
     EXPECT_TRUE(names.count((*it)[1].str())) << (*it)[1].str();
   EXPECT_GE(links, 2);  // the image and the ownership picture
   for (const auto& entry : fs::directory_iterator(dir)) EXPECT_TRUE(names.count(entry.path().filename().string()));
+  EXPECT_NE(html.find("when each processor traced each tile"), std::string::npos);
+}
+
+TEST(MachinePictures, TimelineNeedsARunThatRecordedItsTiles) {
+  const fs::path dir = fs::path(::testing::TempDir()) / "vmpray_machine_pictures_untimed";
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  const auto run = small_run(false, false);
+  app::PictureFiles files;
+  files.timeline_svg = dir / "tiles.svg";
+  EXPECT_THROW(app::write_machine_pictures(files, "teapot", run.image, run.report), std::invalid_argument);
+  EXPECT_FALSE(fs::exists(files.timeline_svg));
 }
 
 }  // namespace

@@ -1,0 +1,44 @@
+// A timeline of a render's farming, as SVG: one row per processor (node 0 at
+// the top, split into one lane per pixel computer), one bar per tile from the
+// time its worker started it to the time it finished it, coloured by the page
+// requests it took per item, under a time axis. It shows how busy every
+// processor was, how the last tiles fall at the end of the run, and which
+// tiles waited on pages.
+// Invariants: one element of class "row" per node and one of class "tile"
+// per bar; a bar is one tile, except that consecutive tiles of one worker
+// that would each be drawn narrower than a pixel, with no visible gap
+// between them, share a bar (at most two pixels wide, coloured by their
+// requests over their items), so the picture stays small for any number of
+// tiles. Every coordinate is finite.
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+namespace viz {
+
+struct TimelineTile {
+  int node = 0;
+  int worker = 0;  // lane within the node's row
+  std::uint32_t first_item = 0;
+  std::uint32_t items = 0;
+  double start = 0;  // seconds
+  double end = 0;
+  std::uint64_t page_requests = 0;
+};
+
+struct Timeline {
+  std::string title{};
+  std::string time_axis{"seconds"};  // axis caption, e.g. "wall time (s)"
+  int nodes = 1;
+  int workers_per_node = 1;
+  std::vector<TimelineTile> tiles{};
+};
+
+// Throws std::invalid_argument for nodes or workers outside 1..4096, a tile
+// on a node or worker out of range, or a tile whose times are not finite,
+// negative, or end before they start.
+std::string timeline_svg(const Timeline& t);
+
+}  // namespace viz
