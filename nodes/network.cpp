@@ -36,7 +36,7 @@ Network::Network(csp::Runtime& runtime, topology::Topology topology, NetworkOpti
     for (NodeId from : topology_.neighbours(node))
       for (unsigned c = 0; c < classes_; ++c)
         link_in_[node].emplace_back(link_name(from, node, c), queue_capacity());
-    injections_.emplace_back("inject " + std::to_string(node));
+    injections_.emplace_back("inject " + std::to_string(node), options_.buffer_capacity);
     for (unsigned j = 0; j < options_.ports_per_node; ++j)
       ports_[node].emplace_back("port " + std::to_string(node) + "." + std::to_string(j), queue_capacity());
     router_counters_.push_back(std::make_unique<RouterCounters>());

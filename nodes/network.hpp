@@ -16,9 +16,12 @@
 //
 // Use: create the Network before Runtime::run(); local processes write to
 // injector(n, p) and read port(n, p). The local processes of a node share
-// one injection channel into its router (a many-writer rendezvous, blocked
-// writers served in FIFO order), which keeps the router's ALT short; a
-// process blocked on it holds up no packet on its way to any port. Once the
+// one injection channel into its router, which keeps the router's ALT
+// short: a buffer of buffer_capacity packets, so that a sender goes on as
+// soon as its packet is queued instead of waiting for its router to run,
+// with blocked writers served in FIFO order when it is full. It feeds only
+// the router, so a process blocked on it holds up no packet on its way to
+// any port. Once the
 // application knows nothing is in flight, one of its processes calls
 // shutdown(), which poisons every network channel: routers, link processes
 // and any reader of a port end with csp::Poisoned, so run() returns with no
@@ -41,7 +44,7 @@
 namespace nodes {
 
 struct NetworkOptions {
-  std::size_t buffer_capacity = 4;  // packets per output queue, at least 1
+  std::size_t buffer_capacity = 4;  // packets per output queue and per injection channel, at least 1
   unsigned ports_per_node = 1;      // local ports per node
   std::uint64_t trace_routes = 0;   // record routes of packets whose id is below this
   LinkModel link;                   // optional per-hop latency and bandwidth
