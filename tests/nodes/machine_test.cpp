@@ -66,6 +66,7 @@ struct Case {
   std::uint16_t prefetch = 1;
   PixelOrder order = PixelOrder::scanline;
   bool spd = false;  // SPD procedure: items are the (size + 1)^2 pixel corners
+  bool record_tiles = false;
 };
 
 nodes::MachineResult run_case(const Case& c) {
@@ -81,6 +82,7 @@ nodes::MachineResult run_case(const Case& c) {
   options.prefetch = c.prefetch;
   options.pixel_order = c.order;
   options.trace.spd_procedure = c.spd;
+  options.record_tiles = c.record_tiles;
   return nodes::run_machine(std::move(db), options);
 }
 
@@ -204,18 +206,10 @@ TEST(Machine, EveryPixelIsComputedExactlyOnce) {
 // tile, and per node the tiles' items, page requests and rays add up to the
 // node's counts; no tile ends before it starts. Off by default.
 TEST(Machine, RecordedTilesCoverEveryItemOnceAndAddUpPerNode) {
-  const Case c{"hypercube", 8, 2, 256, 3, Schedule::affinity, 2, 2};
+  Case c{"hypercube", 8, 2, 256, 3, Schedule::affinity, 2, 2};
   EXPECT_TRUE(run_case(c).report.per_node[0].work.spans.empty());
-  MachineOptions options;
-  options.topology = c.topology;
-  options.nodes = c.nodes;
-  options.threads = c.threads;
-  options.cache_pages = c.cache_pages;
-  options.grain = c.grain;
-  options.schedule = c.schedule;
-  options.workers_per_node = c.workers;
-  options.record_tiles = true;
-  const auto result = nodes::run_machine(make_db(c.scene, c.page_size, c.size), options);
+  c.record_tiles = true;
+  const auto result = run_case(c);
   const auto& r = result.report;
   EXPECT_TRUE(same_bits(result.image.pixels(), cached_reference(c.scene, c.size)));
   std::vector<int> times_computed(r.items, 0);
