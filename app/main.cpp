@@ -36,7 +36,7 @@ int run(const app::Options& o) {
   if (result.report.machine)
     app::write_machine_pictures(
         {o.pictures.machine_svg, o.pictures.ownership_png, o.pictures.report_html, o.pictures.timeline_svg},
-                                result.report.scene, result.image, result.report.machine->report);
+        result.report.scene, result.image, result.report.machine->report);
   return 0;
 }
 

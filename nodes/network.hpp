@@ -21,12 +21,11 @@
 // soon as its packet is queued instead of waiting for its router to run,
 // with blocked writers served in FIFO order when it is full. It feeds only
 // the router, so a process blocked on it holds up no packet on its way to
-// any port. Once the
-// application knows nothing is in flight, one of its processes calls
-// shutdown(), which poisons every network channel: routers, link processes
-// and any reader of a port end with csp::Poisoned, so run() returns with no
-// fiber left blocked. Packets still in the network at shutdown are dropped.
-// stats() is valid after run().
+// any port. Once the application knows nothing is in flight, one of its
+// processes calls shutdown(), which poisons every network channel: routers,
+// link processes and any reader of a port end with csp::Poisoned, so run()
+// returns with no fiber left blocked. Packets still in the network at
+// shutdown are dropped. stats() is valid after run().
 #pragma once
 
 #include <functional>
