@@ -8,6 +8,7 @@
 #include <stdexcept>
 
 #include "app/experiments.hpp"
+#include "app/output_files.hpp"
 #include "app/viz/ownership.hpp"
 #include "topology/spec.hpp"
 
@@ -122,18 +123,16 @@ std::vector<std::filesystem::path> write_machine_pictures(const PictureFiles& fi
   }
   const tracer::Image ownership =
       viz::ownership_image(image.width(), image.height(), pixel_owners(report, image.width(), image.height()));
-  if (!files.machine_svg.empty()) {
-    write_file(files.machine_svg, machine);
-    written.push_back(files.machine_svg);
-  }
-  if (!files.ownership_png.empty()) {
-    ownership.write_image(files.ownership_png.string());
-    written.push_back(files.ownership_png);
-  }
-  if (!files.timeline_svg.empty()) {
-    write_file(files.timeline_svg, tiles);
-    written.push_back(files.timeline_svg);
-  }
+  OutputFiles outputs;
+  const auto write = [&](const std::filesystem::path& path, const auto& write_to) {
+    if (path.empty()) return;
+    outputs.add(path);
+    write_to(path);
+    written.push_back(path);
+  };
+  write(files.machine_svg, [&](const auto& path) { write_file(path, machine); });
+  write(files.ownership_png, [&](const auto& path) { ownership.write_image(path.string()); });
+  write(files.timeline_svg, [&](const auto& path) { write_file(path, tiles); });
   if (!files.report_html.empty()) {
     viz::Section run{.heading = title};
     run.blocks.push_back(viz::ImageFigure{.caption = "rendered image", .image = image});
@@ -144,6 +143,7 @@ std::vector<std::filesystem::path> write_machine_pictures(const PictureFiles& fi
     for (const auto& f : viz::write_html_report(files.report_html, viz::Report{.title = title, .sections = {run}}))
       written.push_back(f);
   }
+  outputs.keep();
   return written;
 }
 

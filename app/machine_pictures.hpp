@@ -40,7 +40,7 @@ struct PictureFiles {
 // Writes the pictures asked for (none: nothing to do); returns every file written. The
 // timeline, alone or in the page, needs a run that recorded its tiles
 // (std::invalid_argument otherwise). Throws std::runtime_error naming the path if one
-// cannot be written.
+// cannot be written, after removing those it had written.
 std::vector<std::filesystem::path> write_machine_pictures(const PictureFiles& files, const std::string& title,
                                                           const tracer::Image& image,
                                                           const nodes::MachineReport& report);

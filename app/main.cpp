@@ -12,6 +12,7 @@
 #include "app/machine_run.hpp"
 #include "app/machine_pictures.hpp"
 #include "app/options.hpp"
+#include "app/output_files.hpp"
 #include "app/report.hpp"
 #include "app/scene_input.hpp"
 #include "app/single.hpp"
@@ -26,17 +27,25 @@ int run(const app::Options& o) {
       std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   app::RenderResult result = o.single ? app::render_single(o, scene) : app::render_machine(o, scene);
   result.report.load_seconds = load_seconds;
+  app::OutputFiles outputs;  // removed again if a later step fails
+  outputs.add(o.output);
   result.image.write_image(o.output);
-  if (!o.stats_path.empty()) app::write_stats_json(o.stats_path, result.report);
+  if (!o.stats_path.empty()) {
+    outputs.add(o.stats_path);
+    app::write_stats_json(o.stats_path, result.report);
+  }
   if (!o.quiet) app::print_report(std::cout, result.report);
   // Asked for by name, so printed even when --quiet.
   if (result.report.machine) std::cout << nodes::format_routes(result.report.machine->report);
-  if (result.report.machine && !o.tiles_csv.empty())
+  if (result.report.machine && !o.tiles_csv.empty()) {
+    outputs.add(o.tiles_csv);
     app::write_tiles_csv(o.tiles_csv, result.report.machine->report);
-  if (result.report.machine)
+  }
+  if (result.report.machine)  // removes what it wrote if it fails
     app::write_machine_pictures(
         {o.pictures.machine_svg, o.pictures.ownership_png, o.pictures.report_html, o.pictures.timeline_svg},
         result.report.scene, result.image, result.report.machine->report);
+  outputs.keep();
   return 0;
 }
 

@@ -93,8 +93,8 @@ class PageWriter {
   void operator()(const ImageFigure& f) {
     const std::string name = html_.stem().string() + "-" + std::to_string(++images_) + ".png";
     const fs::path png = html_.parent_path() / name;
+    written_.push_back(png);  // before writing: a failed write leaves a file to remove too
     f.image.write_png(png.string());
-    written_.push_back(png);
     out += "<figure>\n<img src=\"" + escape_xml(url_of(name)) + "\" width=\"" + std::to_string(f.image.width()) +
            "\" height=\"" + std::to_string(f.image.height()) + "\" alt=\"" + escape_xml(f.caption) + "\"/>\n" +
            figcaption(f.caption) + "</figure>\n";
@@ -120,7 +120,12 @@ void write_atomically(const fs::path& path, const std::string& text) {
   {
     std::ofstream f(tmp, std::ios::binary);
     f << text;
-    if (!f.flush()) throw std::runtime_error("cannot write " + tmp.string());
+    if (!f.flush()) {
+      f.close();
+      std::error_code ignored;
+      fs::remove(tmp, ignored);
+      throw std::runtime_error("cannot write " + tmp.string());
+    }
   }
   std::error_code ec;
   fs::rename(tmp, path, ec);
@@ -130,10 +135,9 @@ void write_atomically(const fs::path& path, const std::string& text) {
   }
 }
 
-}  // namespace
-
-std::vector<fs::path> write_html_report(const fs::path& html_path, const Report& report) {
-  std::vector<fs::path> written;
+// Writes the PNGs (each added to `written` before it is written) and then
+// the page, which is added once it is in place.
+void write_page(const fs::path& html_path, const Report& report, std::vector<fs::path>& written) {
   PageWriter page(html_path, written);
   page.out = "<!DOCTYPE html>\n<html lang=\"en\">\n<head>\n<meta charset=\"utf-8\"/>\n<title>" +
              escape_xml(report.title) + "</title>\n<style>\n" + style + "</style>\n</head>\n<body>\n<h1>" +
@@ -146,6 +150,21 @@ std::vector<fs::path> write_html_report(const fs::path& html_path, const Report&
   page.out += "</body>\n</html>\n";
   write_atomically(html_path, page.out);
   written.push_back(html_path);
+}
+
+}  // namespace
+
+std::vector<fs::path> write_html_report(const fs::path& html_path, const Report& report) {
+  std::vector<fs::path> written;
+  try {
+    write_page(html_path, report, written);
+  } catch (...) {
+    for (const fs::path& p : written) {
+      std::error_code ignored;
+      fs::remove(p, ignored);
+    }
+    throw;
+  }
   return written;
 }
 

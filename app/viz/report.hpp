@@ -57,7 +57,8 @@ struct Report {
 // Writes the page to html_path (through a temporary file renamed into
 // place) and its PNGs beside it. Returns every file written, the HTML last.
 // Throws std::invalid_argument if an SvgFigure does not hold an <svg>
-// document, std::runtime_error naming the path on an I/O failure.
+// document, std::runtime_error naming the path on an I/O failure; either
+// way it first removes the files it had written.
 std::vector<std::filesystem::path> write_html_report(const std::filesystem::path& html_path, const Report& report);
 
 }  // namespace viz

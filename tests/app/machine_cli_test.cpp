@@ -274,6 +274,26 @@ TEST_F(MachineCli, EachBadInputIsOneLineWithNoOutputFile) {
   }
 }
 
+// Outputs are written after the render; when one cannot be, the run fails
+// with one line naming it, and the files written before it are removed.
+TEST_F(MachineCli, AnOutputThatCannotBeWrittenLeavesNoOtherFile) {
+  const std::vector<std::string> cases{
+      "--stats nodir/s.json",
+      "--stats s.json --tiles t.csv --timeline nodir/t.svg",
+      "--stats s.json --machine-svg m.svg --ownership o.png --report nodir/r.html",
+  };
+  for (const std::string& args : cases) {
+    const Outcome r = run(std::string(kSmall) + " -q -o out.png " + args);
+    EXPECT_EQ(r.exit_code, 1) << args;
+    EXPECT_EQ(lines(r.err), 1u) << args << ": " << r.err;
+    EXPECT_NE(r.err.find("nodir/"), std::string::npos) << args << ": " << r.err;
+    for (const auto& entry : fs::directory_iterator(dir_)) {
+      const std::string name = entry.path().filename().string();
+      EXPECT_TRUE(name.starts_with("std")) << args << " left " << name;  // only the captured stdout and stderr
+    }
+  }
+}
+
 TEST_F(MachineCli, ErrorsNameTheOption) {
   EXPECT_NE(run("--cache-pages 0").err.find("--cache-pages"), std::string::npos);
   EXPECT_NE(run("--topology ring:8 --nodes 4").err.find("--topology"), std::string::npos);

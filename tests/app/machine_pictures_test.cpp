@@ -84,6 +84,16 @@ TEST(MachinePictures, WritesWellFormedSvgAndAPageLinkingOnlyItsFiles) {
   EXPECT_NE(html.find("when each processor traced each tile"), std::string::npos);
 }
 
+TEST(MachinePictures, APictureThatCannotBeWrittenTakesTheOthersWithIt) {
+  const fs::path dir = fs::path(::testing::TempDir()) / "vmpray_machine_pictures_failed";
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  const auto run = small_run(false);
+  const app::PictureFiles files{dir / "machine.svg", dir / "owners.png", {}, dir / "missing" / "tiles.svg"};
+  EXPECT_THROW(app::write_machine_pictures(files, "teapot", run.image, run.report), std::runtime_error);
+  EXPECT_TRUE(fs::is_empty(dir));
+}
+
 TEST(MachinePictures, TimelineNeedsARunThatRecordedItsTiles) {
   const fs::path dir = fs::path(::testing::TempDir()) / "vmpray_machine_pictures_untimed";
   fs::remove_all(dir);

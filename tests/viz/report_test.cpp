@@ -1,5 +1,5 @@
 // HTML report: well-formed, escapes text, links only files it wrote (which
-// exist), needs no network.
+// exist), needs no network, and leaves none of them when it fails.
 #include <gtest/gtest.h>
 
 #include <filesystem>
@@ -108,6 +108,16 @@ TEST_F(ReportTest, RejectsFigureThatIsNotSvg) {
 
 TEST_F(ReportTest, UnwritableDirectoryIsAnError) {
   EXPECT_THROW(write_html_report(dir_ / "missing" / "r.html", sample_report()), std::runtime_error);
+}
+
+// The PNGs go out before the page; when the page cannot be put in place
+// (here a directory stands at its path) they are removed again.
+TEST_F(ReportTest, APageThatCannotBeWrittenLeavesNoImagesBehind) {
+  fs::create_directory(dir_ / "r.html");
+  EXPECT_THROW(write_html_report(dir_ / "r.html", sample_report()), std::runtime_error);
+  std::vector<std::string> left;
+  for (const auto& entry : fs::directory_iterator(dir_)) left.push_back(entry.path().filename().string());
+  EXPECT_EQ(left, std::vector<std::string>{"r.html"});
 }
 
 }  // namespace
