@@ -124,15 +124,14 @@ std::vector<std::filesystem::path> write_machine_pictures(const PictureFiles& fi
   const tracer::Image ownership =
       viz::ownership_image(image.width(), image.height(), pixel_owners(report, image.width(), image.height()));
   OutputFiles outputs;
-  const auto write = [&](const std::filesystem::path& path, const auto& write_to) {
-    if (path.empty()) return;
-    outputs.add(path);
-    write_to(path);
-    written.push_back(path);
+  const auto text = [&](const std::filesystem::path& path, const std::string& content) {
+    if (!path.empty()) written.push_back(outputs.write(path, [&](const auto& p) { write_file(p, content); }));
   };
-  write(files.machine_svg, [&](const auto& path) { write_file(path, machine); });
-  write(files.ownership_png, [&](const auto& path) { ownership.write_image(path.string()); });
-  write(files.timeline_svg, [&](const auto& path) { write_file(path, tiles); });
+  text(files.machine_svg, machine);
+  if (!files.ownership_png.empty())
+    written.push_back(
+        outputs.write(files.ownership_png, [&](const auto& p) { ownership.write_image(p.string()); }));
+  text(files.timeline_svg, tiles);
   if (!files.report_html.empty()) {
     viz::Section run{.heading = title};
     run.blocks.push_back(viz::ImageFigure{.caption = "rendered image", .image = image});

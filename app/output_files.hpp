@@ -1,6 +1,8 @@
 // The files a command writes, removed again unless it finishes, so that a
 // failed run leaves no output behind. A path is added before it is written:
-// opening it for writing has already replaced whatever was there.
+// opening it for writing has already replaced whatever was there. Removal
+// goes in reverse order, so a directory added before the files made in it
+// goes last, once it is empty (a directory that is not empty stays).
 #pragma once
 
 #include <filesystem>
@@ -16,13 +18,20 @@ class OutputFiles {
   OutputFiles(const OutputFiles&) = delete;
   OutputFiles& operator=(const OutputFiles&) = delete;
   ~OutputFiles() {
-    for (const auto& path : paths_) {
+    for (auto path = paths_.rbegin(); path != paths_.rend(); ++path) {
       std::error_code ignored;
-      std::filesystem::remove(path, ignored);
+      std::filesystem::remove(*path, ignored);
     }
   }
 
   void add(std::filesystem::path path) { paths_.push_back(std::move(path)); }
+  // Adds `path`, then writes it with write_to(path); returns the path.
+  template <class Write>
+  std::filesystem::path write(const std::filesystem::path& path, Write&& write_to) {
+    add(path);
+    write_to(path);
+    return path;
+  }
   // The command finished: keep every file.
   void keep() { paths_.clear(); }
 

@@ -61,7 +61,9 @@ SweepTable run_sweep(const SweepOptions& options, std::ostream* progress);
 
 std::string sweep_csv(const SweepTable& table);
 std::string sweep_json(const SweepTable& table);
-// Writes csv, json, svg, png panels and html into dir; returns the files written.
+// Writes csv, json, svg, png panels and html into dir; returns the files
+// written. If one cannot be written, removes those it wrote (and dir, if it
+// made it) and throws std::runtime_error naming the path.
 std::vector<std::filesystem::path> write_sweep(const SweepTable& table, const std::filesystem::path& dir);
 
 // The whole subcommand: exit status 0, 1 (run error) or 2 (usage), errors one line on stderr.

@@ -7,6 +7,7 @@
 #include <map>
 #include <sstream>
 
+#include "app/output_files.hpp"
 #include "app/options.hpp"
 #include "app/sweep.hpp"
 #include "app/viz/plot.hpp"
@@ -147,17 +148,21 @@ std::string sweep_json(const SweepTable& t) {
 }
 
 std::vector<std::filesystem::path> write_sweep(const SweepTable& t, const std::filesystem::path& dir) {
+  OutputFiles outputs;
+  if (!std::filesystem::exists(dir)) outputs.add(dir);
   std::filesystem::create_directories(dir);
   const std::string stem = kind_name(t.kind);
   const auto plots = t.kind == SweepOptions::Kind::nodes ? nodes_plots(t) : cache_plots(t);
-  std::vector<std::filesystem::path> files{dir / (stem + ".csv"), dir / (stem + ".json"), dir / (stem + ".svg")};
-  write_text(files[0], sweep_csv(t));
-  write_text(files[1], sweep_json(t));
-  write_text(files[2], viz::plots_svg(plots, static_cast<int>(plots.size())));
-  for (std::size_t i = 0; i < plots.size(); ++i) {
-    files.push_back(dir / (stem + "-" + std::to_string(i + 1) + "-plot.png"));
-    viz::plot_image(plots[i]).write_image(files.back().string());
-  }
+  std::vector<std::filesystem::path> files;
+  const auto text = [&](const std::string& name, const std::string& content) {
+    files.push_back(outputs.write(dir / name, [&](const auto& path) { write_text(path, content); }));
+  };
+  text(stem + ".csv", sweep_csv(t));
+  text(stem + ".json", sweep_json(t));
+  text(stem + ".svg", viz::plots_svg(plots, static_cast<int>(plots.size())));
+  for (std::size_t i = 0; i < plots.size(); ++i)
+    files.push_back(outputs.write(dir / (stem + "-" + std::to_string(i + 1) + "-plot.png"),
+                                  [&](const auto& path) { viz::plot_image(plots[i]).write_image(path.string()); }));
   viz::Report report{.title = "vmpray sweep " + stem + ": " + t.scene};
   viz::Section section{.heading = t.scene + " at " + std::to_string(t.width) + "x" + std::to_string(t.height) +
                                   ", " + std::to_string(t.page_count) + " pages, " + t.tracing + "; " + t.farming};
@@ -167,6 +172,7 @@ std::vector<std::filesystem::path> write_sweep(const SweepTable& t, const std::f
   section.blocks.push_back(viz::SvgFigure{.caption = stem + " sweep", .svg = viz::plots_svg(plots, 1)});
   report.sections.push_back(section);
   for (const auto& f : viz::write_html_report(dir / (stem + ".html"), report)) files.push_back(f);
+  outputs.keep();
   return files;
 }
 

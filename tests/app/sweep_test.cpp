@@ -180,6 +180,18 @@ TEST(Sweep, CacheSweepCountsFewerMissesWithMoreCache) {
   EXPECT_GT(table.points[0].miss_ratio, table.points[1].miss_ratio);
 }
 
+// The HTML page goes last; when it cannot be written (a directory stands at
+// its path) the tables and plots written before it are removed again.
+TEST(Sweep, AFileThatCannotBeWrittenTakesTheOthersWithIt) {
+  const fs::path dir = fresh_dir("vmpray_sweep_failed");
+  fs::create_directories(dir / "cache.html");
+  auto o = parse({"cache", "teapot:2", "--size", "8", "--nodes", "2", "--cache-pages", "4,8"});
+  EXPECT_THROW(app::write_sweep(app::run_sweep(o, nullptr), dir), std::runtime_error);
+  std::vector<std::string> left;
+  for (const auto& entry : fs::directory_iterator(dir)) left.push_back(entry.path().filename().string());
+  EXPECT_EQ(left, std::vector<std::string>{"cache.html"});
+}
+
 TEST(Sweep, HtmlPageLinksOnlyFilesItWrote) {
   const fs::path dir = fresh_dir("vmpray_sweep_html");
   auto o = parse({"cache", "teapot:2", "--size", "8", "--nodes", "2", "--cache-pages", "4,8"});
