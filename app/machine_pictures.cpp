@@ -2,7 +2,6 @@
 // (see machine_pictures.hpp).
 #include "app/machine_pictures.hpp"
 
-#include <fstream>
 #include <iomanip>
 #include <sstream>
 #include <stdexcept>
@@ -31,12 +30,6 @@ std::string fixed(double v, int digits) {
   std::ostringstream out;
   out << std::fixed << std::setprecision(digits) << v;
   return out.str();
-}
-
-void write_file(const std::filesystem::path& path, const std::string& text) {
-  std::ofstream out(path, std::ios::binary);
-  out << text;
-  if (!out.flush()) throw std::runtime_error(path.string() + ": cannot write");
 }
 
 }  // namespace
@@ -124,14 +117,11 @@ std::vector<std::filesystem::path> write_machine_pictures(const PictureFiles& fi
   const tracer::Image ownership =
       viz::ownership_image(image.width(), image.height(), pixel_owners(report, image.width(), image.height()));
   OutputFiles outputs;
-  const auto text = [&](const std::filesystem::path& path, const std::string& content) {
-    if (!path.empty()) written.push_back(outputs.write(path, [&](const auto& p) { write_file(p, content); }));
-  };
-  text(files.machine_svg, machine);
+  if (!files.machine_svg.empty()) written.push_back(outputs.write_text(files.machine_svg, machine));
   if (!files.ownership_png.empty())
     written.push_back(
         outputs.write(files.ownership_png, [&](const auto& p) { ownership.write_image(p.string()); }));
-  text(files.timeline_svg, tiles);
+  if (!files.timeline_svg.empty()) written.push_back(outputs.write_text(files.timeline_svg, tiles));
   if (!files.report_html.empty()) {
     viz::Section run{.heading = title};
     run.blocks.push_back(viz::ImageFigure{.caption = "rendered image", .image = image});

@@ -6,6 +6,9 @@
 #pragma once
 
 #include <filesystem>
+#include <fstream>
+#include <stdexcept>
+#include <string>
 #include <system_error>
 #include <utility>
 #include <vector>
@@ -31,6 +34,15 @@ class OutputFiles {
     add(path);
     write_to(path);
     return path;
+  }
+  // Adds `path`, then writes `text` to it; std::runtime_error naming the
+  // path if it cannot be written.
+  std::filesystem::path write_text(const std::filesystem::path& path, const std::string& text) {
+    return write(path, [&](const std::filesystem::path& p) {
+      std::ofstream out(p, std::ios::binary);
+      out << text;
+      if (!out.flush()) throw std::runtime_error(p.string() + ": cannot write");
+    });
   }
   // The command finished: keep every file.
   void keep() { paths_.clear(); }

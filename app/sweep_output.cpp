@@ -1,7 +1,6 @@
 // What a sweep writes: CSV and JSON tables, the plots (SVG, one PNG per
 // panel), the HTML page, and the subcommand's entry point (see sweep.hpp).
 #include <cmath>
-#include <fstream>
 #include <iomanip>
 #include <iostream>
 #include <map>
@@ -104,12 +103,6 @@ viz::Table html_table(const SweepTable& t) {
   return table;
 }
 
-void write_text(const std::filesystem::path& path, const std::string& text) {
-  std::ofstream out(path, std::ios::binary);
-  out << text;
-  if (!out.flush()) throw std::runtime_error(path.string() + ": cannot write");
-}
-
 }  // namespace
 
 std::string sweep_csv(const SweepTable& t) {
@@ -154,12 +147,9 @@ std::vector<std::filesystem::path> write_sweep(const SweepTable& t, const std::f
   const std::string stem = kind_name(t.kind);
   const auto plots = t.kind == SweepOptions::Kind::nodes ? nodes_plots(t) : cache_plots(t);
   std::vector<std::filesystem::path> files;
-  const auto text = [&](const std::string& name, const std::string& content) {
-    files.push_back(outputs.write(dir / name, [&](const auto& path) { write_text(path, content); }));
-  };
-  text(stem + ".csv", sweep_csv(t));
-  text(stem + ".json", sweep_json(t));
-  text(stem + ".svg", viz::plots_svg(plots, static_cast<int>(plots.size())));
+  files.push_back(outputs.write_text(dir / (stem + ".csv"), sweep_csv(t)));
+  files.push_back(outputs.write_text(dir / (stem + ".json"), sweep_json(t)));
+  files.push_back(outputs.write_text(dir / (stem + ".svg"), viz::plots_svg(plots, static_cast<int>(plots.size()))));
   for (std::size_t i = 0; i < plots.size(); ++i)
     files.push_back(outputs.write(dir / (stem + "-" + std::to_string(i + 1) + "-plot.png"),
                                   [&](const auto& path) { viz::plot_image(plots[i]).write_image(path.string()); }));
