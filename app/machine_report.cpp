@@ -3,9 +3,8 @@
 #include "app/machine_report.hpp"
 
 #include <algorithm>
-#include <fstream>
 #include <iomanip>
-#include <stdexcept>
+#include <sstream>
 #include <tuple>
 #include <vector>
 
@@ -191,7 +190,7 @@ void write_machine_json(std::ostream& out, const MachineSummary& m, const std::s
   out << "\n" << indent << "}";
 }
 
-void write_tiles_csv(const std::string& path, const nodes::MachineReport& report) {
+std::string tiles_csv(const nodes::MachineReport& report) {
   struct Row {
     std::size_t node;
     const nodes::TileSpan* span;
@@ -202,15 +201,14 @@ void write_tiles_csv(const std::string& path, const nodes::MachineReport& report
   std::stable_sort(rows.begin(), rows.end(), [](const Row& a, const Row& b) {
     return std::tie(a.span->start, a.node, a.span->worker) < std::tie(b.span->start, b.node, b.span->worker);
   });
-  std::ofstream f(path);
-  if (!f) throw std::runtime_error(path + ": cannot open for writing");
+  std::ostringstream f;
   f << std::setprecision(9) << "node,worker,first_item,items,start_s,end_s,page_requests,rays\n";
   for (const Row& r : rows) {
     const nodes::TileSpan& s = *r.span;
     f << r.node << ',' << s.worker << ',' << s.tile.first << ',' << s.tile.count << ',' << s.start << ',' << s.end
       << ',' << s.page_requests << ',' << s.rays << '\n';
   }
-  if (!f.flush()) throw std::runtime_error(path + ": cannot write");
+  return f.str();
 }
 
 }  // namespace app

@@ -36,9 +36,8 @@ void print_machine_report(std::ostream& out, const MachineSummary& m);
 // The run's tiles (recorded with MachineOptions::record_tiles) as CSV, one
 // row per tile in order of start time (ties by node, worker): node, worker,
 // first_item, items, start_s, end_s, page_requests, rays. Items are numbered
-// in the run's pixel order. Throws std::runtime_error naming the path if it
-// cannot be written.
-void write_tiles_csv(const std::string& path, const nodes::MachineReport& report);
+// in the run's pixel order.
+std::string tiles_csv(const nodes::MachineReport& report);
 // One JSON object, no trailing newline; nested lines start with indent.
 void write_machine_json(std::ostream& out, const MachineSummary& m, const std::string& indent);
 

@@ -30,17 +30,12 @@ int run(const app::Options& o) {
   app::OutputFiles outputs;  // removed again if a later step fails
   outputs.add(o.output);
   result.image.write_image(o.output);
-  if (!o.stats_path.empty()) {
-    outputs.add(o.stats_path);
-    app::write_stats_json(o.stats_path, result.report);
-  }
+  if (!o.stats_path.empty()) outputs.write_text(o.stats_path, app::stats_json(result.report));
   if (!o.quiet) app::print_report(std::cout, result.report);
   // Asked for by name, so printed even when --quiet.
   if (result.report.machine) std::cout << nodes::format_routes(result.report.machine->report);
-  if (result.report.machine && !o.tiles_csv.empty()) {
-    outputs.add(o.tiles_csv);
-    app::write_tiles_csv(o.tiles_csv, result.report.machine->report);
-  }
+  if (result.report.machine && !o.tiles_csv.empty())
+    outputs.write_text(o.tiles_csv, app::tiles_csv(result.report.machine->report));
   if (result.report.machine)  // removes what it wrote if it fails
     app::write_machine_pictures(
         {o.pictures.machine_svg, o.pictures.ownership_png, o.pictures.report_html, o.pictures.timeline_svg},

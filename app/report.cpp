@@ -2,9 +2,8 @@
 #include "app/report.hpp"
 
 #include <cstdio>
-#include <fstream>
 #include <iomanip>
-#include <stdexcept>
+#include <sstream>
 
 #include "app/options.hpp"
 
@@ -47,9 +46,8 @@ void print_report(std::ostream& out, const RunReport& r) {
   if (r.machine) print_machine_report(out, *r.machine);
 }
 
-void write_stats_json(const std::string& path, const RunReport& r) {
-  std::ofstream f(path);
-  if (!f) throw std::runtime_error(path + ": cannot open for writing");
+std::string stats_json(const RunReport& r) {
+  std::ostringstream f;
   const auto& s = r.rays;
   f << std::setprecision(9) << "{\n"
     << "  \"scene\": " << json_string(r.scene) << ",\n"
@@ -80,7 +78,7 @@ void write_stats_json(const std::string& path, const RunReport& r) {
     write_machine_json(f, *r.machine, "  ");
   }
   f << "\n}\n";
-  if (!f) throw std::runtime_error(path + ": write failed");
+  return f.str();
 }
 
 }  // namespace app

@@ -42,7 +42,7 @@ struct RunReport {
 void print_report(std::ostream& out, const RunReport& r);
 // s as a JSON string literal, quotes included.
 std::string json_string(const std::string& s);
-// Throws std::runtime_error naming the path if the file cannot be written.
-void write_stats_json(const std::string& path, const RunReport& r);
+// The report as the JSON document --stats writes.
+std::string stats_json(const RunReport& r);
 
 }  // namespace app
