@@ -22,7 +22,7 @@ namespace app {
 struct ExperimentSetup {
   std::string topology = "hypercube";
   std::size_t nodes = 1;
-  std::optional<std::uint32_t> cache_pages;  // default: the machine's (1/8 of the database)
+  std::optional<std::uint32_t> cache_pages;  // default: nodes::default_cache_pages
   std::uint32_t grain = 4;
   std::uint16_t prefetch = 0;  // the paper's protocol: a processor asks for work when idle
   nodes::Schedule schedule = nodes::Schedule::dynamic;

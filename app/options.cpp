@@ -62,7 +62,7 @@ po::options_description describe_machine(Options& o, Raw& raw) {
       ("threads", po::value(&raw.threads)->default_value(0),
        "OS threads carrying the processors (0: hardware cores; at most --nodes)")
       ("cache-pages", po::value(&raw.cache_pages),
-       "remote pages cached per node (default: 1/8 of the database)")
+       "remote pages cached per node (default: 1/8 of the database, at least 64 pages)")
       ("cache-kb", po::value(&raw.cache_kb), "the cache per node in KB instead of pages")
       ("grain", po::value(&raw.grain)->default_value(16),
        "pixels per tile handed out (affinity: the smallest tile), a run of the pixel order")

@@ -207,6 +207,11 @@ double imbalance(const std::vector<double>& values) {
 
 }  // namespace
 
+std::uint32_t default_cache_pages(const tracer::DatabaseHeader& header) {
+  constexpr std::uint32_t share = 8, floor_pages = 64;
+  return std::max({std::uint32_t{1}, header.page_count / share, std::min(header.page_count, floor_pages)});
+}
+
 std::uint32_t cache_pages_for(const MachineOptions& options, const tracer::DatabaseHeader& header) {
   if (options.cache_pages && options.cache_kb)
     throw std::invalid_argument("give --cache-pages or --cache-kb, not both");
@@ -221,7 +226,7 @@ std::uint32_t cache_pages_for(const MachineOptions& options, const tracer::Datab
                                   std::to_string(header.page_size) + " bytes)");
     return static_cast<std::uint32_t>(std::min<std::uint64_t>(pages, UINT32_MAX));
   }
-  return std::max<std::uint32_t>(1, header.page_count / 8);
+  return default_cache_pages(header);
 }
 
 MachineResult run_machine(tracer::Database db, const MachineOptions& options) {

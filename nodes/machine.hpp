@@ -65,7 +65,7 @@ struct MachineOptions {
   std::optional<std::size_t> nodes = 16;  // with a bare kind; must agree with a full spec
   unsigned threads = 0;                // 0: hardware cores; never more than the nodes
   std::optional<std::uint32_t> cache_pages;  // remote pages cached per node
-  std::optional<std::uint64_t> cache_kb;     // the same in KB; default (neither): 1/8 of the database
+  std::optional<std::uint64_t> cache_kb;     // the same in KB; default (neither): default_cache_pages()
   std::uint32_t grain = 16;            // items per tile: balance vs farming traffic
   // Each processor's own compact patch first: the fewest page misses and
   // farming messages (the paper: dynamic, scanline).
@@ -138,6 +138,13 @@ struct MachineResult {
   tracer::Image image;
   MachineReport report;
 };
+
+// The cache a node gets when no size is given: 1/8 of the database, a modest
+// share as in the paper's experiments, but at least 64 pages (or the whole
+// database if smaller). A cache smaller than the pages one ray visits, as
+// an eighth of a tiny database would be, makes nearly every access miss;
+// such a cache can still be asked for by size.
+std::uint32_t default_cache_pages(const tracer::DatabaseHeader& header);
 
 // Cache size in pages from the options: std::invalid_argument naming the
 // option for 0 pages, less than a page of KB, or both options given.

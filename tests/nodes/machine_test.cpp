@@ -311,6 +311,32 @@ TEST(Machine, MissRatioFallsAsTheCacheGrowsAndVanishesWhenItHoldsEverything) {
   }
 }
 
+TEST(Machine, DefaultCacheIsAnEighthOfTheDatabaseButNeverTooSmallForARay) {
+  tracer::DatabaseHeader header;
+  header.page_count = 3;
+  EXPECT_EQ(nodes::default_cache_pages(header), 3u);
+  header.page_count = 200;
+  EXPECT_EQ(nodes::default_cache_pages(header), 64u);
+  header.page_count = 661;
+  EXPECT_EQ(nodes::default_cache_pages(header), 82u);
+
+  // A database of a few pages on 16 nodes: an eighth of it would be less
+  // than the pages one ray visits, and nearly every access would miss. The
+  // default holds it all, so each node fetches each remote page once.
+  tracer::Database db = make_db("balls:1", 1024, 32);
+  const std::uint32_t pages = db.header.page_count;
+  ASSERT_LT(pages, 16u);
+  MachineOptions options;
+  options.nodes = 16;
+  options.threads = 1;
+  const auto result = nodes::run_machine(std::move(db), options);
+  for (const auto& node : result.report.per_node) {
+    EXPECT_EQ(node.cache_capacity + node.own_bytes / 1024, pages);  // every page it does not own
+    EXPECT_EQ(node.evictions, 0u);
+    EXPECT_LE(node.svm.misses, pages);
+  }
+}
+
 TEST(Machine, PageCommunicationsEqualMissesWithSharedCaches) {
   const auto result = run_case({"mesh", 9, 2, 256, 2, Schedule::dynamic, 3, 1});
   EXPECT_EQ(result.report.served().pages_served, result.report.svm().misses);
