@@ -29,28 +29,28 @@ constexpr double ipsc2_unit = 371.437e-6;
 // The virtual clock counts picoseconds in 64 bits: about 106 days.
 constexpr double max_virtual_seconds = 9e6;
 
-double time_seconds(const std::string& text) {
-  static const std::pair<const char*, double> units[] = {
-      {"ps", 1e-12}, {"ns", 1e-9}, {"us", 1e-6}, {"ms", 1e-3}, {"s", 1.0}};
+// A number with an optional unit from `units`, scaled to the base unit.
+template <std::size_t N>
+double with_unit(const std::string& text, const std::pair<const char*, double> (&units)[N], const char* what) {
   std::size_t used = 0;
   const double v = std::stod(text, &used);
   const std::string unit = text.substr(used);
   if (unit.empty()) return v;
   for (const auto& [name, scale] : units)
     if (unit == name) return v * scale;
-  throw std::invalid_argument("unknown time unit '" + unit + "'");
+  throw std::invalid_argument(std::string("unknown ") + what + " unit '" + unit + "'");
+}
+
+double time_seconds(const std::string& text) {
+  static const std::pair<const char*, double> units[] = {
+      {"ps", 1e-12}, {"ns", 1e-9}, {"us", 1e-6}, {"ms", 1e-3}, {"s", 1.0}};
+  return with_unit(text, units, "time");
 }
 
 double bytes_per_second(const std::string& text) {
   static const std::pair<const char*, double> units[] = {
       {"B/s", 1.0}, {"KB/s", 1e3}, {"MB/s", 1e6}, {"GB/s", 1e9}};
-  std::size_t used = 0;
-  const double v = std::stod(text, &used);
-  const std::string unit = text.substr(used);
-  if (unit.empty()) return v;
-  for (const auto& [name, scale] : units)
-    if (unit == name) return v * scale;
-  throw std::invalid_argument("unknown bandwidth unit '" + unit + "'");
+  return with_unit(text, units, "bandwidth");
 }
 
 std::string trim(const std::string& s) {
