@@ -309,7 +309,12 @@ void par(std::vector<std::function<void()>> processes) {
 
 void sleep_for(std::chrono::steady_clock::duration d) { boost::this_fiber::sleep_for(d); }
 
-void yield() { boost::this_fiber::yield(); }
+void yield() {
+  if (detail::thread_scheduler())
+    if (auto* props = boost::fibers::context::active()->get_properties())
+      static_cast<ProcessProps*>(props)->yielded = true;
+  boost::this_fiber::yield();
+}
 
 const std::string& current_process_name() {
   static const std::string none;

@@ -67,8 +67,8 @@ void sleep_for(std::chrono::steady_clock::duration d);
 
 // Puts the caller at the back of its thread's ready queue, so that the
 // processes ready before it run first (FifoScheduler: a low-priority caller
-// lets every ready high-priority process run, and the low-priority ones
-// ahead of it). Never counted as blocked.
+// lets every ready high-priority process run, every woken low-priority one,
+// and the ones that yielded before it). Never counted as blocked.
 void yield();
 
 // Name of the calling process ("" outside a Runtime).

@@ -1,5 +1,5 @@
-// FifoScheduler: FIFO ready queues, high priority first; when idle, a short
-// spin, then a sleep.
+// FifoScheduler: FIFO ready queues, high priority first, then woken low
+// priority, then yielded; when idle, a short spin, then a sleep.
 #include "csp/scheduler.hpp"
 
 #include <utility>
@@ -13,30 +13,38 @@ namespace csp {
 // A process's fiber is bound to its record when it first runs, so its first
 // wake-up, at spawn, takes the high-priority queue.
 void FifoScheduler::awakened(boost::fibers::context* ctx, ProcessProps& props) noexcept {
+  const bool yielded = std::exchange(props.yielded, false);
   if (ctx->is_context(boost::fibers::type::dispatcher_context)) {
     dispatcher_ = ctx;
   } else if (props.process && props.process->priority == Priority::low) {
-    ctx->ready_link(ready_low_);
+    ctx->ready_link(yielded ? ready_low_ : ready_low_woken_);
   } else {
     ctx->ready_link(ready_);
   }
 }
 
 boost::fibers::context* FifoScheduler::pick_next() noexcept {
-  const bool none_ready = ready_.empty() && ready_low_.empty();
-  if (dispatcher_ && (none_ready || ++picks_since_dispatch_ >= dispatch_period)) {
+  const bool none_ready = ready_.empty() && ready_low_woken_.empty() && ready_low_.empty();
+  if (dispatcher_ && (none_ready || take_notification() || ++picks_since_dispatch_ >= dispatch_period)) {
     picks_since_dispatch_ = 0;
     return std::exchange(dispatcher_, nullptr);
   }
   if (none_ready) return nullptr;
-  auto& queue = ready_.empty() ? ready_low_ : ready_;
+  auto& queue = !ready_.empty() ? ready_ : !ready_low_woken_.empty() ? ready_low_woken_ : ready_low_;
   boost::fibers::context* ctx = &queue.front();
   queue.pop_front();
   return ctx;
 }
 
 bool FifoScheduler::has_ready_fibers() const noexcept {
-  return dispatcher_ || !ready_.empty() || !ready_low_.empty();
+  return dispatcher_ || !ready_.empty() || !ready_low_woken_.empty() || !ready_low_.empty();
+}
+
+// Claims a pending notify(). Boost queues a remotely woken fiber before it
+// notifies, and the dispatcher that runs next moves it to a ready queue.
+// Reads before it claims, like the spin below.
+bool FifoScheduler::take_notification() noexcept {
+  return notified_.load(std::memory_order_relaxed) && notified_.exchange(false, std::memory_order_acq_rel);
 }
 
 // Spins until notified (true), the spin limit or `when`, whichever first.
@@ -46,8 +54,7 @@ bool FifoScheduler::spin_until_notified(std::chrono::steady_clock::time_point wh
   const auto end = std::min(when, std::chrono::steady_clock::now() + spin_limit);
   do {
     for (int i = 0; i < 64; ++i) {
-      if (notified_.load(std::memory_order_relaxed) && notified_.exchange(false, std::memory_order_acq_rel))
-        return true;
+      if (take_notification()) return true;
       cpu_relax();  // Boost.Fiber's spin-wait hint for this architecture
     }
   } while (std::chrono::steady_clock::now() < end);

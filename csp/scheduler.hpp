@@ -6,16 +6,20 @@
 // belongs to (and a virtual-time scheduler can keep a clock per process).
 // FifoScheduler is the default: ready fibers run in FIFO order, those of
 // high-priority processes before any of low priority (as a transputer runs
-// its two priority levels); when none is ready the thread first spins for a
-// few microseconds watching for notify() (a wake from another thread: waking
-// a sleeping thread costs a system call on both sides, several times a
-// message's own cost), then sleeps on a condition variable until notify() or
-// the next timer deadline. Boost's dispatcher fiber (which moves timed-out
-// and remotely woken fibers to the ready queue, and reads the clock to do
-// so) is kept aside and run when nothing else is ready or after every
-// `dispatch_period` picks, not once per round of the queue: that bounds the
-// delay of timers and cross-thread wakes while taking the clock read off
-// most context switches.
+// its two priority levels). Among low-priority processes, one woken by a
+// communication or a timer runs before those that gave the thread up with
+// csp::yield(): a process that waited on a message has little left to do
+// before it waits again, and the ones that yielded are the long computations
+// it would otherwise queue behind. When none is ready the thread first spins
+// for a few microseconds watching for notify() (a wake from another thread:
+// waking a sleeping thread costs a system call on both sides, several times
+// a message's own cost), then sleeps on a condition variable until notify()
+// or the next timer deadline. Boost's dispatcher fiber (which moves
+// timed-out and remotely woken fibers to the ready queue, and reads the
+// clock to do so) is kept aside and run at the next switch after notify(),
+// when nothing else is ready, or after every `dispatch_period` picks: a
+// process woken from another thread waits for one switch, not for a round
+// of the queue, and most switches read no clock.
 #pragma once
 
 #include <atomic>
@@ -50,6 +54,7 @@ class ProcessProps : public boost::fibers::fiber_properties {
       : fiber_properties(ctx), virtual_time(virtual_time) {}
   detail::Process* process = nullptr;  // null for fibers that are not csp processes
   const bool virtual_time;             // these are VirtualProps (virtual_time.hpp)
+  bool yielded = false;                // set by csp::yield(), cleared when the fiber is ready again
 };
 
 using Scheduler = boost::fibers::algo::algorithm_with_properties<ProcessProps>;
@@ -72,16 +77,18 @@ class FifoScheduler final : public Scheduler {
   static constexpr unsigned dispatch_period = 32;
   static constexpr std::chrono::microseconds spin_limit{50};
 
+  bool take_notification() noexcept;
   bool spin_until_notified(std::chrono::steady_clock::time_point when) noexcept;
   void wait_for_notify(std::chrono::steady_clock::time_point when) noexcept;
 
-  boost::fibers::scheduler::ready_queue_type ready_;      // high priority, and fibers of no process
-  boost::fibers::scheduler::ready_queue_type ready_low_;
+  boost::fibers::scheduler::ready_queue_type ready_;          // high priority, and fibers of no process
+  boost::fibers::scheduler::ready_queue_type ready_low_woken_;  // low priority, woken
+  boost::fibers::scheduler::ready_queue_type ready_low_;      // low priority, yielded
   boost::fibers::context* dispatcher_ = nullptr;  // set while it is ready
   unsigned picks_since_dispatch_ = 0;
   std::mutex mutex_;  // orders notify() against the check before sleeping
   std::condition_variable wakeup_;
-  std::atomic<bool> notified_{false};
+  std::atomic<bool> notified_{false};  // a wake from another thread not yet dispatched
   std::chrono::steady_clock::duration* idle_;
 };
 
