@@ -10,7 +10,8 @@
 // communication or a timer runs before those that gave the thread up with
 // csp::yield(): a process that waited on a message has little left to do
 // before it waits again, and the ones that yielded are the long computations
-// it would otherwise queue behind. When none is ready the thread first spins
+// it would otherwise queue behind (so a process that yielded waits as long
+// as woken ones keep coming). When none is ready the thread first spins
 // for a few microseconds watching for notify() (a wake from another thread:
 // waking a sleeping thread costs a system call on both sides, several times
 // a message's own cost), then sleeps on a condition variable until notify()
