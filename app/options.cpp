@@ -16,7 +16,7 @@ namespace {
 // Values that need checking or converting before they reach Options.
 struct Raw {
   std::string accel, bvh_layout, shadow_rays;
-  std::int64_t page_size = 0;
+  std::int64_t page_size = 0, max_depth = 0, width = 0, height = 0, tessellate = 0;
   std::string topology, schedule, pixel_order, distribution;
   std::int64_t nodes = 0, threads = 0, cache_pages = 0, cache_kb = 0, grain = 0, workers = 0,
                prefetch = 0, trace_routes = 0;
@@ -41,10 +41,10 @@ po::options_description describe_render(Options& o, Raw& raw) {
        "light at every hit, as VM_pRAY counted them (same image, more rays)")
       ("page-size", po::value(&raw.page_size)->default_value(1024),
        "database page size in bytes, a power of two from 256 to 65536")
-      ("max-depth", po::value(&o.max_depth)->default_value(5), "maximum ray depth (eye ray = 1)")
-      ("width", po::value(&o.width), "image width (default: the scene's)")
-      ("height", po::value(&o.height), "image height (default: the scene's)")
-      ("tessellate", po::value(&o.tessellate),
+      ("max-depth", po::value(&raw.max_depth)->default_value(5), "maximum ray depth (eye ray = 1)")
+      ("width", po::value(&raw.width), "image width (default: the scene's)")
+      ("height", po::value(&raw.height), "image height (default: the scene's)")
+      ("tessellate", po::value(&raw.tessellate),
        "tessellate spheres and cones into triangles at this resolution")
       ("quiet,q", po::bool_switch(&o.quiet), "no progress bar and no report");
   return d;
@@ -89,28 +89,16 @@ po::options_description describe_machine(Options& o, Raw& raw) {
   return d;
 }
 
-template <class T>
-T in_range(std::int64_t v, std::int64_t lo, std::int64_t hi, const char* option) {
-  if (v < lo || v > hi)
-    throw UsageError(std::string(option) + ": expected " + std::to_string(lo) + ".." +
-                     std::to_string(hi) + ", got " + std::to_string(v));
-  return static_cast<T>(v);
-}
-
-void check_render(Options& o, const Raw& raw) {
+// Width, height and tessellation are 0 (the scene's own) only when not given.
+void check_render(Options& o, const Raw& raw, const po::variables_map& vm) {
   o.accel = parse_accel(raw.accel);
   o.bvh_layout = parse_bvh_layout(raw.bvh_layout);
   o.shadow_rays_all = parse_shadow_rays(raw.shadow_rays);
-  try {
-    tracer::validate_page_size(static_cast<std::uint64_t>(std::max<std::int64_t>(raw.page_size, 0)));
-  } catch (const tracer::DatabaseError& e) {
-    throw UsageError(std::string("--page-size: ") + e.what());
-  }
-  o.page_size = static_cast<std::uint32_t>(raw.page_size);
-  if (o.max_depth < 1 || o.max_depth > 64) throw UsageError("--max-depth: expected 1..64");
-  if (o.width < 0 || o.width > 16384) throw UsageError("--width: expected 1..16384");
-  if (o.height < 0 || o.height > 16384) throw UsageError("--height: expected 1..16384");
-  if (o.tessellate < 0 || o.tessellate > 256) throw UsageError("--tessellate: expected 1..256");
+  o.page_size = checked_page_size(raw.page_size);
+  o.max_depth = in_range<int>(raw.max_depth, 1, 64, "--max-depth");
+  if (vm.count("width")) o.width = in_range<int>(raw.width, 1, 16384, "--width");
+  if (vm.count("height")) o.height = in_range<int>(raw.height, 1, 16384, "--height");
+  if (vm.count("tessellate")) o.tessellate = in_range<int>(raw.tessellate, 1, 256, "--tessellate");
   if (o.output.empty()) o.output = default_output(o.scene);
 }
 
@@ -164,6 +152,15 @@ void check_machine(Options& o, const Raw& raw, const po::variables_map& vm) {
 }
 
 }  // namespace
+
+std::uint32_t checked_page_size(std::int64_t bytes) {
+  try {
+    tracer::validate_page_size(bytes);
+  } catch (const tracer::DatabaseError& e) {
+    throw UsageError(std::string("--page-size: ") + e.what());
+  }
+  return static_cast<std::uint32_t>(bytes);
+}
 
 bool parse_shadow_rays(const std::string& policy) {
   if (policy == "facing") return false;
@@ -239,7 +236,7 @@ Options parse_options(int argc, const char* const argv[]) {
   }
   if (vm.count("help")) o.action = Options::Action::help;
   else if (vm.count("version")) o.action = Options::Action::version;
-  check_render(o, raw);
+  check_render(o, raw, vm);
   check_machine(o, raw, vm);
   return o;
 }

@@ -46,6 +46,19 @@ struct Options {
   std::string tiles_csv;  // the machine's tile timeline (machine_report.hpp), none when empty
 };
 
+// v as a T when lo <= v <= hi; else UsageError "OPTION: expected lo..hi, got v".
+template <class T>
+T in_range(std::int64_t v, std::int64_t lo, std::int64_t hi, const char* option) {
+  if (v < lo || v > hi)
+    throw UsageError(std::string(option) + ": expected " + std::to_string(lo) + ".." + std::to_string(hi) +
+                     ", got " + std::to_string(v));
+  return static_cast<T>(v);
+}
+
+// --page-size: bytes if the database takes pages of that size (a power of
+// two in its range); UsageError naming the option otherwise.
+std::uint32_t checked_page_size(std::int64_t bytes);
+
 // Throws UsageError. argv[0] is the program name.
 Options parse_options(int argc, const char* const argv[]);
 

@@ -3,6 +3,7 @@
 #include "app/sweep.hpp"
 
 #include <boost/program_options.hpp>
+#include <cmath>
 #include <iomanip>
 #include <iostream>
 #include <sstream>
@@ -48,6 +49,7 @@ struct RawSweep {
   std::string kind, topologies = "hypercube", nodes, cache, profile = "ipsc2", costs, out;
   std::string accel = "bvh", bvh_layout = "treelet", shadow_rays = "facing";
   std::string schedule = "dynamic", pixel_order = "scanline";
+  std::int64_t size = 64, page_size = 1024, grain = 4, prefetch = 0;
 };
 
 po::options_description describe(SweepOptions& o, RawSweep& raw) {
@@ -55,13 +57,13 @@ po::options_description describe(SweepOptions& o, RawSweep& raw) {
   d.add_options()
       ("help,h", "show this help and exit")
       ("scene", po::value(&o.scene), "scene: NFF file or built-in (teapot, mountain, rings4, ...)")
-      ("size", po::value(&o.size), "image width and height in pixels (default 64; the paper: 512)")
-      ("page-size", po::value(&o.page_size), "database page size in bytes (default 1024)")
+      ("size", po::value(&raw.size), "image width and height in pixels (default 64; the paper: 512)")
+      ("page-size", po::value(&raw.page_size), "database page size in bytes (default 1024)")
       ("topology", po::value(&raw.topologies), "topologies, comma-separated (default hypercube)")
       ("nodes", po::value(&raw.nodes), "processor counts, comma-separated (nodes: default 1,2,...,64; cache: 16)")
       ("cache-pages", po::value(&raw.cache), "cache sizes in pages, comma-separated (cache: the axis)")
-      ("grain", po::value(&o.grain), "pixels per work item (default 4)")
-      ("prefetch", po::value(&o.prefetch), "tiles asked for ahead, 0..3 (default 0: ask when idle, as in the paper)")
+      ("grain", po::value(&raw.grain), "pixels per work item (default 4)")
+      ("prefetch", po::value(&raw.prefetch), "tiles asked for ahead, 0..3 (default 0: ask when idle, as in the paper)")
       ("schedule", po::value(&raw.schedule), "dynamic (default, as in the paper), static or affinity")
       ("pixel-order", po::value(&raw.pixel_order), "scanline (default, as in the paper) or hilbert")
       ("accel", po::value(&raw.accel), "acceleration structure: bvh (default) or grid")
@@ -76,15 +78,16 @@ po::options_description describe(SweepOptions& o, RawSweep& raw) {
   return d;
 }
 
-void check_sweep(SweepOptions& o, const RawSweep& raw) {
+void check_sweep(SweepOptions& o, const RawSweep& raw, const po::variables_map& vm) {
   if (raw.kind == "nodes") o.kind = SweepOptions::Kind::nodes;
   else if (raw.kind == "cache") o.kind = SweepOptions::Kind::cache;
   else throw UsageError("sweep: expected 'nodes' or 'cache', got '" + raw.kind + "'");
-  if (o.size < 1 || o.size > 4096) throw UsageError("--size: expected 1..4096");
-  if (o.grain < 1) throw UsageError("--grain: expected at least 1");
-  const std::uint16_t max_prefetch = nodes::max_prefetch(nodes::MachineOptions{});
-  if (o.prefetch > max_prefetch) throw UsageError("--prefetch: expected 0.." + std::to_string(max_prefetch));
-  if (o.fit_seconds < 0) throw UsageError("--fit-seconds: expected a positive time");
+  o.size = in_range<int>(raw.size, 1, 4096, "--size");
+  o.page_size = checked_page_size(raw.page_size);
+  o.grain = in_range<std::uint32_t>(raw.grain, 1, 1 << 20, "--grain");
+  o.prefetch = in_range<std::uint16_t>(raw.prefetch, 0, nodes::max_prefetch(nodes::MachineOptions{}), "--prefetch");
+  if (vm.count("fit-seconds") && !(o.fit_seconds > 0 && std::isfinite(o.fit_seconds)))
+    throw UsageError("--fit-seconds: expected a finite number of seconds above 0");
   o.topologies = split(raw.topologies);
   if (o.topologies.empty()) throw UsageError("--topology: empty list");
   if (!raw.nodes.empty()) o.nodes = parse_list<std::size_t>(raw.nodes, "--nodes");
@@ -133,7 +136,7 @@ SweepOptions parse_sweep_options(int argc, const char* const argv[]) {
     throw UsageError(e.what());
   }
   if (vm.count("help")) throw UsageError("help");
-  check_sweep(o, raw);
+  check_sweep(o, raw, vm);
   o.model = cost_model_from(raw.profile, raw.costs);
   return o;
 }

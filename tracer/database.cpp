@@ -183,8 +183,8 @@ void fill_header(DatabaseHeader& h, const Scene& scene, const Flattened& f,
 
 }  // namespace
 
-void validate_page_size(std::uint64_t page_size) {
-  if (page_size < 256 || page_size > 65536 || !std::has_single_bit(page_size))
+void validate_page_size(std::int64_t page_size) {
+  if (page_size < 256 || page_size > 65536 || !std::has_single_bit(static_cast<std::uint64_t>(page_size)))
     throw DatabaseError("page size " + std::to_string(page_size) +
                         " is not a power of two from 256 to 65536");
 }

@@ -71,7 +71,7 @@ struct BuildOptions {
 };
 
 // Throws DatabaseError unless page_size is a power of two in [256, 65536].
-void validate_page_size(std::uint64_t page_size);
+void validate_page_size(std::int64_t page_size);
 
 // ---- Packed records (trivially copyable; read with memcpy) ----
 

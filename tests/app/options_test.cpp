@@ -58,8 +58,21 @@ TEST(Options, BadValuesNameTheOption) {
   EXPECT_NE(error_of({"--page-size", "128"}).find("--page-size"), std::string::npos);
   EXPECT_NE(error_of({"--max-depth", "0"}).find("--max-depth"), std::string::npos);
   EXPECT_NE(error_of({"--width", "-3"}).find("--width"), std::string::npos);
+  EXPECT_NE(error_of({"--page-size", "-1024"}).find("--page-size: page size -1024"), std::string::npos);
   EXPECT_NE(error_of({"--page-size", "abc"}).find("page-size"), std::string::npos);
   EXPECT_NE(error_of({"--frobnicate"}).find("frobnicate"), std::string::npos);
+}
+
+// 0 stands for "the scene's own" inside Options, but a user who writes 0
+// asked for something that does not exist.
+TEST(Options, AnExplicitZeroSizeOrTessellationIsAnError) {
+  EXPECT_EQ(error_of({"--width", "0"}), "--width: expected 1..16384, got 0");
+  EXPECT_EQ(error_of({"--height", "0"}), "--height: expected 1..16384, got 0");
+  EXPECT_EQ(error_of({"--tessellate", "0"}), "--tessellate: expected 1..256, got 0");
+  const Options o = parse({"--width", "16384", "--height", "1", "--tessellate", "256"});
+  EXPECT_EQ(o.width, 16384);
+  EXPECT_EQ(o.height, 1);
+  EXPECT_EQ(o.tessellate, 256);
 }
 
 TEST(Options, HelpAndVersionAreActions) {

@@ -71,6 +71,14 @@ TEST(SweepOptions, BadValuesNameTheOption) {
       {{"nodes", "--prefetch", "4"}, "--prefetch"},
       {{"nodes", "--schedule", "guided"}, "--schedule"},
       {{"nodes", "--pixel-order", "zorder"}, "--pixel-order"},
+      // Negative numbers must not wrap around into huge unsigned values.
+      {{"nodes", "--grain", "-1"}, "--grain: expected 1..1048576, got -1"},
+      {{"nodes", "--prefetch", "-1"}, "--prefetch: expected 0..3, got -1"},
+      {{"nodes", "--page-size", "-1"}, "--page-size: page size -1"},
+      {{"nodes", "--page-size", "1000"}, "--page-size: page size 1000"},
+      // Zero would otherwise mean "no fit" in silence.
+      {{"nodes", "--fit-seconds", "0"}, "--fit-seconds"},
+      {{"nodes", "--fit-seconds", "inf"}, "--fit-seconds"},
   };
   for (const auto& [args, option] : cases) {
     try {

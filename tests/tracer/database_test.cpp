@@ -95,7 +95,7 @@ TEST(Database, TriangulatesPolygonsAndCountsPolygons) {
 }
 
 TEST(Database, RejectsPageSizesThatAreNotPowersOfTwoInRange) {
-  for (std::uint64_t bad : {0ull, 128ull, 255ull, 1000ull, 131072ull}) {
+  for (std::int64_t bad : {-1024ll, 0ll, 128ll, 255ll, 1000ll, 131072ll}) {
     try {
       validate_page_size(bad);
       ADD_FAILURE() << bad << " accepted";
@@ -103,7 +103,7 @@ TEST(Database, RejectsPageSizesThatAreNotPowersOfTwoInRange) {
       EXPECT_NE(std::string(e.what()).find(std::to_string(bad)), std::string::npos);
     }
   }
-  for (std::uint64_t good : {256ull, 512ull, 4096ull, 65536ull}) EXPECT_NO_THROW(validate_page_size(good));
+  for (std::int64_t good : {256ll, 512ll, 4096ll, 65536ll}) EXPECT_NO_THROW(validate_page_size(good));
   EXPECT_THROW(build_database(testing::showcase_scene(8), {.page_size = 3000}), DatabaseError);
 }
 
