@@ -10,6 +10,7 @@
 #include <fstream>
 #include <iostream>
 #include <iterator>
+#include <limits>
 
 namespace tracer {
 namespace {
@@ -166,6 +167,9 @@ class Parser {
     std::string_view token = lex_.next();
     double value;
     if (!parse_double(token, value)) fail(std::string("a finite number (") + std::string(what) + ")", token);
+    // The database stores floats: a larger number would become infinite there.
+    if (std::abs(value) > std::numeric_limits<float>::max())
+      fail(std::string("a number within single precision, at most 3.4e38 (") + std::string(what) + ")", token);
     return value;
   }
 
