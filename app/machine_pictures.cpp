@@ -129,7 +129,8 @@ std::vector<std::filesystem::path> write_machine_pictures(const PictureFiles& fi
     run.blocks.push_back(viz::SvgFigure{.caption = "the machine after the run", .svg = machine});
     run.blocks.push_back(viz::ImageFigure{.caption = "which processor computed each pixel", .image = ownership});
     run.blocks.push_back(viz::SvgFigure{.caption = "when each processor traced each tile", .svg = tiles});
-    for (const auto& f : viz::write_html_report(files.report_html, viz::Report{.title = title, .sections = {run}}))
+    for (const auto& f : viz::write_html_report(files.report_html, viz::Report{.title = title, .sections = {run}},
+                                                   outputs.tracker()))
       written.push_back(f);
   }
   outputs.keep();

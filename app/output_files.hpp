@@ -7,6 +7,7 @@
 
 #include <filesystem>
 #include <fstream>
+#include <functional>
 #include <stdexcept>
 #include <string>
 #include <system_error>
@@ -28,6 +29,10 @@ class OutputFiles {
   }
 
   void add(std::filesystem::path path) { paths_.push_back(std::move(path)); }
+  // add() as a callable, for writers that report the files they make.
+  std::function<void(const std::filesystem::path&)> tracker() {
+    return [this](const std::filesystem::path& path) { add(path); };
+  }
   // Adds `path`, then writes it with write_to(path); returns the path.
   template <class Write>
   std::filesystem::path write(const std::filesystem::path& path, Write&& write_to) {

@@ -161,7 +161,7 @@ std::vector<std::filesystem::path> write_sweep(const SweepTable& t, const std::f
   section.blocks.push_back(html_table(t));
   section.blocks.push_back(viz::SvgFigure{.caption = stem + " sweep", .svg = viz::plots_svg(plots, 1)});
   report.sections.push_back(section);
-  for (const auto& f : viz::write_html_report(dir / (stem + ".html"), report)) files.push_back(f);
+  for (const auto& f : viz::write_html_report(dir / (stem + ".html"), report, outputs.tracker())) files.push_back(f);
   outputs.keep();
   return files;
 }

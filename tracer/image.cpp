@@ -4,8 +4,6 @@
 #include "tracer/image.hpp"
 
 #include <png.h>
-#include <sys/stat.h>
-#include <unistd.h>
 
 #include <algorithm>
 #include <cctype>
@@ -16,6 +14,8 @@
 #include <functional>
 #include <memory>
 #include <stdexcept>
+
+#include "tracer/atomic_file.hpp"
 
 namespace tracer {
 namespace {
@@ -28,29 +28,6 @@ struct FileCloser {
   void operator()(std::FILE* f) const { std::fclose(f); }
 };
 using FilePtr = std::unique_ptr<std::FILE, FileCloser>;
-
-// Runs write(file) on a fresh temporary file beside path, then renames it to
-// path. On any failure the temporary file is removed and nothing is renamed.
-void write_atomically(const std::string& path, const std::function<bool(std::FILE*)>& write) {
-  std::string tmp = path + ".tmp.XXXXXX";
-  int fd = ::mkstemp(tmp.data());
-  if (fd < 0) throw io_error(path, std::string("cannot create temporary file: ") + std::strerror(errno));
-  ::fchmod(fd, 0644);  // mkstemp's 0600 would hide the image from other users
-  std::FILE* file = ::fdopen(fd, "wb");
-  if (!file) {
-    ::close(fd);
-    ::unlink(tmp.c_str());
-    throw io_error(path, "cannot open temporary file");
-  }
-  bool ok = write(file);
-  ok = std::fflush(file) == 0 && ok;
-  ok = std::fclose(file) == 0 && ok;
-  if (!ok || std::rename(tmp.c_str(), path.c_str()) != 0) {
-    int err = errno;
-    ::unlink(tmp.c_str());
-    throw io_error(path, std::string("cannot write image: ") + std::strerror(err));
-  }
-}
 
 std::string lower_extension(const std::string& path) {
   auto slash = path.find_last_of('/');

@@ -2,11 +2,10 @@
 #include "app/viz/report.hpp"
 
 #include <cctype>
-#include <cstdio>
-#include <fstream>
 #include <stdexcept>
 
 #include "app/viz/svg.hpp"
+#include "tracer/atomic_file.hpp"
 
 namespace viz {
 namespace {
@@ -56,7 +55,8 @@ void caption(std::string& out, const std::string& text) {
 
 class PageWriter {
  public:
-  PageWriter(const fs::path& html, std::vector<fs::path>& written) : html_(html), written_(written) {}
+  PageWriter(const fs::path& html, const FileTracker& track, std::vector<fs::path>& written)
+      : html_(html), track_(track), written_(written) {}
 
   void operator()(const Paragraph& p) { out += "<p>" + escape_xml(p.text) + "</p>\n"; }
 
@@ -93,8 +93,9 @@ class PageWriter {
   void operator()(const ImageFigure& f) {
     const std::string name = html_.stem().string() + "-" + std::to_string(++images_) + ".png";
     const fs::path png = html_.parent_path() / name;
-    written_.push_back(png);  // before writing: a failed write leaves a file to remove too
+    track_(png);  // before writing, as the caller removes what a failure leaves
     f.image.write_png(png.string());
+    written_.push_back(png);
     out += "<figure>\n<img src=\"" + escape_xml(url_of(name)) + "\" width=\"" + std::to_string(f.image.width()) +
            "\" height=\"" + std::to_string(f.image.height()) + "\" alt=\"" + escape_xml(f.caption) + "\"/>\n" +
            figcaption(f.caption) + "</figure>\n";
@@ -111,34 +112,16 @@ class PageWriter {
   }
 
   const fs::path& html_;
+  const FileTracker& track_;
   std::vector<fs::path>& written_;
   int images_ = 0;
 };
 
-void write_atomically(const fs::path& path, const std::string& text) {
-  const fs::path tmp = path.string() + ".tmp";
-  {
-    std::ofstream f(tmp, std::ios::binary);
-    f << text;
-    if (!f.flush()) {
-      f.close();
-      std::error_code ignored;
-      fs::remove(tmp, ignored);
-      throw std::runtime_error("cannot write " + tmp.string());
-    }
-  }
-  std::error_code ec;
-  fs::rename(tmp, path, ec);
-  if (ec) {
-    fs::remove(tmp, ec);
-    throw std::runtime_error("cannot write " + path.string());
-  }
-}
-
-// Writes the PNGs (each added to `written` before it is written) and then
-// the page, which is added once it is in place.
-void write_page(const fs::path& html_path, const Report& report, std::vector<fs::path>& written) {
-  PageWriter page(html_path, written);
+// Writes the PNGs (each tracked before it is written) and then the page,
+// tracked once it is in place.
+void write_page(const fs::path& html_path, const Report& report, const FileTracker& track,
+                std::vector<fs::path>& written) {
+  PageWriter page(html_path, track, written);
   page.out = "<!DOCTYPE html>\n<html lang=\"en\">\n<head>\n<meta charset=\"utf-8\"/>\n<title>" +
              escape_xml(report.title) + "</title>\n<style>\n" + style + "</style>\n</head>\n<body>\n<h1>" +
              escape_xml(report.title) + "</h1>\n";
@@ -148,23 +131,16 @@ void write_page(const fs::path& html_path, const Report& report, std::vector<fs:
     page.out += "</section>\n";
   }
   page.out += "</body>\n</html>\n";
-  write_atomically(html_path, page.out);
+  tracer::write_text_atomically(html_path.string(), page.out);
+  track(html_path);
   written.push_back(html_path);
 }
 
 }  // namespace
 
-std::vector<fs::path> write_html_report(const fs::path& html_path, const Report& report) {
+std::vector<fs::path> write_html_report(const fs::path& html_path, const Report& report, const FileTracker& track) {
   std::vector<fs::path> written;
-  try {
-    write_page(html_path, report, written);
-  } catch (...) {
-    for (const fs::path& p : written) {
-      std::error_code ignored;
-      fs::remove(p, ignored);
-    }
-    throw;
-  }
+  write_page(html_path, report, track, written);
   return written;
 }
 

@@ -8,6 +8,7 @@
 #pragma once
 
 #include <filesystem>
+#include <functional>
 #include <string>
 #include <utility>
 #include <variant>
@@ -54,11 +55,16 @@ struct Report {
   std::vector<Section> sections{};
 };
 
+// Called with each file the writer may leave behind: a PNG before it is
+// written, the page once it is in place. A caller that must leave nothing
+// after a failure removes what it was given (app::OutputFiles).
+using FileTracker = std::function<void(const std::filesystem::path&)>;
+
 // Writes the page to html_path (through a temporary file renamed into
 // place) and its PNGs beside it. Returns every file written, the HTML last.
 // Throws std::invalid_argument if an SvgFigure does not hold an <svg>
-// document, std::runtime_error naming the path on an I/O failure; either
-// way it first removes the files it had written.
-std::vector<std::filesystem::path> write_html_report(const std::filesystem::path& html_path, const Report& report);
+// document, std::runtime_error naming the path on an I/O failure.
+std::vector<std::filesystem::path> write_html_report(const std::filesystem::path& html_path, const Report& report,
+                                                     const FileTracker& track);
 
 }  // namespace viz

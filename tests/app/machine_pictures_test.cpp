@@ -94,6 +94,20 @@ TEST(MachinePictures, APictureThatCannotBeWrittenTakesTheOthersWithIt) {
   EXPECT_TRUE(fs::is_empty(dir));
 }
 
+// The page goes last, after the images it shows; when it cannot be put in
+// place (a directory stands at its path) those images go too.
+TEST(MachinePictures, AReportThatCannotBeWrittenTakesItsImagesWithIt) {
+  const fs::path dir = fs::path(::testing::TempDir()) / "vmpray_machine_report_failed";
+  fs::remove_all(dir);
+  fs::create_directories(dir / "r.html");
+  const auto run = small_run(false);
+  const app::PictureFiles files{dir / "machine.svg", {}, dir / "r.html", {}};
+  EXPECT_THROW(app::write_machine_pictures(files, "teapot", run.image, run.report), std::runtime_error);
+  std::vector<std::string> left;
+  for (const auto& entry : fs::directory_iterator(dir)) left.push_back(entry.path().filename().string());
+  EXPECT_EQ(left, std::vector<std::string>{"r.html"});
+}
+
 TEST(MachinePictures, TimelineNeedsARunThatRecordedItsTiles) {
   const fs::path dir = fs::path(::testing::TempDir()) / "vmpray_machine_pictures_untimed";
   fs::remove_all(dir);

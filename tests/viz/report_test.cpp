@@ -1,8 +1,11 @@
 // HTML report: well-formed, escapes text, links only files it wrote (which
-// exist), needs no network, and leaves none of them when it fails.
+// exist), needs no network, and names every file it may leave behind when
+// it fails, so that the caller can remove them.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <filesystem>
+#include <vector>
 #include <fstream>
 #include <sstream>
 #include <stdexcept>
@@ -23,6 +26,10 @@ class ReportTest : public ::test::ScratchTest {
  protected:
   ReportTest() : ScratchTest("viz-report-") {}
   static std::string read(const fs::path& p) { return ::test::read_file(p); }
+  std::vector<fs::path> write(const fs::path& html, const Report& report) {
+    return write_html_report(html, report, [this](const fs::path& p) { tracked_.push_back(p); });
+  }
+  std::vector<fs::path> tracked_;  // what the writer said it may leave behind
 };
 
 Report sample_report() {
@@ -45,7 +52,7 @@ Report sample_report() {
 
 TEST_F(ReportTest, IsWellFormedAndEscapesText) {
   const fs::path html = dir_ / "report.html";
-  write_html_report(html, sample_report());
+  write(html, sample_report());
   const std::string text = read(html);
   const test::XmlCheck doc = test::check_xml(text);
   ASSERT_TRUE(doc.ok) << doc.error;
@@ -57,7 +64,7 @@ TEST_F(ReportTest, IsWellFormedAndEscapesText) {
 
 TEST_F(ReportTest, LinksOnlyFilesItWrote) {
   const fs::path html = dir_ / "run 1#a.html";  // a name that needs URL encoding
-  const std::vector<fs::path> written = write_html_report(html, sample_report());
+  const std::vector<fs::path> written = write(html, sample_report());
   ASSERT_EQ(written.size(), 3u);
   EXPECT_EQ(written.back(), html);
   const test::XmlCheck doc = test::check_xml(read(html));
@@ -92,7 +99,7 @@ TEST_F(ReportTest, LinksOnlyFilesItWrote) {
 
 TEST_F(ReportTest, NeedsNoNetwork) {
   const fs::path html = dir_ / "r.html";
-  write_html_report(html, sample_report());
+  write(html, sample_report());
   const std::string text = read(html);
   EXPECT_EQ(text.find("<script"), std::string::npos);
   EXPECT_EQ(text.find("<link"), std::string::npos);
@@ -103,21 +110,32 @@ TEST_F(ReportTest, NeedsNoNetwork) {
 TEST_F(ReportTest, RejectsFigureThatIsNotSvg) {
   Report r;
   r.sections.push_back({"bad", {SvgFigure{"x", "<script>alert(1)</script>"}}});
-  EXPECT_THROW(write_html_report(dir_ / "r.html", r), std::invalid_argument);
+  EXPECT_THROW(write(dir_ / "r.html", r), std::invalid_argument);
 }
 
 TEST_F(ReportTest, UnwritableDirectoryIsAnError) {
-  EXPECT_THROW(write_html_report(dir_ / "missing" / "r.html", sample_report()), std::runtime_error);
+  EXPECT_THROW(write(dir_ / "missing" / "r.html", sample_report()), std::runtime_error);
 }
 
 // The PNGs go out before the page; when the page cannot be put in place
-// (here a directory stands at its path) they are removed again.
-TEST_F(ReportTest, APageThatCannotBeWrittenLeavesNoImagesBehind) {
+// (here a directory stands at its path) the writer has named each PNG it
+// wrote, and not the directory that stood in the way.
+TEST_F(ReportTest, APageThatCannotBeWrittenNamesTheImagesItLeft) {
   fs::create_directory(dir_ / "r.html");
-  EXPECT_THROW(write_html_report(dir_ / "r.html", sample_report()), std::runtime_error);
-  std::vector<std::string> left;
-  for (const auto& entry : fs::directory_iterator(dir_)) left.push_back(entry.path().filename().string());
-  EXPECT_EQ(left, std::vector<std::string>{"r.html"});
+  EXPECT_THROW(write(dir_ / "r.html", sample_report()), std::runtime_error);
+  std::vector<fs::path> left;
+  for (const auto& entry : fs::directory_iterator(dir_))
+    if (entry.path().filename() != "r.html") left.push_back(entry.path());
+  std::sort(left.begin(), left.end());
+  EXPECT_EQ(left, (std::vector<fs::path>{dir_ / "r-1.png", dir_ / "r-2.png"}));
+  EXPECT_EQ(tracked_, left);
+}
+
+// Everything written was tracked, the page last.
+TEST_F(ReportTest, TracksEveryFileItWrites) {
+  const std::vector<fs::path> written = write(dir_ / "r.html", sample_report());
+  EXPECT_EQ(tracked_, written);
+  EXPECT_EQ(tracked_.back(), dir_ / "r.html");
 }
 
 }  // namespace
