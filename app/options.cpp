@@ -142,7 +142,9 @@ void check_machine(Options& o, const Raw& raw, const po::variables_map& vm) {
   if (raw.distribution == "modulo") m.distribution = nodes::Distribution::modulo;
   else if (raw.distribution == "block") m.distribution = nodes::Distribution::block;
   else throw UsageError("--distribution: expected modulo or block, got '" + raw.distribution + "'");
-  m.timing = timing_from(raw.timing);
+  TimingChoice timing = raw.timing;
+  timing.profile_given = vm.count("profile") && !vm["profile"].defaulted();
+  m.timing = timing_from(timing);
   for (const auto& [option, path] : {std::pair{"--tiles", &o.tiles_csv}, {"--timeline", &o.pictures.timeline_svg}}) {
     if (path->empty()) continue;
     if (o.single) throw UsageError(std::string(option) + ": --single renders without a machine, so without tiles");

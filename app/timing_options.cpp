@@ -17,7 +17,7 @@ void add_timing_options(po::options_description& d, TimingChoice& timing, Pictur
       ("profile", po::value(&timing.profile)->default_value("ipsc2"),
        "machine model for virtual time: ipsc2, native (calibrated here), or a 'key = value' file")
       ("cost", po::value(&timing.costs),
-       "costs over the profile: box=,prim=,shade=,page=,serve=,msg=,hop= (s, ms, us, ns), bw= (B/s, KB/s, MB/s)")
+       "costs over the profile: box=,prim=,shade=,page=,serve=,msg=,hop= (s, ms, us, ns), bw= (B/s, KB/s, MB/s; 0: unlimited)")
       ("machine-svg", po::value(&pictures.machine_svg), "after a machine render: the machine with its traffic, SVG")
       ("ownership", po::value(&pictures.ownership_png), "after a machine render: which node computed each pixel, PNG")
       ("timeline", po::value(&pictures.timeline_svg),
@@ -43,7 +43,11 @@ nodes::CostModel cost_model_from(const std::string& profile, const std::string& 
 }
 
 std::optional<nodes::CostModel> timing_from(const TimingChoice& choice) {
-  if (choice.timing == "real") return std::nullopt;
+  if (choice.timing == "real") {
+    for (const auto& [option, given] : {std::pair{"--profile", choice.profile_given}, {"--cost", !choice.costs.empty()}})
+      if (given) throw UsageError(std::string(option) + ": a model for --timing virtual, but this run is timed for real");
+    return std::nullopt;
+  }
   if (choice.timing != "virtual")
     throw UsageError("--timing: expected real or virtual, got '" + choice.timing + "'");
   return cost_model_from(choice.profile, choice.costs);

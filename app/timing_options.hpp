@@ -17,6 +17,7 @@ struct TimingChoice {
   std::string timing = "real";     // real | virtual
   std::string profile = "ipsc2";   // ipsc2 | native | a profile file
   std::string costs;               // --cost items over the profile
+  bool profile_given = false;      // --profile was on the command line
 };
 
 struct PicturePaths {
@@ -34,6 +35,8 @@ void add_timing_options(boost::program_options::options_description& d, TimingCh
 nodes::CostModel cost_model_from(const std::string& profile, const std::string& costs);
 
 // The machine's timing: none for --timing real, the model for virtual.
+// A --profile or --cost with real timing is a UsageError: it would change
+// nothing.
 std::optional<nodes::CostModel> timing_from(const TimingChoice& choice);
 
 }  // namespace app

@@ -1,10 +1,11 @@
 // Cost models, profiles and the virtual-time hooks of the machine (see timing.hpp).
 #include "nodes/timing.hpp"
 
+#include <charconv>
 #include <chrono>
 #include <cmath>
-#include <cstring>
 #include <fstream>
+#include <map>
 #include <sstream>
 #include <stdexcept>
 
@@ -29,12 +30,23 @@ constexpr double ipsc2_unit = 371.437e-6;
 // The virtual clock counts picoseconds in 64 bits: about 106 days.
 constexpr double max_virtual_seconds = 9e6;
 
-// A number with an optional unit from `units`, scaled to the base unit.
+std::string trim(const std::string& s) {
+  const auto b = s.find_first_not_of(" \t\r");
+  if (b == std::string::npos) return "";
+  return s.substr(b, s.find_last_not_of(" \t\r") - b + 1);
+}
+
+// A number with an optional unit from `units` after it (spaces between are
+// allowed: "175us", "2.8 MB/s"), scaled to the base unit. Throws
+// std::invalid_argument with the reason.
 template <std::size_t N>
 double with_unit(const std::string& text, const std::pair<const char*, double> (&units)[N], const char* what) {
-  std::size_t used = 0;
-  const double v = std::stod(text, &used);
-  const std::string unit = text.substr(used);
+  const std::string number = trim(text);
+  double v = 0;
+  const auto [end, ec] = std::from_chars(number.data(), number.data() + number.size(), v);
+  if (ec == std::errc::result_out_of_range) throw std::invalid_argument("out of range");
+  if (ec != std::errc()) throw std::invalid_argument(std::string("not a ") + what);
+  const std::string unit = trim(std::string(end, number.data() + number.size()));
   if (unit.empty()) return v;
   for (const auto& [name, scale] : units)
     if (unit == name) return v * scale;
@@ -53,20 +65,13 @@ double bytes_per_second(const std::string& text) {
   return with_unit(text, units, "bandwidth");
 }
 
-std::string trim(const std::string& s) {
-  const auto b = s.find_first_not_of(" \t\r");
-  if (b == std::string::npos) return "";
-  return s.substr(b, s.find_last_not_of(" \t\r") - b + 1);
-}
-
 // Sets one key; throws std::invalid_argument with a short reason.
 void set_cost(CostModel& m, const std::string& key, const std::string& value) {
   double v = 0;
   try {
     v = key == "bw" || key == "bandwidth" ? bytes_per_second(value) : time_seconds(value);
   } catch (const std::invalid_argument& e) {
-    throw std::invalid_argument("bad value '" + value + "' for " + key +
-                                (std::strstr(e.what(), "unit") ? std::string(" (") + e.what() + ")" : ""));
+    throw std::invalid_argument("bad value '" + value + "' for " + key + " (" + e.what() + ")");
   }
   if (!(v >= 0) || !std::isfinite(v)) throw std::invalid_argument(key + " must be a finite value >= 0");
   if (key == "unit") m.unit = v;
@@ -146,7 +151,9 @@ LinkModel CostModel::link_model() const {
 std::string CostModel::describe() const {
   std::ostringstream out;
   out << name << ": unit=" << unit << " box=" << box << " prim=" << prim << " shade=" << shade << " page=" << page
-      << " serve=" << serve << "s msg=" << msg << "s hop=" << hop << "s bw=" << bandwidth << "B/s";
+      << " serve=" << serve << "s msg=" << msg << "s hop=" << hop << "s bw=";
+  if (bandwidth > 0) out << bandwidth << "B/s";
+  else out << "unlimited";
   return out.str();
 }
 
@@ -201,6 +208,7 @@ CostModel read_profile_file(const std::string& path) {
   if (!in) throw std::runtime_error(path + ": cannot open profile");
   CostModel model;
   model.name = path;
+  std::map<std::string, int> set_on_line;  // key -> line it was set on
   int number = 0;
   for (std::string line; std::getline(in, line);) {
     ++number;
@@ -210,6 +218,12 @@ CostModel read_profile_file(const std::string& path) {
     const auto eq = line.find('=');
     if (eq == std::string::npos) throw std::runtime_error(where + ": expected 'key = value', got '" + line + "'");
     const std::string key = trim(line.substr(0, eq)), value = trim(line.substr(eq + 1));
+    // A key set twice, or a base profile after costs it would reset, is a mistake.
+    const std::string name = key == "bandwidth" ? "bw" : key;
+    if (const auto [at, first] = set_on_line.try_emplace(name, number); !first)
+      throw std::runtime_error(where + ": " + key + " is already set on line " + std::to_string(at->second));
+    if (key == "profile" && set_on_line.size() > 1)
+      throw std::runtime_error(where + ": 'profile' must come before the costs it is the base of");
     try {
       if (key == "profile") {
         model = profile_named(value);

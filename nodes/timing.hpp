@@ -75,8 +75,9 @@ CostModel profile_named(const std::string& name);
 // std::invalid_argument naming `where` and the bad item.
 void apply_costs(CostModel& model, const std::string& spec, const std::string& where);
 
-// A profile file: "key = value" lines (also "profile = ipsc2" as a base),
-// '#' comments. std::runtime_error "FILE:LINE: ..." for a bad line.
+// A profile file: "key = value" lines (also "profile = ipsc2" as a base,
+// before any cost), '#' comments, each key at most once.
+// std::runtime_error "FILE:LINE: ..." for a bad line.
 CostModel read_profile_file(const std::string& path);
 
 // One processor's CPU as the meters see it: page-handler time taken from its

@@ -60,6 +60,15 @@ TEST_F(TimingCli, BadTimingOptionsNameTheOptionOnOneLine) {
   EXPECT_EQ(std::count(err_.begin(), err_.end(), '\n'), 1) << err_;
 }
 
+// A model changes nothing in a wall-time run, so asking for one there is a mistake.
+TEST_F(TimingCli, AModelWithoutVirtualTimingIsAnError) {
+  EXPECT_EQ(run("teapot:2 --width 8 --height 8 --cost box=1us"), 2);
+  EXPECT_NE(err_.find("--cost: a model for --timing virtual"), std::string::npos) << err_;
+  EXPECT_EQ(run("teapot:2 --width 8 --height 8 --timing real --profile native"), 2);
+  EXPECT_NE(err_.find("--profile: a model for --timing virtual"), std::string::npos) << err_;
+  EXPECT_FALSE(fs::exists(dir_ / "teapot-2.png"));
+}
+
 TEST_F(TimingCli, ShadowRaysToAllLightsCountMoreRaysForTheSameImage) {
   const std::string common = "teapot:2 --width 24 --height 24 --nodes 4 --timing virtual -q";
   ASSERT_EQ(run(common + " --stats facing.json -o facing.ppm"), 0) << err_;

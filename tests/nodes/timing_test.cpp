@@ -8,6 +8,8 @@
 #include <cstdio>
 #include <fstream>
 #include <string>
+#include <utility>
+#include <vector>
 
 #include "nodes/machine.hpp"
 #include "nodes/messages.hpp"
@@ -197,7 +199,11 @@ TEST(CostModel, ParsesUnitsAndNamesBadItems) {
   EXPECT_DOUBLE_EQ(m.bandwidth, 2.8e6);
   EXPECT_DOUBLE_EQ(m.serve, 1e-4);
   EXPECT_DOUBLE_EQ(m.msg, 175e-6);
-  for (const char* bad : {"box", "box=fast", "colour=1", "hop=3 parsecs", "box=-1"}) {
+  nodes::apply_costs(m, "bw = 2.5 MB/s, hop = 20 us", "--cost");  // spaces around the unit
+  EXPECT_DOUBLE_EQ(m.bandwidth, 2.5e6);
+  EXPECT_DOUBLE_EQ(m.hop, 20e-6);
+  // 1e400 does not fit a double: an error, not an escaping std::out_of_range.
+  for (const char* bad : {"box", "box=fast", "colour=1", "hop=3 parsecs", "box=-1", "box=1e400s", "box=0x10"}) {
     try {
       nodes::apply_costs(m, bad, "--cost");
       ADD_FAILURE() << bad << " accepted";
@@ -226,6 +232,25 @@ TEST(CostModel, ProfileFileErrorsNameFileAndLine) {
   const CostModel m = nodes::read_profile_file(path);
   EXPECT_DOUBLE_EQ(m.hop, 10e-6);
   EXPECT_DOUBLE_EQ(m.bandwidth, nodes::ipsc2_profile().bandwidth);
+  std::remove(path.c_str());
+}
+
+// The last of two settings would win in silence, and a base profile after
+// a cost would reset it: both are mistakes in the file.
+TEST(CostModel, ProfileFileSetsEachKeyOnceAndItsBaseFirst) {
+  const std::string path = ::testing::TempDir() + "vmpray_profile_twice.txt";
+  for (const auto& [text, error] : std::vector<std::pair<std::string, std::string>>{
+           {"hop = 10us\nbox = 1us\nhop = 20us\n", ":3: hop is already set on line 1"},
+           {"bw = 1MB/s\nbandwidth = 2MB/s\n", ":2: bandwidth is already set on line 1"},
+           {"hop = 10us\nprofile = ipsc2\n", ":2: 'profile' must come before the costs it is the base of"}}) {
+    std::ofstream(path) << text;
+    try {
+      nodes::read_profile_file(path);
+      ADD_FAILURE() << text << " accepted";
+    } catch (const std::runtime_error& e) {
+      EXPECT_EQ(std::string(e.what()), path + error);
+    }
+  }
   std::remove(path.c_str());
 }
 
