@@ -54,7 +54,8 @@ po::options_description describe_machine(Options& o, Raw& raw) {
   po::options_description d("Machine options (the image is the same for every setting)");
   d.add_options()
       ("single", po::bool_switch(&o.single),
-       "render in this process with the whole database in memory, no machine")
+       "render in this process with the whole database in memory, no machine (the options below are then "
+       "errors)")
       ("topology", po::value(&raw.topology)->default_value("hypercube"),
        "hypercube, mesh, torus, ring or complete (with --nodes), or a full spec: "
        "hypercube:4, mesh:4x4, torus:4x4, ring:16, complete:16")
@@ -147,10 +148,19 @@ void check_machine(Options& o, const Raw& raw, const po::variables_map& vm) {
   m.timing = timing_from(timing);
   for (const auto& [option, path] : {std::pair{"--tiles", &o.tiles_csv}, {"--timeline", &o.pictures.timeline_svg}}) {
     if (path->empty()) continue;
-    if (o.single) throw UsageError(std::string(option) + ": --single renders without a machine, so without tiles");
     m.record_tiles = true;
   }
   if (!o.pictures.report_html.empty()) m.record_tiles = true;
+}
+
+// --single renders in this process: an option of the machine, given with it,
+// would be ignored.
+void reject_machine_options(const po::options_description& machine, const po::variables_map& vm) {
+  for (const auto& option : machine.options()) {
+    const std::string& name = option->long_name();
+    if (name != "single" && vm.count(name) && !vm[name].defaulted())
+      throw UsageError("--" + name + ": an option of the machine, but --single renders without one");
+  }
 }
 
 }  // namespace
@@ -226,7 +236,8 @@ Options parse_options(int argc, const char* const argv[]) {
   po::options_description hidden;
   hidden.add_options()("scene", po::value(&o.scene));
   po::options_description all;
-  all.add(describe_render(o, raw)).add(describe_machine(o, raw)).add(hidden);
+  const po::options_description machine = describe_machine(o, raw);
+  all.add(describe_render(o, raw)).add(machine).add(hidden);
   po::positional_options_description positional;
   positional.add("scene", 1);
   po::variables_map vm;
@@ -239,6 +250,7 @@ Options parse_options(int argc, const char* const argv[]) {
   if (vm.count("help")) o.action = Options::Action::help;
   else if (vm.count("version")) o.action = Options::Action::version;
   check_render(o, raw, vm);
+  if (o.single) reject_machine_options(machine, vm);
   check_machine(o, raw, vm);
   return o;
 }

@@ -225,7 +225,7 @@ TEST_F(MachineCli, BvhLayoutIsReported) {
 }
 
 TEST_F(MachineCli, EveryMachineMakesTheSingleProcessImage) {
-  const std::string scene = "teapot:2 --width 24 --height 20 --threads 2 -q";
+  const std::string scene = "teapot:2 --width 24 --height 20 -q";
   ASSERT_EQ(run(scene + " --single -o single.ppm").exit_code, 0);
   const std::string single = read_file(dir_ / "single.ppm");
   ASSERT_FALSE(single.empty());
@@ -242,7 +242,7 @@ TEST_F(MachineCli, EveryMachineMakesTheSingleProcessImage) {
       "--topology hypercube:3 --bvh-layout depth-first --cache-pages 3",
   };
   for (const std::string& m : machines) {
-    const Outcome r = run(scene + " " + m + " -o machine.ppm");
+    const Outcome r = run(scene + " --threads 2 " + m + " -o machine.ppm");
     ASSERT_EQ(r.exit_code, 0) << m << ": " << r.err;
     EXPECT_TRUE(read_file(dir_ / "machine.ppm") == single) << m;
   }
@@ -344,7 +344,7 @@ TEST_F(MachineCli, TilesWritesOneCsvRowPerTile) {
   EXPECT_EQ(requests, static_cast<std::uint64_t>(doc["machine"]["svm"]["misses"].number));
   EXPECT_EQ(std::count(computed.begin(), computed.end(), 1), 32 * 32);
 
-  const Outcome single = run(std::string(kSmall) + " --single -o single.png --tiles t.csv");
+  const Outcome single = run("tetra:3 --width 32 --height 32 --single -o single.png --tiles t.csv");
   EXPECT_EQ(single.exit_code, 2);
   EXPECT_NE(single.err.find("--tiles"), std::string::npos) << single.err;
   EXPECT_FALSE(fs::exists(dir_ / "t.csv"));
@@ -361,7 +361,7 @@ TEST_F(MachineCli, TimelineDrawsARowPerNode) {
   EXPECT_EQ(rows, 8u);
   EXPECT_NE(svg.find("wall time (s)"), std::string::npos);
 
-  const Outcome single = run(std::string(kSmall) + " --single -o single.png --timeline t.svg");
+  const Outcome single = run("tetra:3 --width 32 --height 32 --single -o single.png --timeline t.svg");
   EXPECT_EQ(single.exit_code, 2);
   EXPECT_NE(single.err.find("--timeline"), std::string::npos) << single.err;
 }

@@ -75,6 +75,20 @@ TEST(Options, AnExplicitZeroSizeOrTessellationIsAnError) {
   EXPECT_EQ(o.tessellate, 256);
 }
 
+// --single has no machine to give these to; ignoring them would mislead.
+TEST(Options, MachineOptionsWithSingleAreErrors) {
+  for (const char* option : {"--nodes", "--cache-pages", "--grain", "--threads", "--trace-routes"})
+    EXPECT_EQ(error_of({"--single", option, "4"}),
+              std::string(option) + ": an option of the machine, but --single renders without one");
+  for (const auto& [option, value] : {std::pair{"--topology", "ring"}, {"--timing", "virtual"},
+                                      {"--machine-svg", "m.svg"}, {"--report", "r.html"}, {"--cost", "box=1us"}})
+    EXPECT_NE(error_of({"--single", option, value}).find(std::string(option) + ": an option of the machine"),
+              std::string::npos);
+  EXPECT_NE(error_of({"--single", "--compare-serial"}).find("--compare-serial"), std::string::npos);
+  const Options o = parse({"--single", "--width", "8", "--shadow-rays", "all"});
+  EXPECT_TRUE(o.single);
+}
+
 TEST(Options, HelpAndVersionAreActions) {
   EXPECT_EQ(parse({"--help"}).action, Options::Action::help);
   EXPECT_EQ(parse({"--version"}).action, Options::Action::version);
