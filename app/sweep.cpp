@@ -4,6 +4,7 @@
 
 #include <boost/program_options.hpp>
 #include <cmath>
+#include <filesystem>
 #include <iomanip>
 #include <iostream>
 #include <sstream>
@@ -11,6 +12,7 @@
 #include "app/options.hpp"
 #include "app/scene_input.hpp"
 #include "app/timing_options.hpp"
+#include "topology/spec.hpp"
 
 namespace app {
 
@@ -81,7 +83,7 @@ po::options_description describe(SweepOptions& o, RawSweep& raw) {
 void check_sweep(SweepOptions& o, const RawSweep& raw, const po::variables_map& vm) {
   if (raw.kind == "nodes") o.kind = SweepOptions::Kind::nodes;
   else if (raw.kind == "cache") o.kind = SweepOptions::Kind::cache;
-  else throw UsageError("sweep: expected 'nodes' or 'cache', got '" + raw.kind + "'");
+  else throw UsageError("expected 'nodes' or 'cache' after 'sweep', got '" + raw.kind + "'");
   o.size = in_range<int>(raw.size, 1, 4096, "--size");
   o.page_size = checked_page_size(raw.page_size);
   o.grain = in_range<std::uint32_t>(raw.grain, 1, 1 << 20, "--grain");
@@ -94,7 +96,24 @@ void check_sweep(SweepOptions& o, const RawSweep& raw, const po::variables_map& 
   else if (o.kind == SweepOptions::Kind::cache) o.nodes = {16};
   if (!raw.cache.empty()) o.cache_pages = parse_list<std::uint32_t>(raw.cache, "--cache-pages");
   else if (o.kind == SweepOptions::Kind::cache) o.cache_pages = {8, 16, 32, 64, 128, 256, 512};
+  // The other axis is one value: a list there would be cut to its first item.
+  if (o.kind == SweepOptions::Kind::cache && o.nodes.size() > 1)
+    throw UsageError("--nodes: a cache sweep runs one machine size, got " + raw.nodes);
+  if (o.kind == SweepOptions::Kind::nodes && o.cache_pages.size() > 1)
+    throw UsageError("--cache-pages: a nodes sweep runs one cache size, got " + raw.cache);
+  // Every machine of the sweep must exist before the first one runs.
+  for (const std::string& topology : o.topologies)
+    for (const std::size_t n : o.nodes) {
+      try {
+        topology::parse_topology(topology, n);
+      } catch (const std::invalid_argument& e) {
+        throw UsageError(std::string("--topology: ") + e.what());
+      }
+    }
   o.out_dir = raw.out.empty() ? "sweep-" + raw.kind : raw.out;
+  // Found out now rather than after the runs, when the tables are written.
+  if (std::filesystem::exists(o.out_dir) && !std::filesystem::is_directory(o.out_dir))
+    throw UsageError("--out: " + o.out_dir.string() + " exists and is not a directory");
   o.accel = parse_accel(raw.accel);
   o.bvh_layout = parse_bvh_layout(raw.bvh_layout);
   o.schedule = parse_schedule(raw.schedule);

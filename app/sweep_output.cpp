@@ -5,6 +5,8 @@
 #include <iostream>
 #include <map>
 #include <sstream>
+#include <stdexcept>
+#include <system_error>
 
 #include "app/output_files.hpp"
 #include "app/options.hpp"
@@ -143,7 +145,9 @@ std::string sweep_json(const SweepTable& t) {
 std::vector<std::filesystem::path> write_sweep(const SweepTable& t, const std::filesystem::path& dir) {
   OutputFiles outputs;
   if (!std::filesystem::exists(dir)) outputs.add(dir);
-  std::filesystem::create_directories(dir);
+  std::error_code error;
+  std::filesystem::create_directories(dir, error);
+  if (error) throw std::runtime_error(dir.string() + ": cannot create the directory: " + error.message());
   const std::string stem = kind_name(t.kind);
   const auto plots = t.kind == SweepOptions::Kind::nodes ? nodes_plots(t) : cache_plots(t);
   std::vector<std::filesystem::path> files;

@@ -60,7 +60,7 @@ fs::path fresh_dir(const std::string& name) {
 
 TEST(SweepOptions, BadValuesNameTheOption) {
   const std::vector<std::pair<std::vector<const char*>, std::string>> cases{
-      {{"sideways"}, "sweep: expected 'nodes' or 'cache'"},
+      {{"sideways"}, "expected 'nodes' or 'cache' after 'sweep', got 'sideways'"},
       {{"nodes", "--nodes", "1,x"}, "--nodes"},
       {{"cache", "--cache-pages", "0"}, "--cache-pages"},
       {{"nodes", "--cost", "box=slow"}, "--cost"},
@@ -76,6 +76,13 @@ TEST(SweepOptions, BadValuesNameTheOption) {
       {{"nodes", "--prefetch", "-1"}, "--prefetch: expected 0..3, got -1"},
       {{"nodes", "--page-size", "-1"}, "--page-size: page size -1"},
       {{"nodes", "--page-size", "1000"}, "--page-size: page size 1000"},
+      // Every machine is checked before the first one runs.
+      {{"nodes", "--nodes", "1,3"}, "--topology: topology 'hypercube': a hypercube needs a power of two nodes, not 3"},
+      {{"nodes", "--topology", "ring,bogus"}, "--topology: topology 'bogus'"},
+      {{"nodes", "--topology", "hypercube:2", "--nodes", "4,8"}, "--topology: topology 'hypercube:2'"},
+      // The axis not swept takes one value.
+      {{"cache", "--nodes", "4,8"}, "--nodes: a cache sweep runs one machine size, got 4,8"},
+      {{"nodes", "--cache-pages", "4,8"}, "--cache-pages: a nodes sweep runs one cache size, got 4,8"},
       // Zero would otherwise mean "no fit" in silence.
       {{"nodes", "--fit-seconds", "0"}, "--fit-seconds"},
       {{"nodes", "--fit-seconds", "inf"}, "--fit-seconds"},
@@ -88,6 +95,19 @@ TEST(SweepOptions, BadValuesNameTheOption) {
       EXPECT_NE(std::string(e.what()).find(option), std::string::npos) << e.what();
     }
   }
+}
+
+// Known before the runs, which may take minutes, rather than after them.
+TEST(SweepOptions, AnOutputPathThatIsAFileIsAnError) {
+  const fs::path file = fresh_dir("vmpray_sweep_out_file");
+  std::ofstream(file) << "not a directory\n";
+  try {
+    parse({"nodes", "--out", file.c_str()});
+    ADD_FAILURE() << "accepted";
+  } catch (const app::UsageError& e) {
+    EXPECT_EQ(std::string(e.what()), "--out: " + file.string() + " exists and is not a directory");
+  }
+  fs::remove(file);
 }
 
 TEST(SweepOptions, ShadowRaysAndAccelReachTheRuns) {
