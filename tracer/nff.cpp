@@ -136,8 +136,12 @@ class Parser {
     scene_.name = source;
   }
 
+  // Input with no entity at all (an empty file, or a pipe that failed) is
+  // refused rather than rendered as an empty scene.
   Scene run() {
-    for (std::string_view key = lex_.next(); !key.empty(); key = lex_.next()) entity(key);
+    std::string_view key = lex_.next();
+    if (key.empty()) throw SceneError(source_ + ": no NFF entity in the input (is it empty?)");
+    for (; !key.empty(); key = lex_.next()) entity(key);
     return std::move(scene_);
   }
 

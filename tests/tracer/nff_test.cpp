@@ -192,6 +192,8 @@ INSTANTIATE_TEST_SUITE_P(
         BadInput{"NegativeCount", "pp -4\n", "t.nff:1: expected patch vertex count (an integer in 3.."},
         BadInput{"CountLargerThanFile", "p 1000000000000\n0 0 0\n1 0 0\n", "t.nff:3: expected a finite number (polygon vertex), got end of file"},
         BadInput{"NaN", "s 0 nan 0 1", "t.nff:1: expected a finite number (sphere centre), got 'nan'"},
+        BadInput{"Empty", "", "t.nff: no NFF entity in the input (is it empty?)"},
+        BadInput{"OnlyComments", "# nothing\n\n# here\n", "t.nff: no NFF entity in the input (is it empty?)"},
         BadInput{"BeyondFloat", "p 3\n0 0 0\n1e39 0 0\n0 1 0\n",
                  "t.nff:3: expected a number within single precision, at most 3.4e38 (polygon vertex), got '1e39'"},
         BadInput{"Infinity", "l 0 0 -inf", "t.nff:1: expected a finite number (light position), got '-inf'"},
