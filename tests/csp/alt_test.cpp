@@ -5,11 +5,19 @@
 #include <gtest/gtest.h>
 
 #include <array>
+#include <ostream>
 #include <string>
 #include <stdexcept>
 #include <vector>
 
 #include "csp/csp.hpp"
+
+// How gtest shows the parameter, in test names and failures.
+namespace csp {
+void PrintTo(Alt::Waiting waiting, std::ostream* out) {
+  *out << (waiting == Alt::Waiting::relink ? "relink" : "doorbell");
+}
+}  // namespace csp
 
 namespace {
 

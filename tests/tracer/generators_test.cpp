@@ -5,6 +5,7 @@
 
 #include <gtest/gtest.h>
 
+#include <ostream>
 #include <stdexcept>
 
 #include "scene_stats.hpp"
@@ -19,6 +20,8 @@ struct Reference {
   const char* spec;
   const char* file;
 };
+
+void PrintTo(const Reference& r, std::ostream* out) { *out << r.spec; }
 
 class GeneratorVsFile : public ::testing::TestWithParam<Reference> {};
 

@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 #include <zlib.h>
 
+#include <ostream>
 #include <sstream>
 #include <string>
 
@@ -21,6 +22,8 @@ struct ReferenceFile {
   std::size_t polygons, patches, spheres, cones, lights, materials;
   Vec3d lo, hi;
 };
+
+void PrintTo(const ReferenceFile& f, std::ostream* out) { *out << f.name; }
 
 class NffReference : public ::testing::TestWithParam<ReferenceFile> {};
 
@@ -172,6 +175,8 @@ struct BadInput {
   std::string text;
   std::string expected;  // the whole message must start with this
 };
+
+void PrintTo(const BadInput& b, std::ostream* out) { *out << b.label; }
 
 class NffBadInput : public ::testing::TestWithParam<BadInput> {};
 

@@ -2,6 +2,7 @@
 // traffic, every kind up to 64 nodes, clear errors for bad input.
 #include <gtest/gtest.h>
 
+#include <ostream>
 #include <stdexcept>
 
 #include "app/viz/machine.hpp"
@@ -54,6 +55,10 @@ struct Case {
   MachineKind kind;
   int a, b;
 };
+
+void PrintTo(const Case& c, std::ostream* out) {
+  *out << "kind " << static_cast<int>(c.kind) << ", " << c.a << " x " << c.b;
+}
 
 class MachineKinds : public ::testing::TestWithParam<Case> {};
 
