@@ -146,11 +146,8 @@ void check_machine(Options& o, const Raw& raw, const po::variables_map& vm) {
   TimingChoice timing = raw.timing;
   timing.profile_given = vm.count("profile") && !vm["profile"].defaulted();
   m.timing = timing_from(timing);
-  for (const auto& [option, path] : {std::pair{"--tiles", &o.tiles_csv}, {"--timeline", &o.pictures.timeline_svg}}) {
-    if (path->empty()) continue;
-    m.record_tiles = true;
-  }
-  if (!o.pictures.report_html.empty()) m.record_tiles = true;
+  // The tile CSV, the timeline and the report (which shows the timeline) need the tiles.
+  m.record_tiles = !o.tiles_csv.empty() || !o.pictures.timeline_svg.empty() || !o.pictures.report_html.empty();
 }
 
 // --single renders in this process: an option of the machine, given with it,
