@@ -55,8 +55,7 @@ void caption(std::string& out, const std::string& text) {
 
 class PageWriter {
  public:
-  PageWriter(const fs::path& html, const FileTracker& track, std::vector<fs::path>& written)
-      : html_(html), track_(track), written_(written) {}
+  PageWriter(const fs::path& html, const FileTracker& track) : html_(html), track_(track) {}
 
   void operator()(const Paragraph& p) { out += "<p>" + escape_xml(p.text) + "</p>\n"; }
 
@@ -95,7 +94,6 @@ class PageWriter {
     const fs::path png = html_.parent_path() / name;
     track_(png);  // before writing, as the caller removes what a failure leaves
     f.image.write_png(png.string());
-    written_.push_back(png);
     out += "<figure>\n<img src=\"" + escape_xml(url_of(name)) + "\" width=\"" + std::to_string(f.image.width()) +
            "\" height=\"" + std::to_string(f.image.height()) + "\" alt=\"" + escape_xml(f.caption) + "\"/>\n" +
            figcaption(f.caption) + "</figure>\n";
@@ -113,15 +111,13 @@ class PageWriter {
 
   const fs::path& html_;
   const FileTracker& track_;
-  std::vector<fs::path>& written_;
   int images_ = 0;
 };
 
 // Writes the PNGs (each tracked before it is written) and then the page,
 // tracked once it is in place.
-void write_page(const fs::path& html_path, const Report& report, const FileTracker& track,
-                std::vector<fs::path>& written) {
-  PageWriter page(html_path, track, written);
+void write_page(const fs::path& html_path, const Report& report, const FileTracker& track) {
+  PageWriter page(html_path, track);
   page.out = "<!DOCTYPE html>\n<html lang=\"en\">\n<head>\n<meta charset=\"utf-8\"/>\n<title>" +
              escape_xml(report.title) + "</title>\n<style>\n" + style + "</style>\n</head>\n<body>\n<h1>" +
              escape_xml(report.title) + "</h1>\n";
@@ -133,14 +129,17 @@ void write_page(const fs::path& html_path, const Report& report, const FileTrack
   page.out += "</body>\n</html>\n";
   tracer::write_text_atomically(html_path.string(), page.out);
   track(html_path);
-  written.push_back(html_path);
 }
 
 }  // namespace
 
 std::vector<fs::path> write_html_report(const fs::path& html_path, const Report& report, const FileTracker& track) {
+  // What was tracked is what was written, once the page is in place.
   std::vector<fs::path> written;
-  write_page(html_path, report, track, written);
+  write_page(html_path, report, [&](const fs::path& p) {
+    track(p);
+    written.push_back(p);
+  });
   return written;
 }
 

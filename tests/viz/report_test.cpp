@@ -5,10 +5,10 @@
 
 #include <algorithm>
 #include <filesystem>
-#include <vector>
 #include <fstream>
 #include <sstream>
 #include <stdexcept>
+#include <vector>
 
 #include "app/viz/machine.hpp"
 #include "app/viz/ownership.hpp"
