@@ -143,9 +143,7 @@ void check_machine(Options& o, const Raw& raw, const po::variables_map& vm) {
   if (raw.distribution == "modulo") m.distribution = nodes::Distribution::modulo;
   else if (raw.distribution == "block") m.distribution = nodes::Distribution::block;
   else throw UsageError("--distribution: expected modulo or block, got '" + raw.distribution + "'");
-  TimingChoice timing = raw.timing;
-  timing.profile_given = vm.count("profile") && !vm["profile"].defaulted();
-  m.timing = timing_from(timing);
+  m.timing = timing_from(raw.timing);
   // The tile CSV, the timeline and the report (which shows the timeline) need the tiles.
   m.record_tiles = !o.tiles_csv.empty() || !o.pictures.timeline_svg.empty() || !o.pictures.report_html.empty();
 }
@@ -248,6 +246,7 @@ Options parse_options(int argc, const char* const argv[]) {
   else if (vm.count("version")) o.action = Options::Action::version;
   check_render(o, raw, vm);
   if (o.single) reject_machine_options(machine, vm);
+  raw.timing.profile_given = !vm["profile"].defaulted();
   check_machine(o, raw, vm);
   return o;
 }
