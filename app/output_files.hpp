@@ -1,18 +1,20 @@
 // The files a command writes, removed again unless it finishes, so that a
-// failed run leaves no output behind. A path is added before it is written:
-// opening it for writing has already replaced whatever was there. Removal
+// failed run leaves no output behind. A path is added just before it is
+// written, and a failed command removes it even if the write that failed
+// left an older file there, so that nothing at that path can pass for this
+// command's output. Removal
 // goes in reverse order, so a directory added before the files made in it
 // goes last, once it is empty (a directory that is not empty stays).
 #pragma once
 
 #include <filesystem>
-#include <fstream>
 #include <functional>
-#include <stdexcept>
 #include <string>
 #include <system_error>
 #include <utility>
 #include <vector>
+
+#include "tracer/atomic_file.hpp"
 
 namespace app {
 
@@ -40,14 +42,10 @@ class OutputFiles {
     write_to(path);
     return path;
   }
-  // Adds `path`, then writes `text` to it; std::runtime_error naming the
-  // path if it cannot be written.
+  // Adds `path`, then writes `text` to it whole (tracer/atomic_file.hpp);
+  // std::runtime_error naming the path if it cannot be written.
   std::filesystem::path write_text(const std::filesystem::path& path, const std::string& text) {
-    return write(path, [&](const std::filesystem::path& p) {
-      std::ofstream out(p, std::ios::binary);
-      out << text;
-      if (!out.flush()) throw std::runtime_error(p.string() + ": cannot write");
-    });
+    return write(path, [&](const std::filesystem::path& p) { tracer::write_text_atomically(p.string(), text); });
   }
   // The command finished: keep every file.
   void keep() { paths_.clear(); }
