@@ -300,13 +300,7 @@ Box3f piece_bounds(const Piece& poly, const Box3f& within) {
   for (const Vec3f& p : poly) b.extend(p);
   b.lo = max(b.lo, within.lo);
   b.hi = min(b.hi, within.hi);
-  // Float rounding in the clipped vertices: widen by a few ulps of the coordinates.
-  const float m = std::max({std::fabs(b.lo.x), std::fabs(b.lo.y), std::fabs(b.lo.z),
-                            std::fabs(b.hi.x), std::fabs(b.hi.y), std::fabs(b.hi.z)});
-  const float pad = m * 2e-6f + 1e-30f;
-  b.lo -= Vec3f{pad, pad, pad};
-  b.hi += Vec3f{pad, pad, pad};
-  return b;
+  return widened(b, 2e-6f);  // float rounding in the clipped vertices
 }
 
 void split_piece(const Piece& poly, const Box3f& box, float max_area, int depth,

@@ -30,14 +30,7 @@ struct Flattened {
 
 // Widen a box by a few float ulps of its coordinates, so that float rounding
 // in the intersection routines never puts a hit outside its primitive's box.
-Box3f padded(Box3f b) {
-  const float m = std::max({std::fabs(b.lo.x), std::fabs(b.lo.y), std::fabs(b.lo.z),
-                            std::fabs(b.hi.x), std::fabs(b.hi.y), std::fabs(b.hi.z)});
-  const float pad = m * 1e-6f + 1e-30f;
-  b.lo -= Vec3f{pad, pad, pad};
-  b.hi += Vec3f{pad, pad, pad};
-  return b;
-}
+Box3f padded(const Box3f& b) { return widened(b, 1e-6f); }
 
 void add_polygon(Flattened& f, const std::vector<Vec3d>& v, const std::vector<Vec3d>* normals,
                  std::uint32_t material, std::uint32_t object) {

@@ -6,7 +6,9 @@
 // A routine reports a hit only for t in the open interval (t_min, t_max).
 #pragma once
 
+#include <algorithm>
 #include <array>
+#include <cmath>
 #include <cstdint>
 #include <optional>
 #include <vector>
@@ -34,6 +36,18 @@ struct Box3f {
     return empty() ? 0.0f : d.x * d.y + d.y * d.z + d.z * d.x;
   }
 };
+
+// `b` widened on every side by `relative` times its largest coordinate
+// magnitude (plus a denormal), a few float ulps: room for the rounding of
+// the arithmetic that produced its corners or will test against it.
+inline Box3f widened(Box3f b, float relative) {
+  const float m = std::max({std::fabs(b.lo.x), std::fabs(b.lo.y), std::fabs(b.lo.z),
+                            std::fabs(b.hi.x), std::fabs(b.hi.y), std::fabs(b.hi.z)});
+  const float pad = m * relative + 1e-30f;
+  b.lo -= Vec3f{pad, pad, pad};
+  b.hi += Vec3f{pad, pad, pad};
+  return b;
+}
 
 // Reciprocal direction, precomputed once per ray for the slab tests.
 struct RayInverse {
