@@ -15,6 +15,9 @@ namespace app {
 
 namespace {
 
+// The page's images: the rendered image and the ownership picture.
+constexpr int kReportImages = 2;
+
 viz::MachineKind drawing_kind(topology::Kind kind) {
   switch (kind) {
     case topology::Kind::hypercube: return viz::MachineKind::hypercube;
@@ -96,6 +99,19 @@ viz::KeyValueTable machine_statistics(const nodes::MachineReport& r) {
     t.rows.push_back({"predicted synthesis time", paper_duration(r.predicted_seconds)});
   }
   return t;
+}
+
+std::vector<std::pair<std::string, std::filesystem::path>> picture_outputs(const PictureFiles& files) {
+  std::vector<std::pair<std::string, std::filesystem::path>> out;
+  if (!files.machine_svg.empty()) out.emplace_back("--machine-svg", files.machine_svg);
+  if (!files.ownership_png.empty()) out.emplace_back("--ownership", files.ownership_png);
+  if (!files.timeline_svg.empty()) out.emplace_back("--timeline", files.timeline_svg);
+  if (!files.report_html.empty()) {
+    for (int image = 1; image <= kReportImages; ++image)
+      out.emplace_back("--report's image", viz::report_image_path(files.report_html, image));
+    out.emplace_back("--report", files.report_html);
+  }
+  return out;
 }
 
 std::vector<std::filesystem::path> write_machine_pictures(const PictureFiles& files, const std::string& title,

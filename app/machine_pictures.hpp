@@ -7,6 +7,7 @@
 
 #include <filesystem>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "app/viz/machine.hpp"
@@ -36,6 +37,10 @@ struct PictureFiles {
   std::filesystem::path report_html;    // empty: not written
   std::filesystem::path timeline_svg;   // empty: not written
 };
+
+// Every file write_machine_pictures writes for `files`, in order, each with
+// the option that asks for it ("--report's image" for the page's images).
+std::vector<std::pair<std::string, std::filesystem::path>> picture_outputs(const PictureFiles& files);
 
 // Writes the pictures asked for (none: nothing to do); returns every file written. The
 // timeline, alone or in the page, needs a run that recorded its tiles

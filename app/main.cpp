@@ -5,8 +5,8 @@
 // --stats). `vmpray sweep ...` runs the paper's experiments (app/sweep.hpp).
 // Exit 0 on success, 2 for a bad command line, 1 for a runtime error; errors
 // are one line on stderr, and a failed run leaves no output file.
-#include <cctype>
 #include <chrono>
+#include <filesystem>
 #include <iostream>
 
 #include "app/machine_run.hpp"
@@ -20,6 +20,29 @@
 
 namespace {
 
+app::PictureFiles picture_files(const app::Options& o) {
+  return {o.pictures.machine_svg, o.pictures.ownership_png, o.pictures.report_html, o.pictures.timeline_svg};
+}
+
+bool same_file(const std::filesystem::path& a, const std::filesystem::path& b) {
+  std::error_code ignored;
+  return std::filesystem::weakly_canonical(std::filesystem::absolute(a), ignored) ==
+         std::filesystem::weakly_canonical(std::filesystem::absolute(b), ignored);
+}
+
+// Two outputs at one path would overwrite each other: refused before the render.
+void check_distinct_outputs(const app::Options& o) {
+  std::vector<std::pair<std::string, std::filesystem::path>> outputs{{"--output", o.output}};
+  if (!o.stats_path.empty()) outputs.emplace_back("--stats", o.stats_path);
+  if (!o.tiles_csv.empty()) outputs.emplace_back("--tiles", o.tiles_csv);
+  for (auto& output : app::picture_outputs(picture_files(o))) outputs.push_back(std::move(output));
+  for (std::size_t i = 0; i < outputs.size(); ++i)
+    for (std::size_t j = 0; j < i; ++j)
+      if (same_file(outputs[i].second, outputs[j].second))
+        throw app::UsageError(outputs[j].first + " and " + outputs[i].first + " would both write '" +
+                              outputs[i].second.string() + "'");
+}
+
 int run(const app::Options& o) {
   const auto t0 = std::chrono::steady_clock::now();
   const tracer::Scene scene = app::load_scene(o);
@@ -28,8 +51,7 @@ int run(const app::Options& o) {
   app::RenderResult result = o.single ? app::render_single(o, scene) : app::render_machine(o, scene);
   result.report.load_seconds = load_seconds;
   app::OutputFiles outputs;  // removed again if a later step fails
-  outputs.add(o.output);
-  result.image.write_image(o.output);
+  outputs.write(o.output, [&](const auto& path) { result.image.write_image(path.string()); });
   if (!o.stats_path.empty()) outputs.write_text(o.stats_path, app::stats_json(result.report));
   if (!o.quiet) app::print_report(std::cout, result.report);
   // Asked for by name, so printed even when --quiet.
@@ -37,17 +59,9 @@ int run(const app::Options& o) {
   if (result.report.machine && !o.tiles_csv.empty())
     outputs.write_text(o.tiles_csv, app::tiles_csv(result.report.machine->report));
   if (result.report.machine)  // removes what it wrote if it fails
-    app::write_machine_pictures(
-        {o.pictures.machine_svg, o.pictures.ownership_png, o.pictures.report_html, o.pictures.timeline_svg},
-        result.report.scene, result.image, result.report.machine->report);
+    app::write_machine_pictures(picture_files(o), result.report.scene, result.image, result.report.machine->report);
   outputs.keep();
   return 0;
-}
-
-bool has_image_extension(const std::string& path) {
-  auto lower = path.substr(path.size() >= 4 ? path.size() - 4 : 0);
-  for (char& c : lower) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
-  return lower == ".png" || lower == ".ppm";
 }
 
 }  // namespace
@@ -57,9 +71,7 @@ int main(int argc, char** argv) {
   app::Options options;
   try {
     options = app::parse_options(argc, argv);
-    if (!has_image_extension(options.output))
-      throw app::UsageError("--output: expected a .png or .ppm file name, got '" +
-                            options.output + "'");
+    check_distinct_outputs(options);
   } catch (const app::UsageError& e) {
     std::cerr << "vmpray: " << e.what() << " (see vmpray --help)\n";
     return 2;

@@ -4,6 +4,8 @@
 
 #include <algorithm>
 #include <boost/program_options.hpp>
+#include <cctype>
+#include <filesystem>
 #include <sstream>
 
 #include "topology/spec.hpp"
@@ -100,7 +102,7 @@ void check_render(Options& o, const Raw& raw, const po::variables_map& vm) {
   if (vm.count("width")) o.width = in_range<int>(raw.width, 1, 16384, "--width");
   if (vm.count("height")) o.height = in_range<int>(raw.height, 1, 16384, "--height");
   if (vm.count("tessellate")) o.tessellate = in_range<int>(raw.tessellate, 1, 256, "--tessellate");
-  if (o.output.empty()) o.output = default_output(o.scene);
+  if (!vm.count("output")) o.output = default_output(o.scene);
 }
 
 // A bare kind takes --nodes (default 16); a full spec stands alone or must agree.
@@ -155,6 +157,40 @@ void reject_machine_options(const po::options_description& machine, const po::va
     const std::string& name = option->long_name();
     if (name != "single" && vm.count(name) && !vm[name].defaulted())
       throw UsageError("--" + name + ": an option of the machine, but --single renders without one");
+  }
+}
+
+// Each file option names a file, of the kind its writer makes: a name that
+// is empty, or whose extension says another kind, is refused before the
+// render rather than written under a misleading name after it.
+void check_output_names(const Options& o, const po::variables_map& vm) {
+  struct Named {
+    const char* option;
+    const std::string& path;
+    std::vector<std::string> extensions;  // lower case; none: any name
+  };
+  const Named outputs[] = {
+      {"output", o.output, {".png", ".ppm"}},
+      {"stats", o.stats_path, {}},
+      {"tiles", o.tiles_csv, {}},
+      {"machine-svg", o.pictures.machine_svg, {".svg"}},
+      {"ownership", o.pictures.ownership_png, {".png", ".ppm"}},
+      {"timeline", o.pictures.timeline_svg, {".svg"}},
+      {"report", o.pictures.report_html, {".html", ".htm"}},
+  };
+  for (const Named& n : outputs) {
+    if (!vm.count(n.option)) continue;
+    const std::string option = std::string("--") + n.option;
+    if (n.path.empty()) throw UsageError(option + ": needs a file name");
+    if (n.extensions.empty()) continue;
+    std::string extension = std::filesystem::path(n.path).extension().string();
+    std::transform(extension.begin(), extension.end(), extension.begin(),
+                   [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+    if (std::find(n.extensions.begin(), n.extensions.end(), extension) == n.extensions.end()) {
+      std::string kinds;
+      for (const std::string& e : n.extensions) kinds += (kinds.empty() ? "" : " or ") + e;
+      throw UsageError(option + ": expected a " + kinds + " file name, got '" + n.path + "'");
+    }
   }
 }
 
@@ -245,6 +281,7 @@ Options parse_options(int argc, const char* const argv[]) {
   if (vm.count("help")) o.action = Options::Action::help;
   else if (vm.count("version")) o.action = Options::Action::version;
   check_render(o, raw, vm);
+  check_output_names(o, vm);
   if (o.single) reject_machine_options(machine, vm);
   raw.timing.profile_given = !vm["profile"].defaulted();
   check_machine(o, raw, vm);

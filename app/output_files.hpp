@@ -1,10 +1,10 @@
 // The files a command writes, removed again unless it finishes, so that a
-// failed run leaves no output behind. A path is added just before it is
-// written, and a failed command removes it even if the write that failed
-// left an older file there, so that nothing at that path can pass for this
-// command's output. Removal
-// goes in reverse order, so a directory added before the files made in it
-// goes last, once it is empty (a directory that is not empty stays).
+// failed run leaves no output behind. Every writer here puts a file in place
+// whole or not at all (tracer/atomic_file.hpp), and a path is added only
+// once its file is in place: a write that fails leaves whatever stood at
+// that path before, and what a failed command removes is only what it wrote.
+// Removal goes in reverse order, so a directory added before the files made
+// in it goes last, once it is empty (a directory that is not empty stays).
 #pragma once
 
 #include <filesystem>
@@ -35,15 +35,16 @@ class OutputFiles {
   std::function<void(const std::filesystem::path&)> tracker() {
     return [this](const std::filesystem::path& path) { add(path); };
   }
-  // Adds `path`, then writes it with write_to(path); returns the path.
+  // Writes `path` with write_to(path), which must put it in place whole or
+  // not at all, then adds it; returns the path.
   template <class Write>
   std::filesystem::path write(const std::filesystem::path& path, Write&& write_to) {
-    add(path);
     write_to(path);
+    add(path);
     return path;
   }
-  // Adds `path`, then writes `text` to it whole (tracer/atomic_file.hpp);
-  // std::runtime_error naming the path if it cannot be written.
+  // Writes `text` to `path` whole, then adds it; std::runtime_error naming
+  // the path if it cannot be written.
   std::filesystem::path write_text(const std::filesystem::path& path, const std::string& text) {
     return write(path, [&](const std::filesystem::path& p) { tracer::write_text_atomically(p.string(), text); });
   }

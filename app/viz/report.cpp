@@ -90,10 +90,10 @@ class PageWriter {
   }
 
   void operator()(const ImageFigure& f) {
-    const std::string name = html_.stem().string() + "-" + std::to_string(++images_) + ".png";
-    const fs::path png = html_.parent_path() / name;
-    track_(png);  // before writing, as the caller removes what a failure leaves
-    f.image.write_png(png.string());
+    const fs::path png = report_image_path(html_, ++images_);
+    const std::string name = png.filename().string();
+    f.image.write_png(png.string());  // whole or not at all
+    track_(png);
     out += "<figure>\n<img src=\"" + escape_xml(url_of(name)) + "\" width=\"" + std::to_string(f.image.width()) +
            "\" height=\"" + std::to_string(f.image.height()) + "\" alt=\"" + escape_xml(f.caption) + "\"/>\n" +
            figcaption(f.caption) + "</figure>\n";
@@ -114,8 +114,7 @@ class PageWriter {
   int images_ = 0;
 };
 
-// Writes the PNGs (each tracked before it is written) and then the page,
-// tracked once it is in place.
+// Writes the PNGs and then the page, each tracked once it is in place.
 void write_page(const fs::path& html_path, const Report& report, const FileTracker& track) {
   PageWriter page(html_path, track);
   page.out = "<!DOCTYPE html>\n<html lang=\"en\">\n<head>\n<meta charset=\"utf-8\"/>\n<title>" +
@@ -132,6 +131,10 @@ void write_page(const fs::path& html_path, const Report& report, const FileTrack
 }
 
 }  // namespace
+
+fs::path report_image_path(const fs::path& html_path, int n) {
+  return html_path.parent_path() / (html_path.stem().string() + "-" + std::to_string(n) + ".png");
+}
 
 std::vector<fs::path> write_html_report(const fs::path& html_path, const Report& report, const FileTracker& track) {
   // What was tracked is what was written, once the page is in place.

@@ -55,15 +55,18 @@ struct Report {
   std::vector<Section> sections{};
 };
 
-// Called with each file the writer may leave behind: a PNG before it is
-// written, the page once it is in place. A caller that must leave nothing
-// after a failure removes what it was given (app::OutputFiles).
+// Called with each file the writer has put in place, whole: the PNGs, then
+// the page. A caller that must leave nothing after a failure removes what
+// it was given (app::OutputFiles).
 using FileTracker = std::function<void(const std::filesystem::path&)>;
 
 // Writes the page to html_path (through a temporary file renamed into
 // place) and its PNGs beside it. Returns every file written, the HTML last.
 // Throws std::invalid_argument if an SvgFigure does not hold an <svg>
 // document, std::runtime_error naming the path on an I/O failure.
+// Where the page at html_path puts its n-th image (n from 1), beside it.
+std::filesystem::path report_image_path(const std::filesystem::path& html_path, int n);
+
 std::vector<std::filesystem::path> write_html_report(const std::filesystem::path& html_path, const Report& report,
                                                      const FileTracker& track);
 

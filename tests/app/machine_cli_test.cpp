@@ -294,6 +294,35 @@ TEST_F(MachineCli, AnOutputThatCannotBeWrittenLeavesNoOtherFile) {
   }
 }
 
+// Two outputs at one path would overwrite each other; the page's own images
+// count too. Refused before the render, leaving nothing.
+TEST_F(MachineCli, TwoOutputsAtOnePathAreAnError) {
+  const std::vector<std::pair<std::string, std::string>> cases{
+      {"-o x.png --ownership x.png", "--output and --ownership would both write 'x.png'"},
+      {"--stats t.json --tiles ./t.json", "--stats and --tiles would both write './t.json'"},
+      {"-o r-2.png --report r.html", "--output and --report's image would both write 'r-2.png'"},
+  };
+  for (const auto& [args, message] : cases) {
+    const Outcome r = run(std::string(kSmall) + " -q " + args);
+    EXPECT_EQ(r.exit_code, 2) << args;
+    EXPECT_EQ(lines(r.err), 1u) << args << ": " << r.err;
+    EXPECT_NE(r.err.find(message), std::string::npos) << args << ": " << r.err;
+    for (const auto& entry : fs::directory_iterator(dir_))
+      EXPECT_TRUE(entry.path().filename().string().starts_with("std")) << args << " left " << entry.path();
+  }
+}
+
+// A failed run removes what it wrote, and only that: what stood at a path
+// it could not write stays, here an empty directory in the way of --stats.
+TEST_F(MachineCli, AFailedRunLeavesWhatItDidNotWrite) {
+  fs::create_directory(dir_ / "in_the_way.json");
+  const Outcome r = run(std::string(kSmall) + " -q -o out.png --stats in_the_way.json");
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_NE(r.err.find("in_the_way.json"), std::string::npos) << r.err;
+  EXPECT_TRUE(fs::is_directory(dir_ / "in_the_way.json"));
+  EXPECT_FALSE(fs::exists(dir_ / "out.png"));
+}
+
 TEST_F(MachineCli, ErrorsNameTheOption) {
   EXPECT_NE(run("--cache-pages 0").err.find("--cache-pages"), std::string::npos);
   EXPECT_NE(run("--topology ring:8 --nodes 4").err.find("--topology"), std::string::npos);

@@ -61,6 +61,10 @@ TEST(MachinePictures, WritesWellFormedSvgAndAPageLinkingOnlyItsFiles) {
   const auto run = small_run(false);
   const app::PictureFiles files{dir / "machine.svg", dir / "owners.png", dir / "run.html", dir / "tiles.svg"};
   const auto written = app::write_machine_pictures(files, "teapot on a 2x2 mesh", run.image, run.report);
+  // What the command line checks for clashes before the render is what is written.
+  std::vector<fs::path> announced;
+  for (const auto& [option, path] : app::picture_outputs(files)) announced.push_back(path);
+  EXPECT_EQ(written, announced);
 
   const auto svg = viz::test::check_xml(read(files.machine_svg));
   ASSERT_TRUE(svg.ok) << svg.error;

@@ -63,6 +63,22 @@ TEST(Options, BadValuesNameTheOption) {
   EXPECT_NE(error_of({"--frobnicate"}).find("frobnicate"), std::string::npos);
 }
 
+// A file option names a file of the kind its writer makes, given before the
+// render rather than found wanting after it.
+TEST(Options, OutputNamesMustNameAFileOfTheirKind) {
+  EXPECT_EQ(error_of({"--machine-svg", "m.png"}), "--machine-svg: expected a .svg file name, got 'm.png'");
+  EXPECT_EQ(error_of({"--timeline", "t"}), "--timeline: expected a .svg file name, got 't'");
+  EXPECT_EQ(error_of({"--ownership", "notes.txt"}),
+            "--ownership: expected a .png or .ppm file name, got 'notes.txt'");
+  EXPECT_EQ(error_of({"--report", "r.pdf"}), "--report: expected a .html or .htm file name, got 'r.pdf'");
+  EXPECT_EQ(error_of({"-o", "image.jpg"}), "--output: expected a .png or .ppm file name, got 'image.jpg'");
+  for (const char* option : {"--stats", "--tiles", "--machine-svg", "--ownership", "--report", "-o"})
+    EXPECT_NE(error_of({option, ""}).find(": needs a file name"), std::string::npos) << option;
+  const Options o = parse({"-o", "A.PPM", "--machine-svg", "dir.d/M.SVG", "--report", "r.htm", "--stats", "s"});
+  EXPECT_EQ(o.pictures.report_html, "r.htm");
+  EXPECT_EQ(o.stats_path, "s");
+}
+
 // 0 stands for "the scene's own" inside Options, but a user who writes 0
 // asked for something that does not exist.
 TEST(Options, AnExplicitZeroSizeOrTessellationIsAnError) {
