@@ -1,6 +1,7 @@
 // Cost models, profiles and the virtual-time hooks of the machine (see timing.hpp).
 #include "nodes/timing.hpp"
 
+#include <algorithm>
 #include <charconv>
 #include <chrono>
 #include <cmath>
@@ -267,7 +268,10 @@ void ComputeMeter::advance_clock() {
   const auto total_ps = static_cast<std::int64_t>(std::llround(charged_ * 1e12));
   const std::int64_t step = total_ps - charged_ps_;
   charged_ps_ = total_ps;
-  if (step > 0) csp::this_process::advance(csp::VirtualDuration(step));
+  if (step <= 0) return;
+  const std::int64_t now = csp::this_process::now().count();
+  cpu_->busy_until_ps = std::max(now, cpu_->busy_until_ps) + step;
+  csp::this_process::advance(csp::VirtualDuration(cpu_->busy_until_ps - now));
 }
 
 MachineTiming::MachineTiming(CostModel model, int nodes)

@@ -81,10 +81,15 @@ void apply_costs(CostModel& model, const std::string& spec, const std::string& w
 CostModel read_profile_file(const std::string& path);
 
 // One processor's CPU as the meters see it: page-handler time taken from its
-// pixel computers, shared out equally among them.
+// pixel computers, shared out equally among them, and the virtual time until
+// which the CPU is busy with a charge. A node's pixel computers share the
+// one CPU: a charge runs from the later of its process's clock and the end
+// of the charge before it, so their work overlaps only their waits (for
+// pages and tiles), never itself.
 struct NodeCpu {
   double stolen = 0;  // seconds of page handling so far
   int workers = 0;
+  std::int64_t busy_until_ps = 0;
 };
 
 // Charges one pixel computer's counted work as virtual time.
@@ -93,7 +98,8 @@ class ComputeMeter {
   ComputeMeter(const CostModel& model, const tracer::RayStats& rays, std::shared_ptr<NodeCpu> cpu);
   // At the end of a tile: advances the calling process's clock by the work
   // done since the last charge, the tile's two messages and the handler
-  // time stolen from this node meanwhile.
+  // time stolen from this node meanwhile, run on the node's CPU after any
+  // charge of another of its pixel computers still running there.
   void charge();
   // The same before a page request, with its two messages instead.
   void charge_page_request();

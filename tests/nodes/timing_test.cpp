@@ -99,8 +99,9 @@ TEST(Timing, MessageSoftwareCostsBothProcessorsTwoMessagesPerPageRequest) {
 }
 
 nodes::MachineResult run_timed(const std::string& topology, std::size_t n, unsigned threads,
-                               const CostModel& model, bool record_tiles = false) {
+                               const CostModel& model, bool record_tiles = false, int workers_per_node = 1) {
   nodes::MachineOptions options;
+  options.workers_per_node = workers_per_node;
   options.record_tiles = record_tiles;
   options.topology = topology;
   options.nodes = n;
@@ -175,6 +176,26 @@ TEST(Timing, ComputeTimeFollowsCountedWork) {
   EXPECT_NEAR(r.report.compute_seconds, expected, 1e-9);
   // One node, free messages: the frame takes exactly its compute time.
   EXPECT_NEAR(r.report.predicted_seconds, expected, 1e-9);
+}
+
+// A processor's pixel computers share its one CPU: on one node, where no
+// page is remote, more of them cannot finish the frame sooner than its
+// compute time, which is the same work however it is split.
+TEST(Timing, PixelComputersOfANodeShareItsCpu) {
+  CostModel model;
+  model.box = 1e-6;
+  model.prim = 2e-6;
+  const auto one = run_timed("hypercube", 1, 1, model);
+  for (int workers : {2, 3}) {
+    const auto many = run_timed("hypercube", 1, 1, model, false, workers);
+    EXPECT_NEAR(many.report.compute_seconds, one.report.compute_seconds, 1e-9) << workers;
+    EXPECT_NEAR(many.report.predicted_seconds, one.report.predicted_seconds, 1e-9) << workers;
+  }
+  // On several nodes they still overlap one another's waits for pages.
+  model.hop = 1e-3;
+  const auto spread = run_timed("hypercube", 4, 1, model);
+  const auto overlapped = run_timed("hypercube", 4, 1, model, false, 2);
+  EXPECT_LT(overlapped.report.predicted_seconds, spread.report.predicted_seconds);
 }
 
 TEST(Timing, EveryTileCostsTwoMessagesOfSoftware) {
