@@ -3,10 +3,12 @@
 #include "app/sweep.hpp"
 
 #include <boost/program_options.hpp>
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <iomanip>
 #include <iostream>
+#include <limits>
 #include <sstream>
 
 #include "app/options.hpp"
@@ -20,6 +22,8 @@ namespace po = boost::program_options;
 
 namespace {
 
+// The values of a swept axis, in increasing order (a plot's line runs along
+// them); a value listed twice is an error, not a second run.
 template <class T>
 std::vector<T> parse_list(const std::string& text, const std::string& option) {
   std::vector<T> values;
@@ -32,10 +36,14 @@ std::vector<T> parse_list(const std::string& text, const std::string& option) {
     } catch (const std::exception&) {
       used = 0;
     }
-    if (used != item.size() || v < 1) throw UsageError(option + ": expected positive integers, got '" + item + "'");
+    if (used != item.size() || v < 1 || static_cast<unsigned long long>(v) > std::numeric_limits<T>::max())
+      throw UsageError(option + ": expected positive integers, got '" + item + "'");
     values.push_back(static_cast<T>(v));
   }
   if (values.empty()) throw UsageError(option + ": empty list");
+  std::sort(values.begin(), values.end());
+  if (const auto twice = std::adjacent_find(values.begin(), values.end()); twice != values.end())
+    throw UsageError(option + ": " + std::to_string(*twice) + " is listed twice");
   return values;
 }
 

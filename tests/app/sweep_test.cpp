@@ -86,6 +86,10 @@ TEST(SweepOptions, BadValuesNameTheOption) {
       // Zero would otherwise mean "no fit" in silence.
       {{"nodes", "--fit-seconds", "0"}, "--fit-seconds"},
       {{"nodes", "--fit-seconds", "inf"}, "--fit-seconds"},
+      // A value twice would be a second run and a line doubling back.
+      {{"nodes", "--nodes", "2,4,2"}, "--nodes: 2 is listed twice"},
+      {{"cache", "--cache-pages", "8,8"}, "--cache-pages: 8 is listed twice"},
+      {{"cache", "--cache-pages", "4294967297"}, "--cache-pages: expected positive integers, got '4294967297'"},
   };
   for (const auto& [args, option] : cases) {
     try {
@@ -95,6 +99,12 @@ TEST(SweepOptions, BadValuesNameTheOption) {
       EXPECT_NE(std::string(e.what()).find(option), std::string::npos) << e.what();
     }
   }
+}
+
+// A plot's line runs along the axis in increasing order, whatever the order given.
+TEST(SweepOptions, TheSweptAxisRunsInIncreasingOrder) {
+  EXPECT_EQ(parse({"nodes", "--nodes", "4,1,16,2"}).nodes, (std::vector<std::size_t>{1, 2, 4, 16}));
+  EXPECT_EQ(parse({"cache", "--cache-pages", "64,8,32"}).cache_pages, (std::vector<std::uint32_t>{8, 32, 64}));
 }
 
 // Known before the runs, which may take minutes, rather than after them.
