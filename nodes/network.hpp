@@ -45,7 +45,7 @@ namespace nodes {
 struct NetworkOptions {
   std::size_t buffer_capacity = 4;  // packets per output queue and per injection channel, at least 1
   unsigned ports_per_node = 1;      // local ports per node
-  std::uint64_t trace_routes = 0;   // record routes of packets whose id is below this
+  std::uint64_t trace_routes = 0;   // record the routes of the first this many packets injected
   LinkModel link;                   // optional per-hop latency and bandwidth
   std::function<unsigned(NodeId)> placement;  // thread of node n; default block
 };
@@ -103,6 +103,7 @@ class Network {
   // Counters live here so they outlive the processes; each is written by
   // exactly one process and read only after run().
   std::vector<std::unique_ptr<RouterCounters>> router_counters_;
+  std::atomic<std::uint64_t> routes_to_trace_;  // RouterConfig::routes_to_trace
 };
 
 // "page 17: 5 → 4 → 6 → 7 (3 hops)"

@@ -83,9 +83,17 @@ void Router::accept_injection(Packet& packet) const {
   ++counters_.injected;
   packet.source = self_;
   packet.hops = 0;
-  packet.traced = packet.traced || packet.id < config_.trace_routes;
+  packet.traced = packet.traced || take_route_to_trace();
   packet.route.clear();
   if (packet.traced) packet.route.push_back(self_);
+}
+
+bool Router::take_route_to_trace() const {
+  if (config_.routes_to_trace == nullptr) return false;
+  std::uint64_t left = config_.routes_to_trace->load(std::memory_order_relaxed);
+  while (left > 0)
+    if (config_.routes_to_trace->compare_exchange_weak(left, left - 1, std::memory_order_relaxed)) return true;
+  return false;
 }
 
 std::size_t Router::output_queue(const Packet& packet) const {

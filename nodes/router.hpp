@@ -33,6 +33,7 @@
 // cycle through the network with its own injection.
 #pragma once
 
+#include <atomic>
 #include <array>
 #include <cstdint>
 #include <optional>
@@ -80,7 +81,10 @@ struct RouterEnds {
 };
 
 struct RouterConfig {
-  std::uint64_t trace_routes = 0;  // trace packets whose id is below this
+  // Routes still to trace, shared by every router of the network: each
+  // injection takes one while any are left, so the first packets injected
+  // are traced, however their senders number them. Null: none traced.
+  std::atomic<std::uint64_t>* routes_to_trace = nullptr;
 };
 
 class Router {
@@ -98,6 +102,7 @@ class Router {
   void build_alt();
   void receive(std::size_t source, Packet packet);
   void accept_injection(Packet& packet) const;
+  bool take_route_to_trace() const;
   bool try_send(std::size_t queue, Packet& packet);
   void hold(std::size_t source, Packet packet, std::size_t queue);
   void admit_pending(std::size_t queue);

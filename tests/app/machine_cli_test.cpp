@@ -330,6 +330,12 @@ TEST_F(MachineCli, ErrorsNameTheOption) {
 }
 
 TEST_F(MachineCli, TraceRoutesPrintsThatManyRouteLines) {
+  // The first packets injected, whichever processes sent them.
+  for (const char* machine : {"", " --topology ring --nodes 8", " --nodes 64"}) {
+    const Outcome many = run(std::string(kSmall) + machine + " -q --trace-routes 40 -o out.png");
+    ASSERT_EQ(many.exit_code, 0) << machine << ": " << many.err;
+    EXPECT_EQ(lines(many.out), 40u) << machine;
+  }
   const Outcome r = run(std::string(kSmall) + " -q --trace-routes 3 -o out.png");
   ASSERT_EQ(r.exit_code, 0) << r.err;
   EXPECT_EQ(lines(r.out), 3u) << r.out;

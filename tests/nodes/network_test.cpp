@@ -166,8 +166,13 @@ TEST(Network, TracedRoutesFollowLinksHopByHop) {
     for (std::size_t i = 1; i < r.route.size(); ++i)
       EXPECT_EQ(t.distance(r.route[i - 1], r.route[i]), 1u);
   }
-  // Packet 6 goes from node 0 to node 7 by e-cube: 0, 1, 3, 7.
-  EXPECT_EQ(format_route(stats.routes[6], name_kind), "traffic 6: 0 \u2192 1 \u2192 3 \u2192 7 (3 hops)");
+  // Each goes the topology's own way: e-cube, lowest dimension first.
+  for (const auto& r : stats.routes)
+    for (std::size_t i = 1; i < r.route.size(); ++i)
+      EXPECT_EQ(r.route[i], t.neighbour(r.route[i - 1], t.next_hop(r.route[i - 1], r.route.back()).port));
+  // "traffic 6: 0 → 1 → 3 → 7 (3 hops)" for a packet from node 0 to node 7.
+  const nodes::RouteRecord zero_to_seven{6, kind_traffic, {0, 1, 3, 7}};
+  EXPECT_EQ(format_route(zero_to_seven, name_kind), "traffic 6: 0 \u2192 1 \u2192 3 \u2192 7 (3 hops)");
   const std::string summary = format_summary(stats, t, name_kind);
   EXPECT_NE(summary.find("busiest link"), std::string::npos) << summary;
   EXPECT_NE(summary.find("traffic"), std::string::npos) << summary;
