@@ -15,14 +15,20 @@ bool looks_like_path(const std::string& s) {
   return s.find('/') != std::string::npos || s.ends_with(".nff") || s.ends_with(".gz");
 }
 
+// Anything that exists and is not a directory is read as a file, so FIFOs,
+// /dev/stdin and process substitutions work as well as regular files.
 tracer::Scene read_scene(const std::string& spec) {
   std::error_code ec;
-  if (spec == "-" || std::filesystem::is_regular_file(spec, ec)) return tracer::load_nff_file(spec);
-  if (looks_like_path(spec)) throw std::runtime_error(spec + ": no such file");
+  const std::filesystem::file_status status = std::filesystem::status(spec, ec);
+  const bool directory = std::filesystem::is_directory(status);
+  if (spec == "-" || (std::filesystem::exists(status) && !directory)) return tracer::load_nff_file(spec);
+  const std::string not_a_file = directory ? "is a directory, not an NFF file" : "no such file";
+  if (looks_like_path(spec)) throw std::runtime_error(spec + ": " + not_a_file);
   try {
     return tracer::generate_scene(spec);
   } catch (const std::invalid_argument& e) {
-    throw std::runtime_error(std::string(e.what()) + " (and no file of that name)");
+    const std::string file_note = directory ? "that name " + not_a_file : "no file of that name";
+    throw std::runtime_error(std::string(e.what()) + " (and " + file_note + ")");
   }
 }
 

@@ -1,5 +1,7 @@
-// Turns the SCENE argument into a tracer::Scene: an existing file (or "-" for
-// stdin) is parsed as NFF, any other name is looked up among the built-ins.
+// Turns the SCENE argument into a tracer::Scene: anything existing that is not
+// a directory (a regular file, a FIFO, /dev/stdin, a process substitution; or
+// "-" for stdin) is parsed as NFF, any other name is looked up among the
+// built-ins. A directory is refused as such unless a built-in has its name.
 // Image-size and tessellation options are applied here, before any build.
 #pragma once
 

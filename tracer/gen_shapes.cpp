@@ -3,6 +3,7 @@
 // Gaussian generator, so the surface matches the reference files), balls
 // (the sphereflake) and rings (dodecahedral rings of cylinders and spheres).
 // Objects come out in the SPD programs' order.
+#include <algorithm>
 #include <cmath>
 
 #include "tracer/gen_spd.hpp"
@@ -110,11 +111,12 @@ std::vector<Vec3d> flake_directions() {
 void flake(Scene& scene, const std::vector<Vec3d>& set, int depth, const Vec3d& c, double r, const Vec3d& dir) {
   spd::add_sphere(scene, c, r);
   if (depth == 0) return;
-  // Rotation taking +Z to dir.
+  // Rotation taking +Z to dir (unit up to rounding, so dir.z may miss +-1
+  // where dir is along Z: the axis decides, and acos gets a clamped cosine).
+  const Vec3d axis = cross(Vec3d{0, 0, 1}, dir);
   auto orient = [&](const Vec3d& v) {
-    if (dir.z >= 1) return v;
-    if (dir.z <= -1) return spd::rotate_y(v, kPi);
-    return spd::rotate(v, normalize(cross(Vec3d{0, 0, 1}, dir)), std::acos(dir.z));
+    if (length(axis) == 0) return dir.z > 0 ? v : spd::rotate_y(v, kPi);
+    return spd::rotate(v, normalize(axis), std::acos(std::clamp(dir.z, -1.0, 1.0)));
   };
   double scale = r * (1 + 1.0 / 3);
   for (const Vec3d& v : set) {

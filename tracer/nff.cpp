@@ -1,10 +1,13 @@
 // NFF parser: a token reader over the whole (inflated) text, and one small
 // function per entity. Every check that can fail names the line of the token
-// that broke it; see nff.hpp for the choices made where NFF is silent.
+// that broke it, or for a fault of a whole entity (a polygon's shape, a
+// material, a second view) the line of its keyword; see nff.hpp for the
+// choices made where NFF is silent.
 #include "tracer/nff.hpp"
 
 #include <zlib.h>
 
+#include <algorithm>
 #include <charconv>
 #include <cmath>
 #include <fstream>
@@ -20,7 +23,14 @@ bool is_gzip(std::string_view data) {
          static_cast<unsigned char>(data[1]) == 0x8b;
 }
 
-// Inflates a gzip stream (several members allowed, as gzip(1) writes them).
+// Zero bytes after the last member: tape or block padding, which gzip(1)
+// ignores too.
+bool only_zero_bytes(const Bytef* data, uInt size) {
+  return std::all_of(data, data + size, [](Bytef b) { return b == 0; });
+}
+
+// Inflates a gzip stream (several members allowed, as gzip(1) writes them,
+// and trailing zero padding).
 std::string inflate_gzip(std::string_view data, const std::string& source) {
   z_stream zs{};
   if (inflateInit2(&zs, 16 + MAX_WBITS) != Z_OK) throw SceneError(source + ": cannot initialise zlib");
@@ -29,7 +39,7 @@ std::string inflate_gzip(std::string_view data, const std::string& source) {
   std::string out;
   char chunk[1 << 16];
   int status = Z_OK;
-  while (status != Z_STREAM_END || zs.avail_in > 0) {
+  while (status != Z_STREAM_END || !only_zero_bytes(zs.next_in, zs.avail_in)) {
     if (status == Z_STREAM_END) inflateReset(&zs);  // next gzip member
     zs.next_out = reinterpret_cast<Bytef*>(chunk);
     zs.avail_out = sizeof chunk;
@@ -52,9 +62,10 @@ std::string inflate_gzip(std::string_view data, const std::string& source) {
   return out;
 }
 
-// Whitespace-separated tokens; '#' at the start of a token comments out the
-// rest of its line. line() is the line of the last token read, so an error at
-// end of file points at the line that was cut short.
+// Whitespace-separated tokens; '#' anywhere, even right after a token, ends
+// the token and comments out the rest of its line. A line ends at "\n",
+// "\r\n" or a lone "\r" (old Mac files). line() is the line of the last token
+// read, so an error at end of file points at the line that was cut short.
 class Lexer {
  public:
   explicit Lexer(std::string_view text) : text_(text) {}
@@ -63,7 +74,7 @@ class Lexer {
     skip_blanks();
     if (pos_ < text_.size()) token_line_ = line_;
     std::size_t start = pos_;
-    while (pos_ < text_.size() && !is_blank(text_[pos_])) ++pos_;
+    while (pos_ < text_.size() && !is_blank(text_[pos_]) && text_[pos_] != '#') ++pos_;
     return text_.substr(start, pos_ - start);
   }
 
@@ -81,13 +92,18 @@ class Lexer {
     return c == ' ' || c == '\t' || c == '\n' || c == '\r' || c == '\f' || c == '\v';
   }
 
+  // A '\r' followed by '\n' is left to the '\n' to count.
+  bool ends_line(std::size_t at) const {
+    return text_[at] == '\n' || (text_[at] == '\r' && (at + 1 == text_.size() || text_[at + 1] != '\n'));
+  }
+
   void skip_blanks() {
     while (pos_ < text_.size()) {
       char c = text_[pos_];
       if (c == '#') {
-        while (pos_ < text_.size() && text_[pos_] != '\n') ++pos_;
+        while (pos_ < text_.size() && text_[pos_] != '\n' && text_[pos_] != '\r') ++pos_;
       } else if (is_blank(c)) {
-        line_ += c == '\n';
+        line_ += ends_line(pos_);
         ++pos_;
       } else {
         return;
@@ -118,11 +134,45 @@ std::string describe(std::string_view token) {
   return shown + "'";
 }
 
+// Removes one leading '+' (from_chars takes only '-'); false when what follows
+// cannot start an unsigned number, as in "+-1" or "+".
+bool strip_plus(std::string_view& token) {
+  if (token.empty() || token.front() != '+') return true;
+  token.remove_prefix(1);
+  return !token.empty() && token.front() != '+' && token.front() != '-';
+}
+
+// Whether a decimal number that from_chars found out of range is tiny (it
+// underflowed) rather than huge: its first significant digit stands below the
+// units place once the exponent is applied. Such numbers are below 1e-300 or
+// above 1e300, so the order of magnitude alone decides.
+bool underflows(std::string_view token) {
+  const std::size_t e = token.find_first_of("eE");
+  const std::string_view mantissa = token.substr(0, e);
+  long long exponent = 0;
+  if (e != std::string_view::npos) {
+    std::string_view digits = token.substr(e + 1);
+    strip_plus(digits);
+    if (std::from_chars(digits.data(), digits.data() + digits.size(), exponent).ec != std::errc())
+      exponent = digits.front() == '-' ? -(1LL << 62) : 1LL << 62;  // beyond long long
+  }
+  const std::size_t point = std::min(mantissa.find('.'), mantissa.size());
+  const std::size_t first = mantissa.find_first_of("123456789");
+  const long long place = first < point ? static_cast<long long>(point - first) - 1
+                                        : -static_cast<long long>(first - point);
+  return place + exponent < 0;
+}
+
+// A finite double; an underflow is taken as the zero it rounds to.
 bool parse_double(std::string_view token, double& value) {
-  if (!token.empty() && token.front() == '+') token.remove_prefix(1);
-  if (token.empty() || token.front() == '+') return false;
+  if (!strip_plus(token)) return false;
   auto [end, ec] = std::from_chars(token.data(), token.data() + token.size(), value);
-  return ec == std::errc() && end == token.data() + token.size() && std::isfinite(value);
+  if (token.empty() || end != token.data() + token.size()) return false;
+  if (ec == std::errc::result_out_of_range && underflows(token)) {
+    value = token.front() == '-' ? -0.0 : 0.0;
+    return true;
+  }
+  return ec == std::errc() && std::isfinite(value);
 }
 
 bool looks_numeric(std::string_view token) {
@@ -147,6 +197,10 @@ class Parser {
 
  private:
   void entity(std::string_view key) {
+    const std::string_view previous_key = entity_key_;
+    const int previous_line = entity_line_;
+    entity_key_ = key;
+    entity_line_ = lex_.line();
     if (key == "v") return view();
     if (key == "b") return void(scene_.background = color("background colour"));
     if (key == "l") return light();
@@ -155,16 +209,29 @@ class Parser {
     if (key == "s") return sphere();
     if (key == "p") return polygon();
     if (key == "pp") return patch();
-    fail("an entity keyword (v b l f c s p pp)", key);
+    fail("an entity keyword (v b l f c s p pp)", key, surplus_hint(previous_key, previous_line, key));
   }
 
-  [[noreturn]] void fail(std::string_view expected, std::string_view got) const {
+  // A number where a keyword belongs most likely belongs to the entity before.
+  static std::string surplus_hint(std::string_view previous_key, int previous_line, std::string_view got) {
+    if (previous_key.empty() || !looks_numeric(got)) return "";
+    const bool counted = previous_key == "p" || previous_key == "pp";
+    return " (does the '" + std::string(previous_key) + "' at line " + std::to_string(previous_line) +
+           (counted ? " have more vertices than its count says?)" : " have more numbers than it takes?)");
+  }
+
+  [[noreturn]] void fail(std::string_view expected, std::string_view got, const std::string& hint = "") const {
     throw SceneError(source_ + ":" + std::to_string(lex_.line()) + ": expected " +
-                     std::string(expected) + ", got " + describe(got));
+                     std::string(expected) + ", got " + describe(got) + hint);
   }
 
-  [[noreturn]] void fail_here(const std::string& what) const {
-    throw SceneError(source_ + ":" + std::to_string(lex_.line()) + ": " + what);
+  [[noreturn]] void fail_here(const std::string& what) const { fail_at(lex_.line(), what); }
+
+  // For a fault of the entity as a whole: names the line of its keyword.
+  [[noreturn]] void fail_at_entity(const std::string& what) const { fail_at(entity_line_, what); }
+
+  [[noreturn]] void fail_at(int line, const std::string& what) const {
+    throw SceneError(source_ + ":" + std::to_string(line) + ": " + what);
   }
 
   double number(std::string_view what) {
@@ -191,10 +258,13 @@ class Parser {
   }
 
   long long integer(std::string_view what, long long lo, long long hi) {
-    std::string_view token = lex_.next();
+    const std::string_view token = lex_.next();
+    std::string_view digits = token;
     long long value = 0;
-    auto [end, ec] = std::from_chars(token.data(), token.data() + token.size(), value);
-    if (token.empty() || ec != std::errc() || end != token.data() + token.size() || value < lo || value > hi)
+    const bool sign_ok = strip_plus(digits);
+    auto [end, ec] = std::from_chars(digits.data(), digits.data() + digits.size(), value);
+    if (!sign_ok || digits.empty() || ec != std::errc() || end != digits.data() + digits.size() || value < lo ||
+        value > hi)
       fail(std::string(what) + " (an integer in " + std::to_string(lo) + ".." + std::to_string(hi) + ")", token);
     return value;
   }
@@ -215,14 +285,20 @@ class Parser {
   void polygon();
   void patch();
   std::uint32_t current_material();
-  void check_first_corner(const std::vector<Vec3d>& vertices);
+  void check_polygon_shape(const std::vector<Vec3d>& vertices, const std::string& what);
 
   Lexer lex_;
   const std::string& source_;
   Scene scene_;
+  std::string_view entity_key_;  // the entity being read, and its keyword's line
+  int entity_line_ = 0;
+  int view_line_ = 0;  // of the "v" read so far, 0 before it
 };
 
 void Parser::view() {
+  if (view_line_ != 0)
+    fail_at_entity("a second view ('v'); the scene has one camera, already set at line " + std::to_string(view_line_));
+  view_line_ = entity_line_;
   Camera& cam = scene_.camera;
   keyword("from");
   cam.from = vec3("eye position");
@@ -259,6 +335,8 @@ void Parser::material() {
   m.shine = number("Phong exponent");
   m.transmittance = number("transmittance");
   m.ior = number("index of refraction");
+  if (m.transmittance > 0 && !(m.ior > 0))
+    fail_at_entity("a transmitting material (T > 0) needs an index of refraction above 0");
   scene_.materials.push_back(m);
 }
 
@@ -286,19 +364,38 @@ void Parser::sphere() {
   scene_.objects.push_back({s, current_material()});
 }
 
-// The first three vertices fix the normal, so they must span a triangle.
-void Parser::check_first_corner(const std::vector<Vec3d>& v) {
-  Vec3d a = v[1] - v[0], b = v[2] - v[0];
-  double area = length(cross(a, b));
-  if (!(area > 1e-12 * length(a) * length(b)))
-    fail_here("polygon's first three vertices are collinear, so its normal is undefined");
+// The first three vertices fix the normal (NFF.md), so they must span a
+// triangle that turns the way the whole polygon does, judged by its area
+// (Newell) normal; and every vertex must lie in the plane, up to the rounding
+// of coordinates printed with few digits.
+void Parser::check_polygon_shape(const std::vector<Vec3d>& v, const std::string& what) {
+  const Vec3d a = v[1] - v[0], b = v[2] - v[0];
+  const Vec3d corner = cross(a, b);
+  if (!(length(corner) > 1e-12 * length(a) * length(b)))
+    fail_at_entity(what + "'s first three vertices are collinear, so its normal is undefined");
+  Vec3d area{}, lo = v[0], hi = v[0];
+  for (std::size_t i = 1; i < v.size(); ++i) {
+    if (i + 1 < v.size()) area += cross(v[i] - v[0], v[i + 1] - v[0]);
+    lo = min(lo, v[i]);
+    hi = max(hi, v[i]);
+  }
+  if (length(area) > 0) {
+    const Vec3d normal = normalize(area);
+    const double tolerance = kPlanarityTolerance * length(hi - lo);
+    for (std::size_t i = 1; i < v.size(); ++i)
+      if (std::abs(dot(v[i] - v[0], normal)) > tolerance)
+        fail_at_entity(what + " is not planar: its vertices do not lie in one plane");
+  }
+  if (!(dot(corner, area) > 0))
+    fail_at_entity(what + "'s first three vertices form a reflex corner (they turn against the " + what +
+                   "'s winding), so they cannot fix its normal; start it at a convex corner");
 }
 
 void Parser::polygon() {
   long long n = integer("polygon vertex count", 3, 1LL << 40);
   Polygon p;
   for (long long i = 0; i < n; ++i) p.vertices.push_back(vec3("polygon vertex"));
-  check_first_corner(p.vertices);
+  check_polygon_shape(p.vertices, "polygon");
   scene_.objects.push_back({std::move(p), current_material()});
 }
 
@@ -310,7 +407,7 @@ void Parser::patch() {
     p.normals.push_back(vec3("patch vertex normal"));
     if (length(p.normals.back()) == 0) fail_here("patch vertex normal has zero length");
   }
-  check_first_corner(p.vertices);
+  check_polygon_shape(p.vertices, "patch");
   scene_.objects.push_back({std::move(p), current_material()});
 }
 

@@ -28,6 +28,11 @@ void next_cube_face(Vec3d& v, int face) {
   }
 }
 
+// Only the inside of these is visible, which the renderer's two-sided
+// triangles cannot express (a ray from outside would stop at the near side).
+bool inside_only(const Sphere& s) { return s.radius < 0; }
+bool inside_only(const Cone& c) { return c.base_radius < 0 || c.apex_radius < 0; }
+
 bool degenerate(const Patch& tri) {
   return length(cross(tri.vertices[1] - tri.vertices[0], tri.vertices[2] - tri.vertices[0])) == 0;
 }
@@ -99,8 +104,10 @@ void tessellate(Scene& scene, int resolution) {
   objects.reserve(scene.objects.size());
   for (Object& o : scene.objects) {
     std::vector<Patch> pieces;
-    if (auto* s = std::get_if<Sphere>(&o.shape)) pieces = tessellate_sphere(*s, resolution);
-    else if (auto* c = std::get_if<Cone>(&o.shape)) pieces = tessellate_cone(*c, resolution);
+    auto* s = std::get_if<Sphere>(&o.shape);
+    auto* c = std::get_if<Cone>(&o.shape);
+    if (s && !inside_only(*s)) pieces = tessellate_sphere(*s, resolution);
+    else if (c && !inside_only(*c)) pieces = tessellate_cone(*c, resolution);
     else {
       objects.push_back(std::move(o));
       continue;

@@ -9,6 +9,10 @@
 //    two triangles, no caps: 8 r triangles (fewer for a true cone, whose
 //    zero-area triangles at the apex are dropped).
 // Each object keeps its material and its place in the object order.
+// tessellate() leaves spheres and cones with a negative radius (only their
+// inside visible) as they are: the renderer skips their hits from outside,
+// while its triangles are two-sided (render.hpp), so triangles would show the
+// outside instead.
 #pragma once
 
 #include <vector>
@@ -22,7 +26,8 @@ inline constexpr int kMaxTessellation = 64;
 std::vector<Patch> tessellate_sphere(const Sphere& sphere, int resolution);
 std::vector<Patch> tessellate_cone(const Cone& cone, int resolution);
 
-// Replaces every sphere and cone of the scene by its triangles. Throws
+// Replaces every sphere and cone of the scene (except the inside-only ones,
+// see above) by its triangles. Throws
 // std::invalid_argument unless 1 <= resolution <= kMaxTessellation.
 void tessellate(Scene& scene, int resolution);
 

@@ -1,12 +1,18 @@
 // The vmpray executable end to end: exit codes, one-line errors, no partial
-// output on failure, image and JSON on success.
+// output on failure, image and JSON on success, scenes from FIFOs.
+#include <fcntl.h>
 #include <gtest/gtest.h>
+#include <sys/stat.h>
+#include <unistd.h>
 
 #include <algorithm>
+#include <atomic>
+#include <chrono>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
 #include <string>
+#include <thread>
 
 #include "tests/support/scratch.hpp"
 
@@ -57,6 +63,50 @@ TEST_F(Cli, MalformedSceneNamesFileAndLine) {
   EXPECT_EQ(lines(r.err), 1u) << r.err;
   EXPECT_NE(r.err.find("bad.nff:"), std::string::npos) << r.err;
   EXPECT_FALSE(fs::exists(dir_ / "out.png"));
+}
+
+const char* kTinyScene = "v from 0 0 5 at 0 0 0 up 0 1 0 angle 40 hither 0.1 resolution 8 8\nl 0 0 5\ns 0 0 0 1\n";
+
+// Writes `text` into the FIFO as soon as a reader has opened it; gives up
+// once `stop` is set, so a reader that never comes cannot hang the test.
+std::thread feed_fifo(const fs::path& fifo, std::string text, const std::atomic<bool>& stop) {
+  return std::thread([fifo, text, &stop] {
+    while (!stop) {
+      const int fd = ::open(fifo.c_str(), O_WRONLY | O_NONBLOCK);  // fails until there is a reader
+      if (fd >= 0) {
+        EXPECT_EQ(::write(fd, text.data(), text.size()), static_cast<ssize_t>(text.size()));
+        ::close(fd);
+        return;
+      }
+      std::this_thread::sleep_for(std::chrono::milliseconds(2));
+    }
+  });
+}
+
+TEST_F(Cli, ReadsTheSceneFromAFifo) {
+  ASSERT_EQ(::mkfifo((dir_ / "scene.nff").c_str(), 0600), 0);
+  std::atomic<bool> stop = false;
+  std::thread writer = feed_fifo(dir_ / "scene.nff", kTinyScene, stop);
+  const Outcome r = run("scene.nff --single -q -o out.ppm");
+  stop = true;
+  writer.join();
+  EXPECT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_TRUE(fs::exists(dir_ / "out.ppm"));
+}
+
+TEST_F(Cli, DirectoryAsSceneSaysSo) {
+  fs::create_directory(dir_ / "scenes");
+  const Outcome r = run("scenes/ -o out.png");
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_EQ(r.err, "vmpray: scenes/: is a directory, not an NFF file\n");
+  EXPECT_FALSE(fs::exists(dir_ / "out.png"));
+}
+
+TEST_F(Cli, BuiltinNameWinsOverADirectoryOfThatName) {
+  fs::create_directory(dir_ / "tetra");
+  const Outcome r = run("tetra --single -q --width 8 --height 8 -o out.ppm");
+  EXPECT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_TRUE(fs::exists(dir_ / "out.ppm"));
 }
 
 TEST_F(Cli, RendersImageAndJsonStats) {

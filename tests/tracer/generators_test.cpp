@@ -5,6 +5,7 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <ostream>
 #include <stdexcept>
 
@@ -111,6 +112,16 @@ TEST(Generators, TeapotCountFollowsSpdFormula) {
 TEST(Generators, BallsCountIsSumOfPowersOfNine) {
   EXPECT_EQ(scene_stats(generate_scene("balls:2")).spheres, 91u);
   EXPECT_EQ(scene_stats(generate_scene("balls:3")).spheres, 820u);
+}
+
+// Deeper levels have children pointing exactly along -Z, up to rounding.
+TEST(Generators, BallsAreAllFinite) {
+  for (const Object& o : generate_scene("balls:4").objects) {
+    const auto* s = std::get_if<Sphere>(&o.shape);
+    if (!s) continue;  // the floor
+    ASSERT_TRUE(std::isfinite(s->center.x) && std::isfinite(s->center.y) && std::isfinite(s->center.z) &&
+                std::isfinite(s->radius));
+  }
 }
 
 TEST(Generators, GearsAndTreeCountsFollowSpdFormulas) {

@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 #include <zlib.h>
 
+#include <cmath>
 #include <ostream>
 #include <sstream>
 #include <string>
@@ -127,6 +128,44 @@ TEST(Nff, CommentsRunToEndOfLine) {
   EXPECT_EQ(s.objects.size(), 1u);
 }
 
+TEST(Nff, HashEndsATokenAndStartsAComment) {
+  Scene s = parse("s 0 0 0 1#note 5\ns 0 0 0 2#");
+  ASSERT_EQ(s.objects.size(), 2u);
+  EXPECT_DOUBLE_EQ(std::get<Sphere>(s.objects[0].shape).radius, 1);
+  EXPECT_DOUBLE_EQ(std::get<Sphere>(s.objects[1].shape).radius, 2);
+}
+
+TEST(Nff, LoneCarriageReturnEndsALineAndAComment) {
+  Scene s = parse("# old Mac file\rs 0 0 0 1\r# more\rs 0 0 0 2");
+  EXPECT_EQ(s.objects.size(), 2u);
+}
+
+TEST(Nff, NumbersAndCountsMayHaveALeadingPlus) {
+  Scene s = parse("v from 0 0 1 at 0 0 0 up 0 1 0 angle +45 hither 1 resolution +32 +16\n"
+                  "p +3 +1 0 0 0 1 0 0 0 1\n");
+  EXPECT_EQ(s.camera.width, 32);
+  EXPECT_EQ(s.camera.height, 16);
+  EXPECT_EQ(std::get<Polygon>(s.objects[0].shape).vertices.size(), 3u);
+}
+
+TEST(Nff, UnderflowingNumbersBecomeZeroOrDenormal) {
+  Scene s = parse("s 1e-400 -2e-324 1e-99999999999999999999 1\ns 0.00000000001e-310 0 0 1");
+  const Vec3d c = std::get<Sphere>(s.objects[0].shape).center;
+  EXPECT_EQ(c, (Vec3d{0, 0, 0}));
+  EXPECT_TRUE(std::signbit(c.y));
+  EXPECT_GT(std::get<Sphere>(s.objects[1].shape).center.x, 0);  // a denormal
+}
+
+TEST(Nff, OpaqueMaterialMayHaveZeroIndexOfRefraction) {
+  Scene s = parse("f 1 1 1 1 0 1 0 0\ns 0 0 0 1");
+  EXPECT_DOUBLE_EQ(s.materials[0].ior, 0);
+}
+
+TEST(Nff, NearlyPlanarPolygonIsAccepted) {
+  Scene s = parse("p 4\n0 0 0\n1 0 0\n1 1 0.001\n0 1 0\n");
+  EXPECT_EQ(std::get<Polygon>(s.objects[0].shape).vertices.size(), 4u);
+}
+
 TEST(Nff, NegativeRadiusIsLegal) {
   Scene s = parse("s 0 0 0 -1");
   EXPECT_DOUBLE_EQ(std::get<Sphere>(s.objects[0].shape).radius, -1);
@@ -155,6 +194,15 @@ TEST(Nff, GzipIsDetectedByMagicBytes) {
   std::istringstream in(gzip("s 0 0 0 1\ns 1 1 1 2\n"));
   Scene s = parse_nff(in, "x.nff");
   EXPECT_EQ(s.objects.size(), 2u);
+}
+
+TEST(Nff, GzipFollowedByZeroPaddingLoads) {
+  Scene s = parse(gzip("s 0 0 0 1\n") + std::string(512, '\0'));
+  EXPECT_EQ(s.objects.size(), 1u);
+}
+
+TEST(NffError, GzipFollowedByOtherBytesIsAnError) {
+  EXPECT_EQ(error_of(gzip("s 0 0 0 1\n") + std::string(8, '\0') + "junk").rfind("t.nff: ", 0), 0u);
 }
 
 TEST(NffError, TruncatedGzipNamesTheSource) {
@@ -211,7 +259,30 @@ INSTANTIATE_TEST_SUITE_P(
         BadInput{"HugeResolution", "v from 0 0 1 at 0 0 0 up 0 1 0 angle 45 hither 1 resolution 100000 8", "t.nff:1: expected image width (an integer in 1..16384), got '100000'"},
         BadInput{"BadAngle", "v from 0 0 1 at 0 0 0 up 0 1 0 angle 180 hither 1 resolution 8 8", "t.nff:1: 'angle' must lie"},
         BadInput{"ZeroConeAxis", "c 1 1 1 0.5\n1 1 1 0.5", "t.nff:2: cone base and apex coincide"},
-        BadInput{"CollinearFirstCorner", "p 4\n0 0 0\n1 0 0\n2 0 0\n0 1 0\n", "t.nff:5: polygon's first three vertices are collinear"},
+        BadInput{"CollinearFirstCorner", "p 4\n0 0 0\n1 0 0\n2 0 0\n0 1 0\n", "t.nff:1: polygon's first three vertices are collinear"},
+        BadInput{"CollinearPatchCorner", "\npp 3\n0 0 0 0 0 1\n1 0 0 0 0 1\n2 0 0 0 0 1\n", "t.nff:2: patch's first three vertices are collinear"},
+        BadInput{"ReflexFirstCorner", "p 5\n2 2 0\n1 0.5 0\n0 2 0\n0 0 0\n2 0 0\n",
+                 "t.nff:1: polygon's first three vertices form a reflex corner (they turn against the polygon's winding)"},
+        BadInput{"NonPlanarPolygon", "s 0 0 0 1\np 4\n0 0 0\n1 0 0\n1 1 0\n0 1 0.01\n", "t.nff:2: polygon is not planar: its vertices do not lie in one plane"},
+        BadInput{"NonPlanarPatch", "pp 4\n0 0 0 0 0 1\n1 0 0 0 0 1\n1 1 0.5 0 0 1\n0 1 0 0 0 1\n", "t.nff:1: patch is not planar: its vertices do not lie in one plane"},
+        BadInput{"PlusMinus", "s 0 0 0 +-1", "t.nff:1: expected a finite number (sphere radius), got '+-1'"},
+        BadInput{"LonePlus", "s 0 0 0 +", "t.nff:1: expected a finite number (sphere radius), got '+'"},
+        BadInput{"PlusMinusCount", "p +-3", "t.nff:1: expected polygon vertex count (an integer in 3.."},
+        BadInput{"DanglingExponent", "s 0 0 0 1e-", "t.nff:1: expected a finite number (sphere radius), got '1e-'"},
+        BadInput{"HugeExponent", "s 0 0 0 1e99999999999999999999", "t.nff:1: expected a finite number (sphere radius), got '1e99999999999999999999'"},
+        BadInput{"CrOnlyLines", "s 0 0 0 1\r\rs 0 0 x 1", "t.nff:3: expected a finite number (sphere centre), got 'x'"},
+        BadInput{"CrLfIsOneLineEnd", "s 0 0 0 1\r\n\r\ns 0 0 x 1", "t.nff:3: expected a finite number (sphere centre), got 'x'"},
+        BadInput{"CommentEndsAtCr", "s 0 0 0 1 # note\rs 0 0 x 1", "t.nff:2: expected a finite number (sphere centre), got 'x'"},
+        BadInput{"TransmittingWithoutIor", "s 0 0 0 1\nf 1 1 1 1 0 1 0.5\n0\n", "t.nff:2: a transmitting material (T > 0) needs an index of refraction above 0"},
+        BadInput{"SecondView", "v from 0 0 1 at 0 0 0 up 0 1 0 angle 45 hither 1 resolution 8 8\ns 0 0 0 1\n"
+                 "v from 0 0 2 at 0 0 0 up 0 1 0 angle 45 hither 1 resolution 8 8\n",
+                 "t.nff:3: a second view ('v'); the scene has one camera, already set at line 1"},
+        BadInput{"MoreVerticesThanCount", "p 3\n0 0 0\n1 0 0\n0 1 0\n0 0 1\n",
+                 "t.nff:5: expected an entity keyword (v b l f c s p pp), got '0' "
+                 "(does the 'p' at line 1 have more vertices than its count says?)"},
+        BadInput{"MoreNumbersThanFields", "b 0 0 0\ns 0 0 0 1 2\n",
+                 "t.nff:2: expected an entity keyword (v b l f c s p pp), got '2' "
+                 "(does the 's' at line 2 have more numbers than it takes?)"},
         BadInput{"ZeroPatchNormal", "pp 3\n0 0 0 0 0 1\n1 0 0 0 0 0\n", "t.nff:3: patch vertex normal has zero length"},
         BadInput{"ShortMaterial", "f 1 1 1 1 0 1 0\ns 0 0 0 1", "t.nff:2: expected a finite number (index of refraction), got 's'"},
         BadInput{"BinaryGarbage", std::string("s 0 0 0 1\n\x01\x02\xff", 13), "t.nff:2: expected an entity keyword (v b l f c s p pp), got '\\x01\\x02\\xff'"}),

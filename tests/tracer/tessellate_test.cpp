@@ -1,10 +1,13 @@
 // Tessellation: SPD's triangle counts, vertices on the surface with unit
-// outward normals, triangles facing their normals, materials kept in order.
+// outward normals, triangles facing their normals, materials kept in order,
+// inside-only spheres and cones rendered as before.
 #include "tracer/tessellate.hpp"
 
 #include <gtest/gtest.h>
 
 #include <stdexcept>
+
+#include "tracer/render.hpp"
 
 namespace tracer {
 namespace {
@@ -77,6 +80,30 @@ TEST(Tessellate, SceneKeepsOrderAndMaterials) {
   EXPECT_TRUE(std::holds_alternative<Polygon>(scene.objects[48].shape));
   EXPECT_EQ(scene.objects.back().material, 1u);
   EXPECT_EQ(scene.polygon_count(), 65u);
+}
+
+std::vector<Color> render(const Scene& scene) {
+  const Database db = build_database(scene);
+  InMemoryPageSource pages(db);
+  RayStats stats;
+  return render_frame(db.header, pages, {}, stats);
+}
+
+// Seen from outside with the light behind the eye, an inside-only sphere and
+// cylinder show their far inner wall, which their near wall shadows: black.
+TEST(Tessellate, InsideOnlySpheresAndConesLookTheSame) {
+  Scene scene;
+  scene.camera = {{0, 0, 6}, {0, 0, 0}, {0, 1, 0}, 50.0, 0.01, 24, 24};
+  scene.background = {0.2f, 0.3f, 0.5f};
+  scene.lights = {{{0, 0, 8}, {1, 1, 1}}};
+  scene.materials.resize(1);
+  scene.objects.push_back({Sphere{{-1.2, 0, 0}, -1}, 0});
+  scene.objects.push_back({Cone{{1.2, -1, 0}, -0.8, {1.2, 1, 0}, -0.8}, 0});
+  const std::vector<Color> analytic = render(scene);
+  EXPECT_EQ(analytic[12 * 24 + 5], (Color{0, 0, 0}));   // the sphere's centre
+  EXPECT_EQ(analytic[12 * 24 + 18], (Color{0, 0, 0}));  // the cylinder's axis
+  tessellate(scene, 4);
+  EXPECT_EQ(render(scene), analytic);
 }
 
 TEST(Tessellate, RejectsResolutionOutOfRange) {
