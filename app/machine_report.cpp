@@ -26,10 +26,10 @@ void print_node_row(std::ostream& out, std::size_t n, const nodes::NodeReport& r
       << std::setw(11) << r.svm.miss_ratio() << std::setw(10) << r.served.pages_served << "\n";
 }
 
-void print_per_node(std::ostream& out, const nodes::MachineReport& r) {
-  out << "per node       pixels imbalance " << r.item_imbalance() << ", rays imbalance "
+void print_per_node(std::ostream& out, const nodes::MachineReport& r, const char* items) {
+  out << "per node       " << items << " imbalance " << r.item_imbalance() << ", rays imbalance "
       << r.ray_imbalance() << " (max/mean)\n"
-      << "  " << std::setw(5) << "node" << std::setw(10) << "pixels" << std::setw(12) << "rays"
+      << "  " << std::setw(5) << "node" << std::setw(10) << items << std::setw(12) << "rays"
       << std::setw(12) << "accesses" << std::setw(10) << "misses" << std::setw(11) << "miss ratio"
       << std::setw(10) << "served" << "\n";
   const auto& nodes = r.per_node;
@@ -52,6 +52,14 @@ void json_svm(std::ostream& out, const nodes::SvmStats& s) {
   out << "{\"accesses\": " << s.accesses << ", \"local_hits\": " << s.own_hits
       << ", \"cache_hits\": " << s.cache_hits << ", \"misses\": " << s.misses
       << ", \"coalesced\": " << s.coalesced << ", \"miss_ratio\": " << s.miss_ratio() << "}";
+}
+
+// The cache a node actually has: what was asked for, capped at the pages it
+// does not own; the largest over the nodes.
+std::uint32_t largest_cache(const nodes::MachineReport& r) {
+  std::uint32_t largest = 0;
+  for (const nodes::NodeReport& node : r.per_node) largest = std::max(largest, node.cache_capacity);
+  return largest;
 }
 
 void json_per_node(std::ostream& out, const nodes::MachineReport& r, const std::string& indent) {
@@ -79,10 +87,8 @@ void json_network(std::ostream& out, const nodes::NetworkStats& s) {
     first = false;
   }
   out << "}, \"busiest_link\": ";
-  const auto busiest = std::max_element(
-      s.links.begin(), s.links.end(),
-      [](const nodes::LinkStats& a, const nodes::LinkStats& b) { return a.packets < b.packets; });
-  if (busiest == s.links.end()) out << "null";
+  const nodes::LinkStats* busiest = nodes::busiest_link(s);
+  if (!busiest) out << "null";
   else
     out << "{\"from\": " << busiest->from << ", \"to\": " << busiest->to << ", \"packets\": "
         << busiest->packets << ", \"bytes\": " << busiest->bytes << "}";
@@ -122,14 +128,17 @@ void print_machine_report(std::ostream& out, const MachineSummary& m) {
   if (r.schedule == nodes::Schedule::affinity) out << ", " << r.farmer.steals << " steals";
   if (r.schedule != nodes::Schedule::static_split) out << ")";
   out << " in " << nodes::pixel_order_name(r.pixel_order) << " order, " << r.threads << " thread(s), cache "
-      << r.cache_pages << " pages (" << double(r.cache_pages) * r.page_size / 1024.0 << " KB) per node\n"
+      << r.cache_pages << " pages (" << double(r.cache_pages) * r.page_size / 1024.0 << " KB) per node";
+  if (const std::uint32_t used = largest_cache(r); used < r.cache_pages)
+    out << ", holding every remote page (at most " << used << ")";
+  out << "\n"
       << std::setprecision(4) << "svm            " << svm.accesses << " page accesses: "
       << svm.own_hits << " local, " << svm.cache_hits << " cache hits, " << svm.misses << " misses (" << svm.coalesced
       << " coalesced), miss ratio " << svm.miss_ratio() << "\n"
       << "page traffic   " << served.pages_served << " page communications, "
       << served.bytes_served << " bytes; " << r.rays().pages_per_sample()
-      << " distinct pages per pixel\n";
-  print_per_node(out, r);
+      << " distinct pages per " << (m.corner_samples ? "sample" : "pixel") << "\n";
+  print_per_node(out, r, m.corner_samples ? "samples" : "pixels");
   out << nodes::format_summary(r.network, topology::parse_topology(r.topology), kind_name);
   out << std::setprecision(3) << "wall time      " << r.wall_seconds << " s on " << r.threads
       << " thread(s)";
@@ -155,7 +164,8 @@ void write_machine_json(std::ostream& out, const MachineSummary& m, const std::s
       << ", \"pixel_order\": " << json_string(nodes::pixel_order_name(r.pixel_order)) << ", \"grain\": " << r.grain
       << ", \"steals\": " << r.farmer.steals << ",\n"
       << in << "\"cache_pages\": " << r.cache_pages << ", \"cache_kb\": "
-      << double(r.cache_pages) * r.page_size / 1024.0 << ", \"database_pages\": " << r.page_count
+      << double(r.cache_pages) * r.page_size / 1024.0 << ", \"cache_pages_largest_in_use\": " << largest_cache(r)
+      << ", \"database_pages\": " << r.page_count
       << ", \"database_kb\": " << double(r.page_count) * r.page_size / 1024.0 << ",\n"
       << in << "\"svm\": ";
   json_svm(out, r.svm());

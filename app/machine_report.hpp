@@ -24,6 +24,7 @@ struct SerialComparison {
 struct MachineSummary {
   nodes::MachineReport report;
   std::optional<SerialComparison> serial;
+  bool corner_samples = false;  // the items are SPD corner samples, not pixels
 
   // TN: the predicted time under a cost model, the wall time otherwise (as T1).
   double parallel_seconds() const;

@@ -1,6 +1,7 @@
 // Machine rendering; see machine_run.hpp.
 #include "app/machine_run.hpp"
 
+#include <string>
 #include <utility>
 
 #include "app/progress.hpp"
@@ -8,11 +9,15 @@
 namespace app {
 namespace {
 
-// Runs db on the machine of `machine`, with a progress bar labelled `unit`.
+// Runs db on the machine of `machine`, with a progress bar over what it
+// farms out: pixels, or the corner samples of the SPD procedure; `which`
+// follows the unit in the bar.
 nodes::MachineResult run_with_progress(tracer::Database db, nodes::MachineOptions machine,
-                                       const Options& o, const char* unit) {
-  const auto& camera = db.header.camera;
-  ProgressBar bar(std::uint64_t(camera.width) * camera.height, unit, !o.quiet && stderr_is_terminal());
+                                       const Options& o, const std::string& which = "") {
+  const std::uint64_t w = db.header.camera.width, h = db.header.camera.height;
+  const bool samples = machine.trace.spd_procedure;
+  ProgressBar bar(samples ? (w + 1) * (h + 1) : w * h, (samples ? "samples" : "pixels") + which,
+                  !o.quiet && stderr_is_terminal());
   // The collector calls this on its own thread only, so the bar needs no lock.
   machine.progress = [&bar](std::uint64_t done, std::uint64_t) { bar.update(done); };
   nodes::MachineResult result = nodes::run_machine(std::move(db), machine);
@@ -26,7 +31,7 @@ SerialComparison run_serial(const tracer::Database& db, const nodes::MachineOpti
   one.topology = "complete";
   one.nodes = 1;
   one.trace_routes = 0;
-  const nodes::MachineResult r = run_with_progress(db, one, o, "pixels (1 node)");
+  const nodes::MachineResult r = run_with_progress(db, one, o, " (1 node)");
   return {machine.timing ? r.report.predicted_seconds : r.report.wall_seconds, r.report.threads};
 }
 
@@ -42,11 +47,11 @@ RenderResult render_machine(const Options& o, const tracer::Scene& scene) {
   std::optional<SerialComparison> serial;
   // In virtual time T1 is cheap and deterministic: always there for speedup and efficiency.
   if (o.compare_serial || machine.timing) serial = run_serial(db, machine, o);
-  nodes::MachineResult result = run_with_progress(std::move(db), machine, o, "pixels");
+  nodes::MachineResult result = run_with_progress(std::move(db), machine, o);
   out.image = std::move(result.image);
   out.report.rays = result.report.rays();
   out.report.render_seconds = result.report.wall_seconds;
-  out.report.machine = MachineSummary{std::move(result.report), serial};
+  out.report.machine = MachineSummary{std::move(result.report), serial, o.spd_procedure};
   return out;
 }
 

@@ -146,6 +146,11 @@ void check_machine(Options& o, const Raw& raw, const po::variables_map& vm) {
   else if (raw.distribution == "block") m.distribution = nodes::Distribution::block;
   else throw UsageError("--distribution: expected modulo or block, got '" + raw.distribution + "'");
   m.timing = timing_from(raw.timing);
+  // Options that would change nothing here are errors, as with --single.
+  if (m.schedule == nodes::Schedule::static_split && !vm["grain"].defaulted())
+    throw UsageError("--grain: the static schedule hands out fixed shares, not tiles of a grain");
+  if (m.timing && o.compare_serial)
+    throw UsageError("--compare-serial: a virtual-time run always reports speedup against the 1-node machine");
   // The tile CSV, the timeline and the report (which shows the timeline) need the tiles.
   m.record_tiles = !o.tiles_csv.empty() || !o.pictures.timeline_svg.empty() || !o.pictures.report_html.empty();
 }

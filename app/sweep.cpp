@@ -125,6 +125,8 @@ void check_sweep(SweepOptions& o, const RawSweep& raw, const po::variables_map& 
   o.accel = parse_accel(raw.accel);
   o.bvh_layout = parse_bvh_layout(raw.bvh_layout);
   o.schedule = parse_schedule(raw.schedule);
+  if (o.schedule == nodes::Schedule::static_split && vm.count("grain"))
+    throw UsageError("--grain: the static schedule hands out fixed shares, not tiles of a grain");
   o.pixel_order = parse_pixel_order(raw.pixel_order);
   o.trace.shadow_rays_to_all_lights = parse_shadow_rays(raw.shadow_rays);
 }
@@ -190,7 +192,8 @@ SweepTable run_sweep(const SweepOptions& o, std::ostream* progress) {
   table.page_count = db.header.page_count;
   table.tracing = accel_description(o.accel, o.bvh_layout) + ", shadow rays " +
                   (o.trace.shadow_rays_to_all_lights ? "all" : "facing");
-  table.farming = std::string(nodes::schedule_name(o.schedule)) + " schedule, grain " + std::to_string(o.grain) +
+  table.farming = std::string(nodes::schedule_name(o.schedule)) + " schedule" +
+                  (o.schedule == nodes::Schedule::static_split ? "" : ", grain " + std::to_string(o.grain)) +
                   ", prefetch " + std::to_string(o.prefetch) + ", " + nodes::pixel_order_name(o.pixel_order) +
                   " order";
   ExperimentSetup setup;

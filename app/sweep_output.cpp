@@ -36,7 +36,7 @@ std::string quoted(const std::string& s) {
 }
 
 const char* const csv_header =
-    "scene,topology,nodes,cache_pages,predicted_seconds,paper_time,speedup,efficiency,miss_ratio,"
+    "scene,topology,nodes,cache_pages,predicted_seconds,predicted_hms,speedup,efficiency,miss_ratio,"
     "page_requests,page_accesses,pages_per_pixel,mean_hops,messages,rays,wall_seconds";
 
 std::string kind_name(SweepOptions::Kind kind) { return kind == SweepOptions::Kind::nodes ? "nodes" : "cache"; }

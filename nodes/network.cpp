@@ -141,6 +141,12 @@ std::string format_route(const RouteRecord& record, const KindNamer& kind_name) 
   return s;
 }
 
+const LinkStats* busiest_link(const NetworkStats& stats) {
+  const auto busiest = std::max_element(stats.links.begin(), stats.links.end(),
+                                        [](const LinkStats& a, const LinkStats& b) { return a.packets < b.packets; });
+  return busiest == stats.links.end() ? nullptr : &*busiest;
+}
+
 std::string format_summary(const NetworkStats& stats, const topology::Topology& topology,
                            const KindNamer& kind_name) {
   std::ostringstream out;
@@ -153,11 +159,8 @@ std::string format_summary(const NetworkStats& stats, const topology::Topology& 
   for (const auto& [kind, h] : stats.hops_by_kind)
     out << "  " << std::left << std::setw(16) << kind_name(kind) << std::right << std::setw(12)
         << h.packets << std::setw(12) << h.mean() << std::setw(10) << h.max_hops << "\n";
-  const auto busiest = std::max_element(
-      stats.links.begin(), stats.links.end(),
-      [](const LinkStats& a, const LinkStats& b) { return a.packets < b.packets; });
-  if (busiest != stats.links.end())
-    out << "  busiest link " << busiest->from << " -> " << busiest->to << ": " << busiest->packets
+  if (const LinkStats* busiest = busiest_link(stats))
+    out << "  busiest link (most packets) " << busiest->from << " -> " << busiest->to << ": " << busiest->packets
         << " packets, " << busiest->bytes << " bytes\n";
   std::uint32_t peak = 0;
   std::uint64_t forwarded = 0;

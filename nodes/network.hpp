@@ -108,6 +108,10 @@ class Network {
 
 // "page 17: 5 → 4 → 6 → 7 (3 hops)"
 std::string format_route(const RouteRecord& record, const KindNamer& kind_name);
+
+// The link that carried the most packets, or null for a machine without links.
+const LinkStats* busiest_link(const NetworkStats& stats);
+
 // Table: packets, mean/max hops overall and per kind, busiest link, peak buffers.
 std::string format_summary(const NetworkStats& stats, const topology::Topology& topology,
                            const KindNamer& kind_name);

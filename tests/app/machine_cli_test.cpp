@@ -155,6 +155,35 @@ class MachineCli : public test::ScratchTest {
 
 constexpr const char* kSmall = "tetra:3 --width 32 --height 32 --threads 2";
 
+// A cache larger than the pages a node does not own is capped there; the
+// report says so rather than claim the size asked for.
+TEST_F(MachineCli, ACacheLargerThanTheRemotePagesIsReportedAsCapped) {
+  const Outcome r = run(std::string(kSmall) + " --cache-pages 100000 -o out.png --stats s.json");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const Json m = JsonReader(read_file(dir_ / "s.json")).document()["machine"];
+  double largest = 0;
+  for (const Json& n : m["per_node"].items) largest = std::max(largest, n["cache_pages"].number);
+  EXPECT_EQ(m["cache_pages"].number, 100000);
+  EXPECT_EQ(m["cache_pages_largest_in_use"].number, largest);
+  EXPECT_LE(largest, m["database_pages"].number);
+  EXPECT_NE(r.out.find("holding every remote page (at most " + std::to_string(int(largest)) + ")"), std::string::npos)
+      << r.out;
+}
+
+// Under the SPD procedure the machine farms out corner samples, and the
+// report counts them as such.
+TEST_F(MachineCli, SpdProcedureReportsSamplesNotPixels) {
+  const Outcome r = run(std::string(kSmall) + " --spd-procedure -o out.png --stats s.json");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_NE(r.out.find("distinct pages per sample"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("per node       samples imbalance"), std::string::npos) << r.out;
+  EXPECT_EQ(r.out.find("pixels"), std::string::npos) << r.out;
+  const Json j = JsonReader(read_file(dir_ / "s.json")).document();
+  double samples = 0;
+  for (const Json& n : j["machine"]["per_node"].items) samples += n["pixels"].number;
+  EXPECT_EQ(samples, 33 * 33);
+}
+
 TEST_F(MachineCli, DefaultMachineWritesImageAndJsonWithMachineFields) {
   const Outcome r = run(std::string(kSmall) + " -o out.png --stats s.json");
   ASSERT_EQ(r.exit_code, 0) << r.err;
@@ -231,7 +260,7 @@ TEST_F(MachineCli, EveryMachineMakesTheSingleProcessImage) {
   ASSERT_FALSE(single.empty());
   const std::vector<std::string> machines{
       "",
-      "--topology mesh:3x3 --cache-pages 1 --grain 7 --schedule static --distribution block",
+      "--topology mesh:3x3 --cache-pages 1 --schedule static --distribution block",
       "--topology ring --nodes 5 --workers-per-node 2 --page-size 256 --schedule dynamic",
       "--topology torus:4x2 --cache-kb 2 --grain 1 --prefetch 0 --pixel-order scanline",
       "--topology hypercube:3 --grain 3 --prefetch 3 --schedule dynamic --pixel-order scanline",
@@ -448,12 +477,13 @@ TEST(MachineOptions, AFullSpecNeedsNoNodeCount) {
 }
 
 TEST(MachineOptions, ValuesReachTheMachine) {
-  const app::Options o = parse({"--cache-kb", "8", "--grain", "9", "--schedule", "static",
+  const app::Options o = parse({"--cache-kb", "8", "--grain", "9", "--schedule", "dynamic",
                                 "--workers-per-node", "3", "--distribution", "block",
                                 "--trace-routes", "5", "--threads", "2", "--compare-serial", "--prefetch", "2"});
   EXPECT_EQ(o.machine.cache_kb, 8u);
   EXPECT_EQ(o.machine.grain, 9u);
-  EXPECT_EQ(o.machine.schedule, nodes::Schedule::static_split);
+  EXPECT_EQ(o.machine.schedule, nodes::Schedule::dynamic);
+  EXPECT_EQ(parse({"--schedule", "static"}).machine.schedule, nodes::Schedule::static_split);
   EXPECT_EQ(parse({"--schedule", "affinity"}).machine.schedule, nodes::Schedule::affinity);
   EXPECT_EQ(parse({"--pixel-order", "scanline"}).machine.pixel_order, nodes::PixelOrder::scanline);
   EXPECT_EQ(parse({"--schedule", "dynamic"}).machine.schedule, nodes::Schedule::dynamic);

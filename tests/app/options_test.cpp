@@ -79,6 +79,16 @@ TEST(Options, OutputNamesMustNameAFileOfTheirKind) {
   EXPECT_EQ(o.stats_path, "s");
 }
 
+// Options that would change nothing in the run asked for are errors.
+TEST(Options, OptionsThatWouldChangeNothingAreErrors) {
+  EXPECT_EQ(error_of({"--schedule", "static", "--grain", "64"}),
+            "--grain: the static schedule hands out fixed shares, not tiles of a grain");
+  EXPECT_EQ(error_of({"--timing", "virtual", "--compare-serial"}),
+            "--compare-serial: a virtual-time run always reports speedup against the 1-node machine");
+  EXPECT_EQ(parse({"--schedule", "static"}).machine.schedule, nodes::Schedule::static_split);
+  EXPECT_TRUE(parse({"--compare-serial"}).compare_serial);
+}
+
 // 0 stands for "the scene's own" inside Options, but a user who writes 0
 // asked for something that does not exist.
 TEST(Options, AnExplicitZeroSizeOrTessellationIsAnError) {

@@ -86,6 +86,7 @@ TEST(SweepOptions, BadValuesNameTheOption) {
       // Zero would otherwise mean "no fit" in silence.
       {{"nodes", "--fit-seconds", "0"}, "--fit-seconds"},
       {{"nodes", "--fit-seconds", "inf"}, "--fit-seconds"},
+      {{"nodes", "--schedule", "static", "--grain", "8"}, "--grain: the static schedule hands out fixed shares"},
       // A value twice would be a second run and a line doubling back.
       {{"nodes", "--nodes", "2,4,2"}, "--nodes: 2 is listed twice"},
       {{"cache", "--cache-pages", "8,8"}, "--cache-pages: 8 is listed twice"},
@@ -144,6 +145,7 @@ TEST(Sweep, NodesSweepWritesWellFormedTablesAndPlots) {
   const auto rows = csv_rows(read(dir / "nodes.csv"));
   ASSERT_EQ(rows.size(), 7u);  // header + 2 topologies x 3 sizes
   for (const auto& row : rows) EXPECT_EQ(row.size(), rows.front().size());
+  EXPECT_EQ(rows[0][5], "predicted_hms");  // the predicted time written as the paper writes times
   EXPECT_EQ(rows[1][2], "1");
   EXPECT_DOUBLE_EQ(std::stod(rows[1][7]), 1.0);  // efficiency of N = 1
   for (std::size_t i = 1; i < rows.size(); ++i) EXPECT_GT(std::stod(rows[i][4]), 0.0);
@@ -196,7 +198,7 @@ TEST(Sweep, HilbertOrderReachesTheRuns) {
   ASSERT_EQ(hilbert.points.size(), 1u);
   EXPECT_EQ(hilbert.points[0].rays, scanline.points[0].rays);
   EXPECT_LT(hilbert.points[0].misses, scanline.points[0].misses);
-  EXPECT_EQ(hilbert.farming, "static schedule, grain 4, prefetch 0, hilbert order");
+  EXPECT_EQ(hilbert.farming, "static schedule, prefetch 0, hilbert order");  // fixed shares: no grain
 }
 
 // The BVH layout reaches the runs: the same rays, and more page accesses
