@@ -8,6 +8,9 @@
 #include <chrono>
 #include <filesystem>
 #include <iostream>
+#include <string>
+#include <utility>
+#include <vector>
 
 #include "app/machine_run.hpp"
 #include "app/machine_pictures.hpp"
