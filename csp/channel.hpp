@@ -7,9 +7,10 @@
 //   writer fills directly (so the writer returns without parking: the reader
 //   has taken the value). A writer that finds only an ALT reader fires the
 //   ALT, then parks until the ALT's read takes the value.
-// - capacity k: a bounded buffer of exactly k values. Readers park only when
-//   it is empty, writers only when it is full; a reader that frees a slot
-//   moves the first parked writer's value in and wakes that writer.
+// - capacity k: a bounded buffer of at most k values (its storage grows on
+//   demand up to k). Readers park only when it is empty, writers only when
+//   it holds k; a reader that frees a slot moves the first parked writer's
+//   value in and wakes that writer.
 // - An ALT may wait for room in a buffered channel (Alt::add_room): its
 //   record waits in room_waiters_, and the reader that frees a slot (with no
 //   parked writer to refill it) fires it. Poison fires it too.
@@ -29,6 +30,7 @@
 // (and fire room guards), poison wakes all; see detail/wait.hpp for the claiming rules.
 #pragma once
 
+#include <algorithm>
 #include <cstddef>
 #include <memory>
 #include <optional>
@@ -51,7 +53,7 @@ template <class T>
 class ChannelState final : public ChannelBase {
  public:
   ChannelState(std::string name, std::size_t capacity)
-      : ChannelBase(std::move(name), capacity), ring_(capacity) {
+      : ChannelBase(std::move(name), capacity), ring_(std::min(capacity, kFirstRingSlots)) {
     publish_hints(false, capacity > 0);
   }
 
@@ -134,7 +136,7 @@ class ChannelState final : public ChannelBase {
     if (count_ > 0) {
       std::optional<T> v(std::in_place, std::move(*ring_[head_]));
       ring_[head_].reset();
-      head_ = (head_ + 1) % capacity_;
+      head_ = (head_ + 1) % ring_.size();
       --count_;
       if (Record* r = claim_front_locked(writers_)) {
         push_locked(std::move(*static_cast<T*>(r->slot)));
@@ -184,7 +186,8 @@ class ChannelState final : public ChannelBase {
   }
 
   void push_locked(T&& value) {
-    ring_[(head_ + count_) % capacity_].emplace(std::move(value));
+    if (count_ == ring_.size()) grow_ring_locked();
+    ring_[(head_ + count_) % ring_.size()].emplace(std::move(value));
     ++count_;
     publish_hints_locked();
   }
@@ -203,7 +206,20 @@ class ChannelState final : public ChannelBase {
     unwind_deadlock();
   }
 
-  std::vector<std::optional<T>> ring_;  // capacity_ slots, values at head_ .. head_+count_
+  // Room for twice the values, at most capacity_ (a buffer allowed many
+  // values seldom holds them all: a mailbox sized for every sender in a
+  // large machine would otherwise take memory for all of them up front).
+  void grow_ring_locked() {
+    std::vector<std::optional<T>> bigger(std::min(capacity_, 2 * ring_.size()));
+    for (std::size_t i = 0; i < count_; ++i) bigger[i] = std::move(ring_[(head_ + i) % ring_.size()]);
+    ring_ = std::move(bigger);
+    head_ = 0;
+  }
+
+  static constexpr std::size_t kFirstRingSlots = 4;
+  // Values at head_ .. head_+count_ (modulo its size); grown on demand, by
+  // doubling, up to capacity_ slots.
+  std::vector<std::optional<T>> ring_;
   std::size_t head_ = 0;
   std::size_t count_ = 0;
 };

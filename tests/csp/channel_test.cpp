@@ -67,6 +67,28 @@ TEST(Channel, BufferHoldsExactlyCapacity) {
   }
 }
 
+// A large buffer grows its storage as values arrive: it still holds exactly
+// its capacity, in order, also when growth finds the values wrapped around.
+TEST(Channel, LargeBufferHoldsItsCapacityInOrderAsItGrows) {
+  constexpr int capacity = 100;
+  csp::Channel<int> c("c", capacity);
+  auto in = c.reader();
+  auto out = c.writer();
+  int next_in = 0, next_out = 0;
+  for (int v : {0, 1, 2}) {
+    int value = v;
+    ASSERT_TRUE(out.try_write(value));
+  }
+  next_in = 3;
+  EXPECT_EQ(in.try_read(), next_out++);
+  EXPECT_EQ(in.try_read(), next_out++);
+  for (int value = next_in; value < next_out + capacity; ++value, ++next_in) ASSERT_TRUE(out.try_write(value));
+  int refused = -1;
+  EXPECT_FALSE(out.try_write(refused));
+  while (next_out < next_in) EXPECT_EQ(in.try_read(), next_out++);
+  EXPECT_FALSE(in.try_read().has_value());
+}
+
 TEST(Channel, TryOperationsNeverBlock) {
   csp::Channel<int> c("c", 1);
   auto in = c.reader();
