@@ -61,7 +61,8 @@ po::options_description describe_machine(Options& o, Raw& raw) {
       ("topology", po::value(&raw.topology)->default_value("hypercube"),
        "hypercube, mesh, torus, ring or complete (with --nodes), or a full spec: "
        "hypercube:4, mesh:4x4, torus:4x4, ring:16, complete:16")
-      ("nodes", po::value(&raw.nodes), "processors (default 16, or the full spec's)")
+      ("nodes", po::value(&raw.nodes),
+       ("processors, at most " + std::to_string(topology::max_nodes) + " (default 16, or the full spec's)").c_str())
       ("threads", po::value(&raw.threads)->default_value(0),
        "OS threads carrying the processors (0: hardware cores; at most --nodes)")
       ("cache-pages", po::value(&raw.cache_pages),

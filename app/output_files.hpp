@@ -5,7 +5,18 @@
 // that path before, and what a failed command removes is only what it wrote.
 // Removal goes in reverse order, so a directory added before the files made
 // in it goes last, once it is empty (a directory that is not empty stays).
+//
+// OutputPhase holds back, while a command writes its outputs, the signals
+// that would end it half-way (SIGINT, SIGTERM, SIGHUP, and SIGPIPE from a
+// closed standard output): the command looks at interrupted() once every
+// file is in place, and gives up its files if one came. Ending the phase
+// lets a held signal through, so the command still ends as it asked.
+// Only for a single-threaded process: other threads would take the signals.
 #pragma once
+
+#include <pthread.h>
+
+#include <csignal>
 
 #include <filesystem>
 #include <functional>
@@ -53,6 +64,31 @@ class OutputFiles {
 
  private:
   std::vector<std::filesystem::path> paths_;
+};
+
+class OutputPhase {
+ public:
+  OutputPhase() {
+    sigemptyset(&held_);
+    for (int signal : {SIGINT, SIGTERM, SIGHUP, SIGPIPE}) sigaddset(&held_, signal);
+    pthread_sigmask(SIG_BLOCK, &held_, &before_);
+  }
+  OutputPhase(const OutputPhase&) = delete;
+  OutputPhase& operator=(const OutputPhase&) = delete;
+  ~OutputPhase() { pthread_sigmask(SIG_SETMASK, &before_, nullptr); }
+
+  // Whether a signal asked the command to stop while it wrote.
+  bool interrupted() const {
+    sigset_t pending;
+    sigpending(&pending);
+    for (int signal : {SIGINT, SIGTERM, SIGHUP, SIGPIPE})
+      if (sigismember(&pending, signal)) return true;
+    return false;
+  }
+
+ private:
+  sigset_t held_;
+  sigset_t before_;
 };
 
 }  // namespace app

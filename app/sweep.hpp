@@ -16,6 +16,7 @@
 #include <vector>
 
 #include "app/experiments.hpp"
+#include "app/output_files.hpp"
 
 namespace app {
 
@@ -61,10 +62,12 @@ SweepTable run_sweep(const SweepOptions& options, std::ostream* progress);
 
 std::string sweep_csv(const SweepTable& table);
 std::string sweep_json(const SweepTable& table);
-// Writes csv, json, svg, png panels and html into dir; returns the files
-// written. If one cannot be written, removes those it wrote (and dir, if it
-// made it) and throws std::runtime_error naming the path.
-std::vector<std::filesystem::path> write_sweep(const SweepTable& table, const std::filesystem::path& dir);
+// Writes csv, json, svg, png panels and html into dir, adding each to
+// `outputs` (and dir first, if it makes it): the caller keeps them once its
+// command has finished. Returns the files written. Throws std::runtime_error
+// naming the path if one cannot be written.
+std::vector<std::filesystem::path> write_sweep(const SweepTable& table, const std::filesystem::path& dir,
+                                               OutputFiles& outputs);
 
 // The whole subcommand: exit status 0, 1 (run error) or 2 (usage), errors one line on stderr.
 int sweep_main(int argc, const char* const argv[]);

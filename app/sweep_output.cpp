@@ -142,8 +142,8 @@ std::string sweep_json(const SweepTable& t) {
   return out.str();
 }
 
-std::vector<std::filesystem::path> write_sweep(const SweepTable& t, const std::filesystem::path& dir) {
-  OutputFiles outputs;
+std::vector<std::filesystem::path> write_sweep(const SweepTable& t, const std::filesystem::path& dir,
+                                               OutputFiles& outputs) {
   if (!std::filesystem::exists(dir)) outputs.add(dir);
   std::error_code error;
   std::filesystem::create_directories(dir, error);
@@ -166,7 +166,6 @@ std::vector<std::filesystem::path> write_sweep(const SweepTable& t, const std::f
   section.blocks.push_back(viz::SvgFigure{.caption = stem + " sweep", .svg = viz::plots_svg(plots, 1)});
   report.sections.push_back(section);
   for (const auto& f : viz::write_html_report(dir / (stem + ".html"), report, outputs.tracker())) files.push_back(f);
-  outputs.keep();
   return files;
 }
 
@@ -184,11 +183,17 @@ int sweep_main(int argc, const char* const argv[]) {
   }
   try {
     const SweepTable table = run_sweep(options, options.quiet ? nullptr : &std::cerr);
-    const auto files = write_sweep(table, options.out_dir);
+    // Ends after the outputs are removed, if they are, letting a held signal through.
+    const OutputPhase phase;
+    OutputFiles outputs;
+    const auto files = write_sweep(table, options.out_dir, outputs);
     if (!options.quiet) {
       std::cout << sweep_csv(table);
       std::cout << "wrote " << files.size() << " files in " << options.out_dir.string() << "\n";
     }
+    if (!std::cout.flush()) throw std::runtime_error("standard output: cannot write the table");
+    if (phase.interrupted()) return 1;
+    outputs.keep();
     return 0;
   } catch (const std::exception& e) {
     std::cerr << "vmpray sweep: " << e.what() << "\n";

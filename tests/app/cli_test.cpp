@@ -1,5 +1,6 @@
 // The vmpray executable end to end: exit codes, one-line errors, no partial
-// output on failure, image and JSON on success, scenes from FIFOs.
+// output on failure, image and JSON on success, scenes from FIFOs, and
+// signals held back while the outputs are written.
 #include <fcntl.h>
 #include <gtest/gtest.h>
 #include <sys/stat.h>
@@ -8,12 +9,14 @@
 #include <algorithm>
 #include <atomic>
 #include <chrono>
+#include <csignal>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
 #include <string>
 #include <thread>
 
+#include "app/output_files.hpp"
 #include "tests/support/scratch.hpp"
 
 namespace {
@@ -127,6 +130,22 @@ TEST_F(Cli, ReportNamesTheShadowRayPolicyInTextAndJson) {
   ASSERT_EQ(r.exit_code, 0) << r.err;
   EXPECT_NE(r.out.find("(shadow rays to every light)"), std::string::npos) << r.out;
   EXPECT_NE(test::read_file(dir_ / "s.json").find("\"shadow_rays\": \"all\""), std::string::npos);
+}
+
+// A signal that would end the command while it writes its outputs waits
+// until they are all in place (or all removed), then goes through.
+TEST(OutputPhase, HoldsAnInterruptUntilItEnds) {
+  static volatile std::sig_atomic_t delivered = 0;
+  const auto before = std::signal(SIGINT, [](int) { delivered = 1; });
+  {
+    const app::OutputPhase phase;
+    EXPECT_FALSE(phase.interrupted());
+    std::raise(SIGINT);
+    EXPECT_EQ(delivered, 0);
+    EXPECT_TRUE(phase.interrupted());
+  }
+  EXPECT_EQ(delivered, 1);
+  std::signal(SIGINT, before);
 }
 
 }  // namespace

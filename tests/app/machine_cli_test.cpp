@@ -323,6 +323,19 @@ TEST_F(MachineCli, AnOutputThatCannotBeWrittenLeavesNoOtherFile) {
   }
 }
 
+// The report on standard output is part of the run's output: when it cannot
+// be written (a full device, a closed descriptor) the run fails and takes
+// its files with it.
+TEST_F(MachineCli, AReportThatCannotBePrintedFailsTheRun) {
+  for (const char* target : {"/dev/full", "&-"}) {
+    const Outcome r = run_vmpray(std::string(kSmall) + " -o out.png --stats s.json --machine-svg m.svg", target);
+    EXPECT_EQ(r.exit_code, 1) << target;
+    EXPECT_EQ(lines(r.err), 1u) << target << ": " << r.err;
+    EXPECT_NE(r.err.find("standard output"), std::string::npos) << target << ": " << r.err;
+    for (const char* name : {"out.png", "s.json", "m.svg"}) EXPECT_FALSE(fs::exists(dir_ / name)) << target << " " << name;
+  }
+}
+
 // Two outputs at one path would overwrite each other; the page's own images
 // count too. Refused before the render, leaving nothing.
 TEST_F(MachineCli, TwoOutputsAtOnePathAreAnError) {

@@ -140,7 +140,9 @@ TEST(Sweep, NodesSweepWritesWellFormedTablesAndPlots) {
   const fs::path dir = fresh_dir("vmpray_sweep_nodes");
   auto o = parse({"nodes", "teapot:2", "--size", "12", "--nodes", "1,2,4", "--topology", "hypercube,ring"});
   const app::SweepTable table = app::run_sweep(o, nullptr);
-  const auto files = app::write_sweep(table, dir);
+  app::OutputFiles outputs;
+  const auto files = app::write_sweep(table, dir, outputs);
+  outputs.keep();
 
   const auto rows = csv_rows(read(dir / "nodes.csv"));
   ASSERT_EQ(rows.size(), 7u);  // header + 2 topologies x 3 sizes
@@ -226,7 +228,10 @@ TEST(Sweep, AFileThatCannotBeWrittenTakesTheOthersWithIt) {
   const fs::path dir = fresh_dir("vmpray_sweep_failed");
   fs::create_directories(dir / "cache.html");
   auto o = parse({"cache", "teapot:2", "--size", "8", "--nodes", "2", "--cache-pages", "4,8"});
-  EXPECT_THROW(app::write_sweep(app::run_sweep(o, nullptr), dir), std::runtime_error);
+  {
+    app::OutputFiles outputs;  // removes, as it ends, what was written
+    EXPECT_THROW(app::write_sweep(app::run_sweep(o, nullptr), dir, outputs), std::runtime_error);
+  }
   std::vector<std::string> left;
   for (const auto& entry : fs::directory_iterator(dir)) left.push_back(entry.path().filename().string());
   EXPECT_EQ(left, std::vector<std::string>{"cache.html"});
@@ -235,7 +240,9 @@ TEST(Sweep, AFileThatCannotBeWrittenTakesTheOthersWithIt) {
 TEST(Sweep, HtmlPageLinksOnlyFilesItWrote) {
   const fs::path dir = fresh_dir("vmpray_sweep_html");
   auto o = parse({"cache", "teapot:2", "--size", "8", "--nodes", "2", "--cache-pages", "4,8"});
-  const auto files = app::write_sweep(app::run_sweep(o, nullptr), dir);
+  app::OutputFiles outputs;
+  const auto files = app::write_sweep(app::run_sweep(o, nullptr), dir, outputs);
+  outputs.keep();
   std::set<std::string> written;
   for (const auto& f : files) written.insert(f.filename().string());
   const std::string html = read(dir / "cache.html");
