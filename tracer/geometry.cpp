@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <numbers>
 
 namespace tracer {
 
@@ -132,10 +133,65 @@ bool is_ear(const std::vector<P2>& pts, const std::vector<std::uint32_t>& ring, 
   }
   return true;
 }
+
+// Does the ring turn with `sign` at every corner, going round exactly once?
+// Then it is strictly convex: every corner is an ear.
+bool is_strictly_convex(const std::vector<P2>& pts, double sign) {
+  const std::size_t n = pts.size();
+  double turning = 0;  // sum of exterior angles: 2 pi for a ring that goes round once
+  for (std::size_t k = 0; k < n; ++k) {
+    const P2& a = pts[(k + n - 1) % n];
+    const P2& b = pts[k];
+    const P2& c = pts[(k + 1) % n];
+    const double turn = sign * cross2(a, b, c);
+    if (!(turn > 0)) return false;
+    const double along = (b.x - a.x) * (c.x - b.x) + (b.y - a.y) * (c.y - b.y);
+    turning += std::atan2(turn, along);
+  }
+  return turning < 3 * std::numbers::pi;  // the sum is a multiple of 2 pi
+}
+
+using Triangles = std::vector<std::array<std::uint32_t, 3>>;
+
+// Strictly convex ring: each pass clips the ears at every other vertex, from
+// ring position 0, and leaves the rest as the next, half-size ring; the last
+// three vertices make the last triangle. O(n), and the triangles of a regular
+// polygon are as fat as its ring allows: thin ones only along the rim, where
+// they are small, instead of a fan's slivers across the whole polygon.
+void clip_alternate_ears(std::vector<std::uint32_t> ring, Triangles& tris) {
+  std::vector<std::uint32_t> kept;
+  while (ring.size() > 3) {
+    const std::size_t n = ring.size();
+    kept.clear();
+    for (std::size_t k = 0; k < n; ++k) {
+      if (k % 2 == 0 && k + 1 < n)
+        tris.push_back({ring[(k + n - 1) % n], ring[k], ring[k + 1]});
+      else
+        kept.push_back(ring[k]);
+    }
+    ring.swap(kept);
+  }
+  if (ring.size() == 3) tris.push_back({ring[0], ring[1], ring[2]});
+}
+
+// Any ring: clip the first ear from the start of the ring, again and again;
+// a ring with no ear left is finished as a fan. At least O(n^2).
+void clip_first_ears(std::vector<std::uint32_t> ring, const std::vector<P2>& pts, double sign,
+                     Triangles& tris) {
+  while (ring.size() > 3) {
+    std::size_t k = 0;
+    while (k < ring.size() && !is_ear(pts, ring, k, sign)) ++k;
+    if (k == ring.size()) break;  // no ear: finish as a fan below
+    const std::size_t n_ring = ring.size();
+    tris.push_back({ring[(k + n_ring - 1) % n_ring], ring[k], ring[(k + 1) % n_ring]});
+    ring.erase(ring.begin() + static_cast<std::ptrdiff_t>(k));
+  }
+  for (std::size_t k = 1; k + 1 < ring.size(); ++k) tris.push_back({ring[0], ring[k], ring[k + 1]});
+}
 }  // namespace
 
 std::vector<std::array<std::uint32_t, 3>> triangulate_polygon(const std::vector<Vec3d>& v) {
-  std::vector<std::array<std::uint32_t, 3>> tris;
+  Triangles tris;
   if (v.size() < 3) return tris;
   // Project onto the plane that drops the normal's dominant axis.
   const Vec3d n = cross(v[1] - v[0], v[2] - v[0]);
@@ -147,15 +203,11 @@ std::vector<std::array<std::uint32_t, 3>> triangulate_polygon(const std::vector<
   const double sign = n[drop] >= 0 ? 1.0 : -1.0;  // winding as seen in the projection
   std::vector<std::uint32_t> ring(v.size());
   for (std::uint32_t i = 0; i < ring.size(); ++i) ring[i] = i;
-  while (ring.size() > 3) {
-    std::size_t k = 0;
-    while (k < ring.size() && !is_ear(pts, ring, k, sign)) ++k;
-    if (k == ring.size()) break;  // no ear: finish as a fan below
-    const std::size_t n_ring = ring.size();
-    tris.push_back({ring[(k + n_ring - 1) % n_ring], ring[k], ring[(k + 1) % n_ring]});
-    ring.erase(ring.begin() + static_cast<std::ptrdiff_t>(k));
-  }
-  for (std::size_t k = 1; k + 1 < ring.size(); ++k) tris.push_back({ring[0], ring[k], ring[k + 1]});
+  tris.reserve(v.size() - 2);
+  if (is_strictly_convex(pts, sign))
+    clip_alternate_ears(std::move(ring), tris);
+  else
+    clip_first_ears(std::move(ring), pts, sign, tris);
   return tris;
 }
 

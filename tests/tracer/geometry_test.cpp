@@ -3,6 +3,10 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <cmath>
+#include <numbers>
+
 namespace tracer {
 namespace {
 
@@ -108,6 +112,67 @@ TEST(Triangulate, NonConvexPolygonCoversItsArea) {
     area += 0.5 * n.z;
   }
   EXPECT_NEAR(area, 3.0, 1e-12);
+}
+
+std::vector<Vec3d> regular_polygon(int vertices, double radius) {
+  std::vector<Vec3d> v;
+  for (int i = 0; i < vertices; ++i) {
+    const double a = 2 * std::numbers::pi * i / vertices;
+    v.push_back({radius * std::cos(a), radius * std::sin(a), 0});
+  }
+  return v;
+}
+
+double smallest_angle(const Vec3d& a, const Vec3d& b, const Vec3d& c) {
+  auto angle = [](const Vec3d& p, const Vec3d& q, const Vec3d& r) {
+    return std::acos(dot(normalize(q - p), normalize(r - p)));
+  };
+  return std::min({angle(a, b, c), angle(b, c, a), angle(c, a, b)});
+}
+
+// No triangulation on a regular polygon's own vertices avoids thin triangles
+// (an ear's corners are pi / n), but a fan makes every triangle a sliver; here
+// the thin ones must be small. Counter-clockwise, odd and even counts.
+TEST(Triangulate, RegularPolygonHasFewThinTriangles) {
+  for (int n : {1999, 2000}) {
+    const auto v = regular_polygon(n, 1.5);
+    const auto tris = triangulate_polygon(v);
+    ASSERT_EQ(tris.size(), std::size_t(n - 2));
+    double area = 0, thin_area = 0;
+    for (const auto& t : tris) {
+      const double a = 0.5 * cross(v[t[1]] - v[t[0]], v[t[2]] - v[t[0]]).z;
+      ASSERT_GT(a, 0) << "every triangle keeps the polygon's winding";
+      area += a;
+      if (smallest_angle(v[t[0]], v[t[1]], v[t[2]]) < std::numbers::pi / 180) thin_area += a;
+    }
+    const double polygon_area = 0.5 * n * 1.5 * 1.5 * std::sin(2 * std::numbers::pi / n);
+    EXPECT_NEAR(area, polygon_area, 1e-12 * polygon_area) << n;
+    EXPECT_LT(thin_area, 0.01 * area) << n << ": area in triangles with a corner under 1 degree";
+  }
+}
+
+// Points spread over a convex polygon (within its inscribed circle, off the
+// diagonals) each lie in exactly one triangle.
+TEST(Triangulate, ConvexPolygonIsCoveredOnce) {
+  for (int n : {5, 6, 7, 64, 101}) {
+    const auto v = regular_polygon(n, 1.0);
+    const auto tris = triangulate_polygon(v);
+    auto inside = [&](const std::array<std::uint32_t, 3>& t, double x, double y) {
+      for (int k = 0; k < 3; ++k) {
+        const Vec3d& a = v[t[k]];
+        const Vec3d& b = v[t[(k + 1) % 3]];
+        if ((b.x - a.x) * (y - a.y) - (b.y - a.y) * (x - a.x) < 0) return false;
+      }
+      return true;
+    };
+    for (double y = -0.693; y < 0.7; y += 0.0517)
+      for (double x = -0.691; x < 0.7; x += 0.0513) {
+        if (std::hypot(x, y) > 0.8) continue;
+        int covering = 0;
+        for (const auto& t : tris) covering += inside(t, x, y);
+        EXPECT_EQ(covering, 1) << n << " vertices, point " << x << ' ' << y;
+      }
+  }
 }
 
 }  // namespace

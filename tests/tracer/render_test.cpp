@@ -1,10 +1,13 @@
 // Renders of a small scene: independent of page size, of the page cache, of
 // how pixels are split; BVH and grid agree; SPD mode counts rays as specified.
+// A lit polygon of thousands of vertices does not shadow itself.
 #include "tracer/render.hpp"
 
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <cstring>
+#include <numbers>
 
 #include "test_scenes.hpp"
 #include "tracer/generators.hpp"
@@ -126,6 +129,35 @@ TEST(Render, MaxDepthOneTracesNoSecondaryRays) {
   RayStats stats;
   render(testing::showcase_scene(16), {}, {.max_depth = 1}, &stats);
   EXPECT_EQ(stats.reflected + stats.refracted, 0u);
+}
+
+// A disc of radius 1.5 as a 2000-gon facing the camera and the light. Fanned
+// from one vertex, its slivers' hit distances were off by more than the
+// shadow rays' offset, which then started below the disc and hit it.
+TEST(Render, ManySidedDiscIsLitEverywhere) {
+  constexpr int kVertices = 2000;
+  Scene s;
+  s.name = "disc";
+  s.camera = {{0, 0, 5}, {0, 0, 0}, {0, 1, 0}, 45.0, 1.0, 48, 48};
+  s.background = {0, 0, 1};
+  s.lights = {{{0, 0, 10}, {1, 1, 1}}};
+  s.materials = {{{1, 0, 0}, 1.0, 0.0, 0, 0, 1}};
+  Polygon disc;
+  for (int i = 0; i < kVertices; ++i) {
+    const double a = 2 * std::numbers::pi * i / kVertices;
+    disc.vertices.push_back({1.5 * std::cos(a), 1.5 * std::sin(a), 0});
+  }
+  s.objects.push_back({disc, 0});
+  int lit = 0, unlit = 0;
+  for (const Color& c : render(s, {})) {
+    if (c == s.background) continue;
+    if (c.r > 0)
+      ++lit;
+    else
+      ++unlit;
+  }
+  EXPECT_GT(lit, 48 * 48 / 4);
+  EXPECT_EQ(unlit, 0);
 }
 
 TEST(Render, BackgroundWhenNothingIsHit) {
