@@ -1,5 +1,6 @@
 // Line plots as SVG: one panel per plot, drawn in the order grid, thresholds,
-// series (clipped to the data area), axes and labels, legend.
+// series (clipped to the data area), axes and labels, legend (series, then
+// thresholds).
 // A title always fits its panel: its font shrinks down to a floor and, if
 // still too wide, its middle gives way to an ellipsis; the whole title stays
 // in the panel's <title>.
@@ -24,6 +25,8 @@ constexpr double char_width = 6.6;  // mean advance of 12px sans-serif
 constexpr double bold_em = 0.62;
 constexpr double title_font_max = 14, title_font_min = 11;
 constexpr double title_pad = 4;  // between a title and its panel's sides
+constexpr const char* threshold_grey = "#777777";
+constexpr const char* threshold_dashes = "2 3";
 
 void draw_grid_and_ticks(SvgDocument& doc, const PlotGeometry& g) {
   const Rect& a = g.area();
@@ -108,9 +111,7 @@ void draw_data(SvgDocument& doc, const LinePlot& plot, const PlotGeometry& g, co
   for (const Threshold& t : plot.thresholds) {
     if (!g.drawable({g.x_ticks().lo, t.y})) continue;
     doc.leaf("line", {{"class", "threshold"}, {"x1", num(a.left)}, {"y1", num(g.y(t.y))}, {"x2", num(a.right())},
-                      {"y2", num(g.y(t.y))}, {"stroke", "#777777"}, {"stroke-dasharray", "2 3"}});
-    doc.text(t.label, {{"x", num(a.right() - 4)}, {"y", num(g.y(t.y) - 4)}, {"text-anchor", "end"},
-                       {"font-size", "11"}, {"fill", "#555555"}});
+                      {"y2", num(g.y(t.y))}, {"stroke", threshold_grey}, {"stroke-dasharray", threshold_dashes}});
   }
   for (std::size_t i = 0; i < plot.series.size(); ++i) {
     const Series& s = plot.series[i];
@@ -140,6 +141,13 @@ void draw_legend(SvgDocument& doc, const LinePlot& plot, const PlotGeometry& g) 
                       {"stroke", colour}, {"stroke-width", "2"},
                       {"stroke-dasharray", s.style == LineStyle::dashed ? "6 4" : "none"}});
     doc.text(s.name, {{"x", num(l.left + 30)}, {"y", num(y)}});
+    y += 16;
+  }
+  for (const Threshold& t : plot.thresholds) {
+    if (t.label.empty() || !g.drawable({g.x_ticks().lo, t.y})) continue;
+    doc.leaf("line", {{"x1", num(l.left)}, {"y1", num(y - 4)}, {"x2", num(l.left + 24)}, {"y2", num(y - 4)},
+                      {"stroke", threshold_grey}, {"stroke-dasharray", threshold_dashes}});
+    doc.text(t.label, {{"x", num(l.left + 30)}, {"y", num(y)}, {"fill", "#555555"}});
     y += 16;
   }
   doc.close();

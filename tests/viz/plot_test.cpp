@@ -112,6 +112,27 @@ TEST(LinePlot, ThresholdDrawnAtItsValue) {
   }
 }
 
+// The label goes in the legend, where it cannot cover the lines that end
+// near the threshold.
+TEST(LinePlot, ThresholdLabelIsInTheLegend) {
+  LinePlot p;
+  p.y_min = 0;
+  p.y_max = 100;
+  p.series.push_back({"hypercube", {{1, 100}, {64, 78}}});
+  p.thresholds.push_back({78, "paper: 78% at 64"});
+  const test::XmlCheck doc = test::check_xml(plot_svg(p));
+  const detail::PlotGeometry g(p, {0, 0, 520, 340}, 6.6);
+  std::size_t labels = 0;
+  for (const auto& e : doc.elements) {
+    if (e.tag != "text" || e.text != "paper: 78% at 64") continue;
+    ++labels;
+    EXPECT_GE(std::stod(e.attrs.at("x")), g.legend().left);
+    EXPECT_GE(std::stod(e.attrs.at("y")), g.legend().top);
+    EXPECT_LE(std::stod(e.attrs.at("y")), g.legend().bottom());
+  }
+  EXPECT_EQ(labels, 1u);
+}
+
 TEST(LinePlot, FixedRangeBoundsTheAxis) {
   LinePlot p;
   p.y_min = 0.25;
