@@ -10,6 +10,7 @@
 #include <sstream>
 
 #include "app/machine_pictures.hpp"
+#include "app/viz/colour.hpp"
 #include "tests/viz/xml_check.hpp"
 #include "tracer/generators.hpp"
 
@@ -86,6 +87,9 @@ TEST(MachinePictures, WritesWellFormedSvgAndAPageLinkingOnlyItsFiles) {
   EXPECT_GE(links, 2);  // the image and the ownership picture
   for (const auto& entry : fs::directory_iterator(dir)) EXPECT_TRUE(names.count(entry.path().filename().string()));
   EXPECT_NE(html.find("when each processor traced each tile"), std::string::npos);
+  // The ownership picture's key: one swatch per processor, in its colour.
+  for (int n = 0; n < 4; ++n)
+    EXPECT_NE(html.find("<li style=\"background:" + viz::hex(viz::node_colour(n))), std::string::npos) << n;
 }
 
 TEST(MachinePictures, APictureThatCannotBeWrittenTakesTheOthersWithIt) {
