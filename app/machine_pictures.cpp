@@ -146,7 +146,7 @@ std::vector<std::filesystem::path> write_machine_pictures(const PictureFiles& fi
         outputs.write(files.ownership_png, [&](const auto& p) { ownership.write_image(p.string()); }));
   if (!files.timeline_svg.empty()) written.push_back(outputs.write_text(files.timeline_svg, tiles));
   if (!files.report_html.empty()) {
-    viz::Section run{.heading = title};
+    viz::Section run{.heading = "The run on " + report.topology};
     run.blocks.push_back(viz::ImageFigure{.caption = "rendered image", .image = image});
     run.blocks.push_back(machine_statistics(report));
     run.blocks.push_back(viz::SvgFigure{.caption = "the machine after the run", .svg = machine});

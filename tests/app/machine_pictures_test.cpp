@@ -80,6 +80,9 @@ TEST(MachinePictures, WritesWellFormedSvgAndAPageLinkingOnlyItsFiles) {
   for (const auto& f : written) names.insert(f.filename().string());
   const std::string html = read(files.report_html);
   EXPECT_NE(html.find("predicted synthesis time"), std::string::npos);
+  // The page is titled by the scene; its section says what it shows.
+  EXPECT_NE(html.find("<h1>teapot on a 2x2 mesh</h1>"), std::string::npos);
+  EXPECT_NE(html.find("<h2>The run on mesh:2x2</h2>"), std::string::npos);
   const std::regex link(R"((?:src|href)=\"([^\"]*)\")");
   int links = 0;
   for (auto it = std::sregex_iterator(html.begin(), html.end(), link); it != std::sregex_iterator(); ++it, ++links)
