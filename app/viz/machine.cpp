@@ -242,7 +242,37 @@ void draw_node(SvgDocument& doc, int id, const NodeWork& w, Vec2 centre, const V
   doc.close();
 }
 
-void draw_legend(SvgDocument& doc, double y, const MachineDrawing& m, const Scales& s) {
+// One line of the legend's notes, after a short sample of a link's stroke
+// when it explains one.
+struct Note {
+  std::string text;
+  const char* sample = nullptr;  // stroke colour of the sample; none: no sample
+};
+
+// What the picture shows beyond the colour bars, only what it has: rings if
+// some node served pages, the rest if there are links.
+std::vector<Note> legend_notes(const MachineDrawing& m, const Scales& s) {
+  std::vector<Note> notes;
+  if (s.max_requests > 0)
+    notes.push_back({"ring width: page requests served (max " + std::to_string(s.max_requests) + ")"});
+  if (m.links.empty()) return notes;
+  notes.push_back({"each direction drawn on its right-hand side"});
+  const auto idle = std::count_if(m.links.begin(), m.links.end(), [](const LinkTraffic& l) { return l.packets == 0; });
+  if (m.links.size() > max_detailed_links && idle > 0)
+    notes.push_back({std::to_string(idle) + " idle links not drawn"});
+  else if (idle > 0)
+    notes.push_back({"idle link: carried no packets", idle_grey});
+  if (std::any_of(m.links.begin(), m.links.end(),
+                  [&](const LinkTraffic& l) { return link_geometry(m, std::min(l.from, l.to), std::max(l.from, l.to)).wrap; }))
+    notes.push_back({"stubs at the border: wrap-around links"});
+  return notes;
+}
+
+constexpr double note_step = 16;
+
+// Colour bars for node work and, with links, for traffic; then the notes.
+void draw_legend(SvgDocument& doc, double y, const MachineDrawing& m, const Scales& s,
+                 const std::vector<Note>& notes) {
   doc.open("g", {{"class", "legend"}});
   doc.open("defs", {});
   // Fixed ids with fixed content: duplicates across inlined SVGs are harmless.
@@ -250,14 +280,18 @@ void draw_legend(SvgDocument& doc, double y, const MachineDrawing& m, const Scal
   scale_gradient(doc, "viz-traffic-scale", traffic_scale);
   doc.close();
   colour_bar(doc, 20, y, "viz-work-scale", "node fill: pixels computed", static_cast<double>(s.max_pixels));
-  colour_bar(doc, 220, y, "viz-traffic-scale", s.by_bytes ? "link: bytes carried" : "link: packets carried",
-             static_cast<double>(s.max_link));
-  doc.text("ring width: page requests served (max " + std::to_string(s.max_requests) + ")",
-           {{"x", "420"}, {"y", num(y)}, {"font-size", "12"}});
-  doc.text("each direction drawn on its right-hand side", {{"x", "420"}, {"y", num(y + 18)}, {"font-size", "11"}});
-  if (m.links.size() > max_detailed_links) {
-    const auto idle = std::count_if(m.links.begin(), m.links.end(), [](const LinkTraffic& l) { return l.packets == 0; });
-    doc.text(std::to_string(idle) + " idle links not drawn", {{"x", "420"}, {"y", num(y + 34)}, {"font-size", "11"}});
+  if (!m.links.empty())
+    colour_bar(doc, 220, y, "viz-traffic-scale", s.by_bytes ? "link: bytes carried" : "link: packets carried",
+               static_cast<double>(s.max_link));
+  for (std::size_t i = 0; i < notes.size(); ++i) {
+    const double line_y = y + note_step * static_cast<double>(i);
+    double x = 420;
+    if (notes[i].sample) {
+      doc.leaf("line", {{"x1", num(x)}, {"y1", num(line_y - 4)}, {"x2", num(x + 20)}, {"y2", num(line_y - 4)},
+                        {"stroke", notes[i].sample}, {"stroke-width", "1.5"}});
+      x += 26;
+    }
+    doc.text(notes[i].text, {{"x", num(x)}, {"y", num(line_y)}, {"font-size", "11"}});
   }
   doc.close();
 }
@@ -300,18 +334,19 @@ std::string machine_svg(const MachineDrawing& m) {
   v.left = (width - bw * v.scale) / 2;
   v.top = title_h;
   const double legend_y = title_h + bh * v.scale + 16;
-  SvgDocument doc(width, legend_y + 50);
+  const Scales s = scales_of(m);
+  const std::vector<Note> notes = legend_notes(m, s);
+  SvgDocument doc(width, legend_y + std::max(44.0, note_step * static_cast<double>(notes.size()) + 4));
   doc.leaf("rect", {{"width", "100%"}, {"height", "100%"}, {"fill", "white"}});
   if (!m.title.empty())
     doc.text(m.title, {{"x", num(width / 2)}, {"y", "22"}, {"text-anchor", "middle"}, {"font-size", "15"},
                        {"font-weight", "bold"}});
-  const Scales s = scales_of(m);
   draw_links(doc, m, pos, v, s);
   doc.open("g", {{"class", "nodes"}});
   for (int i = 0; i < n; ++i)
     draw_node(doc, i, m.nodes[static_cast<std::size_t>(i)], pos[static_cast<std::size_t>(i)], v, s);
   doc.close();
-  draw_legend(doc, legend_y, m, s);
+  draw_legend(doc, legend_y, m, s, notes);
   return doc.finish();
 }
 

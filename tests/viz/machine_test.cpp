@@ -139,6 +139,38 @@ TEST(MachineDrawing, ManyLinksAreDrawnInBulk) {
   EXPECT_LT(svg.size(), 2'000'000u);
 }
 
+// Everything the legend's text says, in order.
+std::string legend_text(const test::XmlCheck& doc) {
+  std::string text;
+  bool in_legend = false;
+  for (const auto& e : doc.elements) {
+    if (e.attrs.count("class") && e.attrs.at("class") == "legend") in_legend = true;
+    if (in_legend && e.tag == "text") text += e.text + "\n";
+  }
+  return text;
+}
+
+TEST(MachineDrawing, LegendExplainsIdleAndWrapLinks) {
+  std::size_t busy = 0;
+  const std::string torus = legend_text(test::check_xml(machine_svg(drawing(MachineKind::torus, 4, 4, &busy))));
+  EXPECT_NE(torus.find("idle link"), std::string::npos) << torus;
+  EXPECT_NE(torus.find("wrap-around links"), std::string::npos) << torus;
+  const std::string mesh = legend_text(test::check_xml(machine_svg(drawing(MachineKind::mesh, 4, 4, &busy))));
+  EXPECT_NE(mesh.find("idle link"), std::string::npos) << mesh;
+  EXPECT_EQ(mesh.find("wrap"), std::string::npos) << mesh;
+}
+
+// One node: no links and no pages served, so neither is in the legend.
+TEST(MachineDrawing, LegendOfASingleNodeHasNoLinksOrRings) {
+  const MachineDrawing m{MachineKind::complete, 1, 1, "", {{4096, 0, ""}}, {}};
+  const test::XmlCheck doc = test::check_xml(machine_svg(m));
+  ASSERT_TRUE(doc.ok) << doc.error;
+  const std::string legend = legend_text(doc);
+  EXPECT_NE(legend.find("node fill: pixels computed"), std::string::npos) << legend;
+  EXPECT_EQ(legend.find("link"), std::string::npos) << legend;
+  EXPECT_EQ(legend.find("ring width"), std::string::npos) << legend;
+}
+
 TEST(MachineDrawing, EscapesTitleAndLabels) {
   std::size_t busy = 0;
   MachineDrawing m = drawing(MachineKind::ring, 4, 1, &busy);
