@@ -29,6 +29,13 @@ viz::MachineKind drawing_kind(topology::Kind kind) {
   throw std::logic_error("unknown topology kind");
 }
 
+// Which colour the ownership picture gives each processor.
+std::vector<viz::KeyEntry> ownership_key(int nodes) {
+  std::vector<viz::KeyEntry> key;
+  for (int n = 0; n < nodes; ++n) key.push_back({std::to_string(n), viz::node_colour(n)});
+  return key;
+}
+
 std::string fixed(double v, int digits) {
   std::ostringstream out;
   out << std::fixed << std::setprecision(digits) << v;
@@ -139,11 +146,13 @@ std::vector<std::filesystem::path> write_machine_pictures(const PictureFiles& fi
         outputs.write(files.ownership_png, [&](const auto& p) { ownership.write_image(p.string()); }));
   if (!files.timeline_svg.empty()) written.push_back(outputs.write_text(files.timeline_svg, tiles));
   if (!files.report_html.empty()) {
-    viz::Section run{.heading = title};
+    viz::Section run{.heading = "The run on " + report.topology};
     run.blocks.push_back(viz::ImageFigure{.caption = "rendered image", .image = image});
     run.blocks.push_back(machine_statistics(report));
     run.blocks.push_back(viz::SvgFigure{.caption = "the machine after the run", .svg = machine});
-    run.blocks.push_back(viz::ImageFigure{.caption = "which processor computed each pixel", .image = ownership});
+    run.blocks.push_back(viz::ImageFigure{.caption = "which processor computed each pixel (key: processor numbers)",
+                                          .image = ownership,
+                                          .key = ownership_key(static_cast<int>(report.nodes))});
     run.blocks.push_back(viz::SvgFigure{.caption = "when each processor traced each tile", .svg = tiles});
     for (const auto& f : viz::write_html_report(files.report_html, viz::Report{.title = title, .sections = {run}},
                                                    outputs.tracker()))

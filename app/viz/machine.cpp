@@ -24,6 +24,12 @@ struct Vec2 {
 
 constexpr double node_radius = 0.3;  // units
 constexpr double margin = 1.0;       // units around the layout: room for bows and wrap arcs
+constexpr double label_em = 0.85;    // label font size per node radius
+constexpr double min_label_px = 10;  // the picture grows to keep labels this large...
+constexpr double max_extent = 1400;  // ...but no larger than this, in pixels
+constexpr std::size_t max_detailed_links = 4096;  // beyond: links drawn in bulk
+constexpr int traffic_bands = 16;                 // bulk links: one element per band
+constexpr const char* idle_grey = "#cccccc";
 
 // Distance between the two halves of hypercube level `level` along one axis:
 // each level's gap grows so that every sub-cube is visibly a block.
@@ -105,6 +111,15 @@ Vec2 wrap_outward(Vec2 p, Vec2 other) {
   return {0.0, p.y < other.y ? -1.0 : 1.0};
 }
 
+// A straight line from p to q, as SVG path commands.
+std::string line(const View& v, Vec2 p, Vec2 q) {
+  std::string d = "M";
+  d += v.pt(p);
+  d += 'L';
+  d += v.pt(q);
+  return d;
+}
+
 // A quadratic Bezier from p through control c to q, as SVG path commands.
 std::string curve(const View& v, Vec2 p, Vec2 c, Vec2 q) {
   std::string d = "M";
@@ -126,9 +141,8 @@ std::string link_path(const MachineDrawing& m, const std::vector<Vec2>& pos, con
   // Right-hand lane of the direction of travel keeps the two directions apart.
   const Vec2 off = n * (l.from == a ? lane : -lane);
   const LinkGeometry g = link_geometry(m, a, b);
-  if (!g.wrap) {
-    return curve(v, pa + off, (pa + pb) * 0.5 + n * g.bow + off, pb + off);
-  }
+  if (!g.wrap && g.bow == 0) return line(v, pa + off, pb + off);
+  if (!g.wrap) return curve(v, pa + off, (pa + pb) * 0.5 + n * g.bow + off, pb + off);
   std::string path;
   for (const auto& [p, q] : {std::pair{pa, pb}, std::pair{pb, pa}}) {
     const Vec2 o = wrap_outward(p, q);
@@ -167,11 +181,29 @@ void draw_links(SvgDocument& doc, const MachineDrawing& m, const std::vector<Vec
   const bool complete = m.kind == MachineKind::complete;
   const double lane = complete ? 0.03 : 0.07;
   const double max_width = complete ? 2.5 : std::max(1.5, 0.1 * v.scale);
-  std::vector<const LinkTraffic*> active;
+  auto width = [&](double f) { return num(0.8 + (max_width - 0.8) * f); };
   doc.open("g", {{"class", "links"}, {"fill", "none"}, {"stroke-linecap", "round"}});
+  if (m.links.size() > max_detailed_links) {
+    // Too many to tell apart or to point at: lightest band first, idle links left out.
+    std::vector<std::string> bands(traffic_bands);
+    for (const LinkTraffic& l : m.links) {
+      if (l.packets == 0) continue;
+      const int band = std::min(traffic_bands - 1, static_cast<int>(fraction(s.measure(l), s.max_link) * traffic_bands));
+      bands[static_cast<std::size_t>(band)] += link_path(m, pos, l, v, lane);
+    }
+    for (int b = 0; b < traffic_bands; ++b) {
+      if (bands[static_cast<std::size_t>(b)].empty()) continue;
+      const double f = (b + 0.5) / traffic_bands;
+      doc.leaf("path", {{"class", "link-band"}, {"d", bands[static_cast<std::size_t>(b)]},
+                        {"stroke", hex(traffic_scale(f))}, {"stroke-width", width(f)}});
+    }
+    doc.close();
+    return;
+  }
+  std::vector<const LinkTraffic*> active;
   for (const LinkTraffic& l : m.links) {
     if (l.packets > 0) { active.push_back(&l); continue; }
-    doc.leaf("path", {{"class", "idle-link"}, {"d", link_path(m, pos, l, v, 0.0)}, {"stroke", "#cccccc"},
+    doc.leaf("path", {{"class", "idle-link"}, {"d", link_path(m, pos, l, v, 0.0)}, {"stroke", idle_grey},
                       {"stroke-width", "0.8"}});
   }
   // Heaviest links last, so they are drawn on top.
@@ -180,7 +212,7 @@ void draw_links(SvgDocument& doc, const MachineDrawing& m, const std::vector<Vec
   for (const LinkTraffic* l : active) {
     const double f = fraction(s.measure(*l), s.max_link);
     doc.open("path", {{"class", "link"}, {"d", link_path(m, pos, *l, v, lane)}, {"stroke", hex(traffic_scale(f))},
-                      {"stroke-width", num(0.8 + (max_width - 0.8) * f)}});
+                      {"stroke-width", width(f)}});
     doc.title(std::to_string(l->from) + " -> " + std::to_string(l->to) + ": " + std::to_string(l->packets) +
               " packets, " + std::to_string(l->bytes) + " bytes");
     doc.close();
@@ -205,12 +237,42 @@ void draw_node(SvgDocument& doc, int id, const NodeWork& w, Vec2 centre, const V
   doc.leaf("circle", {{"cx", cx}, {"cy", cy}, {"r", num(r)}, {"fill", hex(fill)}, {"stroke", "#333333"}});
   const bool dark = 0.299 * fill.r + 0.587 * fill.g + 0.114 * fill.b < 110.0;
   doc.text(w.label.empty() ? std::to_string(id) : w.label,
-           {{"x", cx}, {"y", num(std::stod(cy) + 0.32 * r)}, {"text-anchor", "middle"}, {"font-size", num(0.85 * r)},
+           {{"x", cx}, {"y", num(std::stod(cy) + 0.32 * r)}, {"text-anchor", "middle"}, {"font-size", num(label_em * r)},
             {"fill", dark ? "white" : "black"}});
   doc.close();
 }
 
-void draw_legend(SvgDocument& doc, double y, const Scales& s) {
+// One line of the legend's notes, after a short sample of a link's stroke
+// when it explains one.
+struct Note {
+  std::string text;
+  const char* sample = nullptr;  // stroke colour of the sample; none: no sample
+};
+
+// What the picture shows beyond the colour bars, only what it has: rings if
+// some node served pages, the rest if there are links.
+std::vector<Note> legend_notes(const MachineDrawing& m, const Scales& s) {
+  std::vector<Note> notes;
+  if (s.max_requests > 0)
+    notes.push_back({"ring width: page requests served (max " + std::to_string(s.max_requests) + ")"});
+  if (m.links.empty()) return notes;
+  notes.push_back({"each direction drawn on its right-hand side"});
+  const auto idle = std::count_if(m.links.begin(), m.links.end(), [](const LinkTraffic& l) { return l.packets == 0; });
+  if (m.links.size() > max_detailed_links && idle > 0)
+    notes.push_back({std::to_string(idle) + " idle links not drawn"});
+  else if (idle > 0)
+    notes.push_back({"idle link: carried no packets", idle_grey});
+  if (std::any_of(m.links.begin(), m.links.end(),
+                  [&](const LinkTraffic& l) { return link_geometry(m, std::min(l.from, l.to), std::max(l.from, l.to)).wrap; }))
+    notes.push_back({"stubs at the border: wrap-around links"});
+  return notes;
+}
+
+constexpr double note_step = 16;
+
+// Colour bars for node work and, with links, for traffic; then the notes.
+void draw_legend(SvgDocument& doc, double y, const MachineDrawing& m, const Scales& s,
+                 const std::vector<Note>& notes) {
   doc.open("g", {{"class", "legend"}});
   doc.open("defs", {});
   // Fixed ids with fixed content: duplicates across inlined SVGs are harmless.
@@ -218,11 +280,19 @@ void draw_legend(SvgDocument& doc, double y, const Scales& s) {
   scale_gradient(doc, "viz-traffic-scale", traffic_scale);
   doc.close();
   colour_bar(doc, 20, y, "viz-work-scale", "node fill: pixels computed", static_cast<double>(s.max_pixels));
-  colour_bar(doc, 220, y, "viz-traffic-scale", s.by_bytes ? "link: bytes carried" : "link: packets carried",
-             static_cast<double>(s.max_link));
-  doc.text("ring width: page requests served (max " + std::to_string(s.max_requests) + ")",
-           {{"x", "420"}, {"y", num(y)}, {"font-size", "12"}});
-  doc.text("each direction drawn on its right-hand side", {{"x", "420"}, {"y", num(y + 18)}, {"font-size", "11"}});
+  if (!m.links.empty())
+    colour_bar(doc, 220, y, "viz-traffic-scale", s.by_bytes ? "link: bytes carried" : "link: packets carried",
+               static_cast<double>(s.max_link));
+  for (std::size_t i = 0; i < notes.size(); ++i) {
+    const double line_y = y + note_step * static_cast<double>(i);
+    double x = 420;
+    if (notes[i].sample) {
+      doc.leaf("line", {{"x1", num(x)}, {"y1", num(line_y - 4)}, {"x2", num(x + 20)}, {"y2", num(line_y - 4)},
+                        {"stroke", notes[i].sample}, {"stroke-width", "1.5"}});
+      x += 26;
+    }
+    doc.text(notes[i].text, {{"x", num(x)}, {"y", num(line_y)}, {"font-size", "11"}});
+  }
   doc.close();
 }
 
@@ -255,25 +325,28 @@ std::string machine_svg(const MachineDrawing& m) {
   }
   const double bw = hi.x - lo.x + 2 * margin, bh = hi.y - lo.y + 2 * margin;
   View v;
-  v.scale = std::min({720.0 / bw, 600.0 / bh, 90.0});
+  // As large as fits 720 x 600; larger, within max_extent, if labels would be too small.
+  const double legible = min_label_px / (label_em * node_radius);
+  v.scale = std::max(std::min({720.0 / bw, 600.0 / bh, 90.0}), std::min(legible, max_extent / std::max(bw, bh)));
   const double width = std::max(bw * v.scale, 700.0) + 20.0;
   const double title_h = m.title.empty() ? 10.0 : 34.0;
   v.origin = lo - Vec2{margin, margin};
   v.left = (width - bw * v.scale) / 2;
   v.top = title_h;
   const double legend_y = title_h + bh * v.scale + 16;
-  SvgDocument doc(width, legend_y + 44);
+  const Scales s = scales_of(m);
+  const std::vector<Note> notes = legend_notes(m, s);
+  SvgDocument doc(width, legend_y + std::max(44.0, note_step * static_cast<double>(notes.size()) + 4));
   doc.leaf("rect", {{"width", "100%"}, {"height", "100%"}, {"fill", "white"}});
   if (!m.title.empty())
     doc.text(m.title, {{"x", num(width / 2)}, {"y", "22"}, {"text-anchor", "middle"}, {"font-size", "15"},
                        {"font-weight", "bold"}});
-  const Scales s = scales_of(m);
   draw_links(doc, m, pos, v, s);
   doc.open("g", {{"class", "nodes"}});
   for (int i = 0; i < n; ++i)
     draw_node(doc, i, m.nodes[static_cast<std::size_t>(i)], pos[static_cast<std::size_t>(i)], v, s);
   doc.close();
-  draw_legend(doc, legend_y, s);
+  draw_legend(doc, legend_y, m, s, notes);
   return doc.finish();
 }
 

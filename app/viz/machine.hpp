@@ -5,10 +5,16 @@
 // with gaps growing per level, so sub-cubes stand apart; mesh and torus on a
 // grid with node id = y * W + x (wrap links as arcs leaving the border); ring
 // and complete graph on a circle, node 0 at the top, ids clockwise.
-// Invariants: one element of class "node" per node, one of class "link" per
-// directed link that carried packets (the two directions of a link are drawn
-// side by side, each offset to the right of its direction of travel), one of
-// class "idle-link" per listed link that carried none.
+// The picture grows with the layout, up to a bound, so that node labels stay
+// legible (at least 10 px for every kind up to 64 nodes).
+// Invariants: one element of class "node" per node. Up to 4096 listed links
+// (every machine of up to 64 nodes): one element of class "link", with a
+// tooltip, per directed link that carried packets (the two directions of a
+// link are drawn side by side, each offset to the right of its direction of
+// travel), one of class "idle-link" per listed link that carried none. More
+// links than that are drawn in bulk: busy links grouped by traffic into at
+// most 16 elements of class "link-band", idle links left out and counted in
+// the legend.
 #pragma once
 
 #include <cstdint>

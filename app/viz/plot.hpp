@@ -28,10 +28,11 @@ struct Series {
   std::string colour{};         // "#rrggbb"; empty: the palette colour of its index
 };
 
-// A horizontal reference line across the plot (the paper's 50% efficiency).
+// A horizontal reference line across the plot (the paper's 50% efficiency),
+// named in the legend rather than over the data.
 struct Threshold {
   double y = 0;
-  std::string label{};
+  std::string label{};  // legend entry; empty: not listed
 };
 
 struct LinePlot {

@@ -63,6 +63,8 @@ PlotGeometry::PlotGeometry(const LinePlot& plot, Rect panel, double char_width)
   std::vector<std::string> names;
   for (const Series& s : plot.series)
     if (!s.name.empty()) names.push_back(s.name);
+  for (const Threshold& t : plot.thresholds)
+    if (!t.label.empty() && usable(plot.y_scale, t.y)) names.push_back(t.label);
   const double legend_w =
       names.empty() ? 0.0
                     : std::min(panel.width * 0.4, 34.0 + char_width * static_cast<double>(longest(names)));

@@ -56,7 +56,6 @@ void draw_data(Canvas& c, const LinePlot& plot, const PlotGeometry& g) {
   for (const Threshold& t : plot.thresholds) {
     if (!g.drawable({g.x_ticks().lo, t.y})) continue;
     c.line({a.left, g.y(t.y)}, {a.right(), g.y(t.y)}, 1, threshold_grey, 3);
-    c.text(a.right() - 4, g.y(t.y) - 10, t.label, 1, threshold_grey, Align::right);
   }
   for (std::size_t i = 0; i < plot.series.size(); ++i) {
     const Series& s = plot.series[i];
@@ -89,6 +88,12 @@ void draw_legend(Canvas& c, const LinePlot& plot, const PlotGeometry& g) {
     const Rgb8 colour = colour_of(s, static_cast<int>(i));
     c.line({l.left, y}, {l.left + 24, y}, 2, colour, s.style == LineStyle::dashed ? 5 : 0);
     c.text(l.left + 30, y - 3, s.name, 1, ink);
+    y += 16;
+  }
+  for (const Threshold& t : plot.thresholds) {
+    if (t.label.empty() || !g.drawable({g.x_ticks().lo, t.y})) continue;
+    c.line({l.left, y}, {l.left + 24, y}, 1, threshold_grey, 3);
+    c.text(l.left + 30, y - 3, t.label, 1, threshold_grey);
     y += 16;
   }
 }

@@ -1,8 +1,13 @@
 // Line plots as SVG: one panel per plot, drawn in the order grid, thresholds,
-// series (clipped to the data area), axes and labels, legend.
+// series (clipped to the data area), axes and labels, legend (series, then
+// thresholds).
+// A title always fits its panel: its font shrinks down to a floor and, if
+// still too wide, its middle gives way to an ellipsis; the whole title stays
+// in the panel's <title>.
 #include <algorithm>
 #include <cmath>
 #include <string>
+#include <vector>
 
 #include "app/viz/plot.hpp"
 #include "app/viz/plot_geometry.hpp"
@@ -15,6 +20,13 @@ using detail::PlotGeometry;
 using detail::Rect;
 
 constexpr double char_width = 6.6;  // mean advance of 12px sans-serif
+// Mean advance of bold sans-serif per px of font size, a little generous
+// (DejaVu Sans Bold measures about 0.58 on plot titles).
+constexpr double bold_em = 0.62;
+constexpr double title_font_max = 14, title_font_min = 11;
+constexpr double title_pad = 4;  // between a title and its panel's sides
+constexpr const char* threshold_grey = "#777777";
+constexpr const char* threshold_dashes = "2 3";
 
 void draw_grid_and_ticks(SvgDocument& doc, const PlotGeometry& g) {
   const Rect& a = g.area();
@@ -37,12 +49,45 @@ void draw_grid_and_ticks(SvgDocument& doc, const PlotGeometry& g) {
   doc.close();
 }
 
+// Byte offsets where the UTF-8 characters of `s` start, and s.size() last.
+std::vector<std::size_t> char_starts(const std::string& s) {
+  std::vector<std::size_t> starts;
+  for (std::size_t i = 0; i < s.size(); ++i)
+    if ((static_cast<unsigned char>(s[i]) & 0xC0) != 0x80) starts.push_back(i);
+  starts.push_back(s.size());
+  return starts;
+}
+
+struct FittedTitle {
+  std::string text;
+  double font_size = 0;
+  double width = 0;  // estimated
+};
+
+// The title at the largest font size that fits `room`, no smaller than the
+// floor; too long even then, it keeps its beginning and end around an ellipsis.
+FittedTitle fit_title(const std::string& title, double room) {
+  const std::vector<std::size_t> starts = char_starts(title);
+  const auto chars = static_cast<double>(starts.size() - 1);
+  const double size = std::clamp(room / (bold_em * chars), title_font_min, title_font_max);
+  if (chars * bold_em * size <= room) return {title, size, chars * bold_em * size};
+  const auto fit = static_cast<std::size_t>(std::max(0.0, std::floor(room / (bold_em * size)) - 1));
+  const std::size_t tail = fit / 2, head = fit - tail;
+  const std::string text = title.substr(0, starts[head]) + "\u2026" + title.substr(starts[starts.size() - 1 - tail]);
+  return {text, size, static_cast<double>(fit + 1) * bold_em * size};
+}
+
 void draw_labels(SvgDocument& doc, const LinePlot& plot, const PlotGeometry& g) {
   const Rect& a = g.area();
   const Rect& p = g.panel();
-  if (!plot.title.empty())
-    doc.text(plot.title, {{"x", num(a.left + a.width / 2)}, {"y", num(p.top + 20)}, {"text-anchor", "middle"},
-                          {"font-size", "14"}, {"font-weight", "bold"}});
+  if (!plot.title.empty()) {
+    const FittedTitle t = fit_title(plot.title, p.width - 2 * title_pad);
+    // Centred over the data area, unless that would push it off the panel.
+    const double x = std::clamp(a.left + a.width / 2, p.left + title_pad + t.width / 2,
+                                std::max(p.left + title_pad + t.width / 2, p.right() - title_pad - t.width / 2));
+    doc.text(t.text, {{"class", "plot-title"}, {"x", num(x)}, {"y", num(p.top + 20)}, {"text-anchor", "middle"},
+                      {"font-size", num(t.font_size)}, {"font-weight", "bold"}});
+  }
   if (!plot.x_label.empty())
     doc.text(plot.x_label, {{"x", num(a.left + a.width / 2)}, {"y", num(a.bottom() + 34)},
                             {"text-anchor", "middle"}, {"font-size", "12"}});
@@ -66,9 +111,7 @@ void draw_data(SvgDocument& doc, const LinePlot& plot, const PlotGeometry& g, co
   for (const Threshold& t : plot.thresholds) {
     if (!g.drawable({g.x_ticks().lo, t.y})) continue;
     doc.leaf("line", {{"class", "threshold"}, {"x1", num(a.left)}, {"y1", num(g.y(t.y))}, {"x2", num(a.right())},
-                      {"y2", num(g.y(t.y))}, {"stroke", "#777777"}, {"stroke-dasharray", "2 3"}});
-    doc.text(t.label, {{"x", num(a.right() - 4)}, {"y", num(g.y(t.y) - 4)}, {"text-anchor", "end"},
-                       {"font-size", "11"}, {"fill", "#555555"}});
+                      {"y2", num(g.y(t.y))}, {"stroke", threshold_grey}, {"stroke-dasharray", threshold_dashes}});
   }
   for (std::size_t i = 0; i < plot.series.size(); ++i) {
     const Series& s = plot.series[i];
@@ -100,6 +143,13 @@ void draw_legend(SvgDocument& doc, const LinePlot& plot, const PlotGeometry& g) 
     doc.text(s.name, {{"x", num(l.left + 30)}, {"y", num(y)}});
     y += 16;
   }
+  for (const Threshold& t : plot.thresholds) {
+    if (t.label.empty() || !g.drawable({g.x_ticks().lo, t.y})) continue;
+    doc.leaf("line", {{"x1", num(l.left)}, {"y1", num(y - 4)}, {"x2", num(l.left + 24)}, {"y2", num(y - 4)},
+                      {"stroke", threshold_grey}, {"stroke-dasharray", threshold_dashes}});
+    doc.text(t.label, {{"x", num(l.left + 30)}, {"y", num(y)}, {"fill", "#555555"}});
+    y += 16;
+  }
   doc.close();
 }
 
@@ -116,6 +166,7 @@ void draw_panel(SvgDocument& doc, const LinePlot& plot, Rect panel) {
   const Rect& a = g.area();
   const std::string clip_id = clip_id_for(a);
   doc.open("g", {{"class", "plot"}});
+  if (!plot.title.empty()) doc.title(plot.title);
   doc.open("clipPath", {{"id", clip_id}});
   // A little wider than the area so that markers on the border show whole.
   doc.leaf("rect", {{"x", num(a.left - 4)}, {"y", num(a.top - 4)}, {"width", num(a.width + 8)},

@@ -1,6 +1,7 @@
 // HTML report writer; see report.hpp for what the page may reference.
 #include "app/viz/report.hpp"
 
+#include <algorithm>
 #include <cctype>
 #include <stdexcept>
 
@@ -22,7 +23,11 @@ th { background: #f0f0f0; text-align: left; }
 td.num { text-align: right; font-variant-numeric: tabular-nums; }
 figure { margin: 1em 0; overflow-x: auto; }
 figcaption { color: #555; font-size: 0.9em; }
-img { image-rendering: pixelated; max-width: 100%; }
+img { image-rendering: pixelated; max-width: 100%; height: auto; }
+.keyed { display: flex; flex-wrap: wrap; gap: 1em; align-items: flex-start; }
+ol.key { list-style: none; margin: 0; padding: 0; display: grid; grid-template-columns: repeat(16, 2.6em);
+         gap: 2px; font-size: 0.75em; }
+ol.key li { text-align: center; border-radius: 2px; }
 )";
 
 // A file name as a relative URL: anything but unreserved characters is %-encoded.
@@ -38,6 +43,17 @@ std::string url_of(const std::string& name) {
     }
   }
   return out;
+}
+
+// Images narrower than this are shown enlarged.
+constexpr int min_display_width = 256;
+
+// The whole factor that shows an image at least min_display_width wide.
+int display_factor(int width) { return std::max(1, (min_display_width + width - 1) / std::max(width, 1)); }
+
+// Black or white, whichever reads better on `background`.
+std::string text_colour_on(Rgb8 background) {
+  return 0.299 * background.r + 0.587 * background.g + 0.114 * background.b < 128.0 ? "#ffffff" : "#000000";
 }
 
 bool looks_numeric(const std::string& s) {
@@ -94,9 +110,21 @@ class PageWriter {
     const std::string name = png.filename().string();
     f.image.write_png(png.string());  // whole or not at all
     track_(png);
-    out += "<figure>\n<img src=\"" + escape_xml(url_of(name)) + "\" width=\"" + std::to_string(f.image.width()) +
-           "\" height=\"" + std::to_string(f.image.height()) + "\" alt=\"" + escape_xml(f.caption) + "\"/>\n" +
-           figcaption(f.caption) + "</figure>\n";
+    const int factor = display_factor(f.image.width());
+    const std::string img = "<img src=\"" + escape_xml(url_of(name)) + "\" width=\"" +
+                            std::to_string(factor * f.image.width()) + "\" height=\"" +
+                            std::to_string(factor * f.image.height()) + "\" alt=\"" + escape_xml(f.caption) + "\"/>\n";
+    out += "<figure>\n";
+    if (f.key.empty()) {
+      out += img;
+    } else {
+      out += "<div class=\"keyed\">\n" + img + "<ol class=\"key\">\n";
+      for (const KeyEntry& k : f.key)
+        out += "<li style=\"background:" + hex(k.colour) + ";color:" + text_colour_on(k.colour) + "\">" +
+               escape_xml(k.label) + "</li>\n";
+      out += "</ol>\n</div>\n";
+    }
+    out += figcaption(f.caption) + "</figure>\n";
   }
 
   std::string out;

@@ -5,6 +5,8 @@
 // (n = 1, 2, ... in document order) and linked by file name, so the page
 // references only files it wrote itself. All text is escaped; SVG figures
 // are inserted as they are and must come from this library's *_svg functions.
+// An image narrower than 256 px is shown enlarged by a whole factor, its
+// pixels kept sharp; its PNG keeps the image's own size.
 #pragma once
 
 #include <filesystem>
@@ -14,6 +16,7 @@
 #include <variant>
 #include <vector>
 
+#include "app/viz/colour.hpp"
 #include "tracer/image.hpp"
 
 namespace viz {
@@ -38,9 +41,16 @@ struct SvgFigure {
   std::string svg{};  // a document from plot_svg, plots_svg or machine_svg
 };
 
+// One entry of an image's colour key: what a colour in the image stands for.
+struct KeyEntry {
+  std::string label{};
+  Rgb8 colour{};
+};
+
 struct ImageFigure {
   std::string caption{};
   tracer::Image image{};
+  std::vector<KeyEntry> key{};  // shown beside the image as numbered swatches; empty: none
 };
 
 using Block = std::variant<Paragraph, KeyValueTable, Table, SvgFigure, ImageFigure>;

@@ -10,6 +10,7 @@
 #include <sstream>
 
 #include "app/machine_pictures.hpp"
+#include "app/viz/colour.hpp"
 #include "tests/viz/xml_check.hpp"
 #include "tracer/generators.hpp"
 
@@ -79,6 +80,9 @@ TEST(MachinePictures, WritesWellFormedSvgAndAPageLinkingOnlyItsFiles) {
   for (const auto& f : written) names.insert(f.filename().string());
   const std::string html = read(files.report_html);
   EXPECT_NE(html.find("predicted synthesis time"), std::string::npos);
+  // The page is titled by the scene; its section says what it shows.
+  EXPECT_NE(html.find("<h1>teapot on a 2x2 mesh</h1>"), std::string::npos);
+  EXPECT_NE(html.find("<h2>The run on mesh:2x2</h2>"), std::string::npos);
   const std::regex link(R"((?:src|href)=\"([^\"]*)\")");
   int links = 0;
   for (auto it = std::sregex_iterator(html.begin(), html.end(), link); it != std::sregex_iterator(); ++it, ++links)
@@ -86,6 +90,9 @@ TEST(MachinePictures, WritesWellFormedSvgAndAPageLinkingOnlyItsFiles) {
   EXPECT_GE(links, 2);  // the image and the ownership picture
   for (const auto& entry : fs::directory_iterator(dir)) EXPECT_TRUE(names.count(entry.path().filename().string()));
   EXPECT_NE(html.find("when each processor traced each tile"), std::string::npos);
+  // The ownership picture's key: one swatch per processor, in its colour.
+  for (int n = 0; n < 4; ++n)
+    EXPECT_NE(html.find("<li style=\"background:" + viz::hex(viz::node_colour(n))), std::string::npos) << n;
 }
 
 TEST(MachinePictures, APictureThatCannotBeWrittenTakesTheOthersWithIt) {

@@ -2,6 +2,7 @@
 // traffic, every kind up to 64 nodes, clear errors for bad input.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <ostream>
 #include <stdexcept>
 
@@ -84,6 +85,91 @@ INSTANTIATE_TEST_SUITE_P(AllKinds, MachineKinds,
                                            Case{MachineKind::torus, 8, 8}, Case{MachineKind::torus, 2, 3},
                                            Case{MachineKind::ring, 64, 1}, Case{MachineKind::ring, 2, 1},
                                            Case{MachineKind::complete, 16, 1}, Case{MachineKind::complete, 1, 1}));
+
+// The font size of each node's label, in node order.
+std::vector<double> label_sizes(const test::XmlCheck& doc) {
+  std::vector<double> sizes;
+  bool in_node = false;
+  for (const auto& e : doc.elements) {
+    if (e.attrs.count("class") && e.attrs.at("class") == "node") in_node = true;
+    if (in_node && e.tag == "text") {
+      sizes.push_back(std::stod(e.attrs.at("font-size")));
+      in_node = false;
+    }
+  }
+  return sizes;
+}
+
+class SixtyFourNodes : public ::testing::TestWithParam<Case> {};
+
+TEST_P(SixtyFourNodes, LabelsAreLegible) {
+  std::size_t busy = 0;
+  const test::XmlCheck doc = test::check_xml(machine_svg(drawing(GetParam().kind, GetParam().a, GetParam().b, &busy)));
+  ASSERT_TRUE(doc.ok) << doc.error;
+  const std::vector<double> sizes = label_sizes(doc);
+  ASSERT_EQ(sizes.size(), 64u);
+  for (double size : sizes) EXPECT_GE(size, 10.0);
+}
+
+INSTANTIATE_TEST_SUITE_P(AllKinds, SixtyFourNodes,
+                         ::testing::Values(Case{MachineKind::ring, 64, 1}, Case{MachineKind::complete, 64, 1},
+                                           Case{MachineKind::hypercube, 6, 1}, Case{MachineKind::mesh, 8, 8},
+                                           Case{MachineKind::torus, 8, 8}));
+
+// A complete graph of 256 nodes has 65280 directed links: drawn in bulk,
+// every busy link is a stroke of one of a few traffic bands, the idle ones
+// are only counted, and the file stays small.
+TEST(MachineDrawing, ManyLinksAreDrawnInBulk) {
+  std::size_t busy = 0;
+  const MachineDrawing m = drawing(MachineKind::complete, 256, 1, &busy);
+  const std::string svg = machine_svg(m);
+  const test::XmlCheck doc = test::check_xml(svg);
+  ASSERT_TRUE(doc.ok) << doc.error;
+  EXPECT_EQ(test::count_class(doc, "link"), 0u);
+  EXPECT_EQ(test::count_class(doc, "idle-link"), 0u);
+  const std::size_t bands = test::count_class(doc, "link-band");
+  EXPECT_GE(bands, 1u);
+  EXPECT_LE(bands, 16u);
+  std::size_t strokes = 0;
+  for (const auto& e : doc.elements)
+    if (e.attrs.count("class") && e.attrs.at("class") == "link-band")
+      strokes += static_cast<std::size_t>(std::count(e.attrs.at("d").begin(), e.attrs.at("d").end(), 'M'));
+  EXPECT_EQ(strokes, busy);
+  EXPECT_NE(svg.find(std::to_string(m.links.size() - busy) + " idle links not drawn"), std::string::npos);
+  EXPECT_LT(svg.size(), 2'000'000u);
+}
+
+// Everything the legend's text says, in order.
+std::string legend_text(const test::XmlCheck& doc) {
+  std::string text;
+  bool in_legend = false;
+  for (const auto& e : doc.elements) {
+    if (e.attrs.count("class") && e.attrs.at("class") == "legend") in_legend = true;
+    if (in_legend && e.tag == "text") text += e.text + "\n";
+  }
+  return text;
+}
+
+TEST(MachineDrawing, LegendExplainsIdleAndWrapLinks) {
+  std::size_t busy = 0;
+  const std::string torus = legend_text(test::check_xml(machine_svg(drawing(MachineKind::torus, 4, 4, &busy))));
+  EXPECT_NE(torus.find("idle link"), std::string::npos) << torus;
+  EXPECT_NE(torus.find("wrap-around links"), std::string::npos) << torus;
+  const std::string mesh = legend_text(test::check_xml(machine_svg(drawing(MachineKind::mesh, 4, 4, &busy))));
+  EXPECT_NE(mesh.find("idle link"), std::string::npos) << mesh;
+  EXPECT_EQ(mesh.find("wrap"), std::string::npos) << mesh;
+}
+
+// One node: no links and no pages served, so neither is in the legend.
+TEST(MachineDrawing, LegendOfASingleNodeHasNoLinksOrRings) {
+  const MachineDrawing m{MachineKind::complete, 1, 1, "", {{4096, 0, ""}}, {}};
+  const test::XmlCheck doc = test::check_xml(machine_svg(m));
+  ASSERT_TRUE(doc.ok) << doc.error;
+  const std::string legend = legend_text(doc);
+  EXPECT_NE(legend.find("node fill: pixels computed"), std::string::npos) << legend;
+  EXPECT_EQ(legend.find("link"), std::string::npos) << legend;
+  EXPECT_EQ(legend.find("ring width"), std::string::npos) << legend;
+}
 
 TEST(MachineDrawing, EscapesTitleAndLabels) {
   std::size_t busy = 0;

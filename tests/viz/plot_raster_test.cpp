@@ -1,6 +1,8 @@
 // Rasterised plots: the size asked for, data drawn where the geometry puts it.
 #include <gtest/gtest.h>
 
+#include <cmath>
+#include <cstdlib>
 #include <stdexcept>
 
 #include "app/viz/colour.hpp"
@@ -26,6 +28,31 @@ TEST(PlotImage, DrawsSeriesWhereTheGeometrySays) {
     EXPECT_EQ(bytes.rgb[i + 1], c.g);
     EXPECT_EQ(bytes.rgb[i + 2], c.b);
   }
+}
+
+// Nothing of the threshold's grey inside the data area but its line: the
+// label is in the legend, not over the data.
+TEST(PlotImage, ThresholdLabelIsInTheLegend) {
+  LinePlot p;
+  p.y_min = 0;
+  p.y_max = 100;
+  p.series.push_back({"hypercube", {{1, 100}, {64, 78}}});
+  p.thresholds.push_back({50, "50% THRESHOLD"});
+  const tracer::Image img = plot_image(p, 400, 300);
+  const detail::PlotGeometry g(p, {0, 0, 400, 300}, 6.0);
+  const tracer::Rgb8Image bytes = img.to_rgb8();
+  auto grey_pixels = [&](const detail::Rect& r) {
+    int n = 0;
+    for (int y = static_cast<int>(r.top) + 1; y < static_cast<int>(r.bottom()); ++y)
+      for (int x = static_cast<int>(r.left) + 1; x < static_cast<int>(r.right()); ++x) {
+        if (std::abs(y - g.y(50)) < 2) continue;  // the threshold line itself
+        const std::size_t i = (static_cast<std::size_t>(y) * 400 + static_cast<std::size_t>(x)) * 3;
+        n += bytes.rgb[i] == 119 && bytes.rgb[i + 1] == 119 && bytes.rgb[i + 2] == 119;
+      }
+    return n;
+  };
+  EXPECT_EQ(grey_pixels(g.area()), 0);
+  EXPECT_GT(grey_pixels(g.legend()), 0);
 }
 
 TEST(PlotImage, RejectsSillySizes) {

@@ -2,6 +2,7 @@
 // data, log axes, thresholds and small multiples.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <sstream>
@@ -111,6 +112,27 @@ TEST(LinePlot, ThresholdDrawnAtItsValue) {
   }
 }
 
+// The label goes in the legend, where it cannot cover the lines that end
+// near the threshold.
+TEST(LinePlot, ThresholdLabelIsInTheLegend) {
+  LinePlot p;
+  p.y_min = 0;
+  p.y_max = 100;
+  p.series.push_back({"hypercube", {{1, 100}, {64, 78}}});
+  p.thresholds.push_back({78, "paper: 78% at 64"});
+  const test::XmlCheck doc = test::check_xml(plot_svg(p));
+  const detail::PlotGeometry g(p, {0, 0, 520, 340}, 6.6);
+  std::size_t labels = 0;
+  for (const auto& e : doc.elements) {
+    if (e.tag != "text" || e.text != "paper: 78% at 64") continue;
+    ++labels;
+    EXPECT_GE(std::stod(e.attrs.at("x")), g.legend().left);
+    EXPECT_GE(std::stod(e.attrs.at("y")), g.legend().top);
+    EXPECT_LE(std::stod(e.attrs.at("y")), g.legend().bottom());
+  }
+  EXPECT_EQ(labels, 1u);
+}
+
 TEST(LinePlot, FixedRangeBoundsTheAxis) {
   LinePlot p;
   p.y_min = 0.25;
@@ -133,6 +155,48 @@ TEST(LinePlot, SmallMultiplesHoldEveryPanel) {
   ASSERT_TRUE(doc.ok) << doc.error;
   EXPECT_EQ(test::count_class(doc, "plot"), 3u);
   EXPECT_EQ(std::stod(doc.elements.front().attrs.at("width")), 3 * PlotSize{}.width);
+}
+
+std::size_t utf8_chars(const std::string& s) {
+  return static_cast<std::size_t>(
+      std::count_if(s.begin(), s.end(), [](char c) { return (static_cast<unsigned char>(c) & 0xC0) != 0x80; }));
+}
+
+// Small multiples side by side, as a sweep draws them, with titles that start
+// with a long scene name: each title, at a generous estimate of bold
+// sans-serif (0.62 em a character), stays inside its own panel, and the
+// panel's tooltip keeps the whole title.
+TEST(LinePlot, LongTitlesStayInsideTheirPanels) {
+  const std::string scene = "a_rather_long_scene_file_name_for_the_class_demo.nff";
+  std::vector<LinePlot> panels(3, speedup_plot());
+  panels[0].title = scene + ": predicted synthesis time";
+  panels[1].title = scene + scene + ": speedup";
+  panels[2].title = "short";
+  const PlotSize size{};
+  const test::XmlCheck doc = test::check_xml(plots_svg(panels, 3, size));
+  ASSERT_TRUE(doc.ok) << doc.error;
+  std::vector<std::string> tooltips, shown;
+  std::size_t panel = 0;
+  for (const auto& e : doc.elements) {
+    if (e.tag == "title") tooltips.push_back(e.text);
+    if (!e.attrs.count("class") || e.attrs.at("class") != "plot-title") continue;
+    ASSERT_EQ(e.attrs.at("text-anchor"), "middle");
+    const double half = 0.5 * 0.62 * std::stod(e.attrs.at("font-size")) * static_cast<double>(utf8_chars(e.text));
+    const double x = std::stod(e.attrs.at("x"));
+    EXPECT_GE(x - half, panel * size.width) << e.text;
+    EXPECT_LE(x + half, (panel + 1) * size.width) << e.text;
+    EXPECT_GE(std::stod(e.attrs.at("font-size")), 11.0);
+    shown.push_back(e.text);
+    ++panel;
+  }
+  ASSERT_EQ(panel, 3u);
+  // Too long to fit even when shrunk: the start of the scene and what the panel shows remain.
+  EXPECT_EQ(shown[1].rfind("a_rather", 0), 0u) << shown[1];
+  EXPECT_NE(shown[1].find("\u2026"), std::string::npos) << shown[1];
+  EXPECT_EQ(shown[1].substr(shown[1].size() - 9), ": speedup");
+  EXPECT_EQ(shown[2], "short");
+  for (const LinePlot& p : panels)
+    EXPECT_NE(std::find(tooltips.begin(), tooltips.end(), p.title), tooltips.end()) << p.title;
 }
 
 TEST(Ticks, LinearTicksAreNiceAndCoverTheRange) {

@@ -97,6 +97,47 @@ TEST_F(ReportTest, LinksOnlyFilesItWrote) {
   EXPECT_EQ(png.rgb[(1 * 4 + 1) * 3], 255);
 }
 
+// A key lists its entries beside the image, in order, each on its colour.
+TEST_F(ReportTest, KeyedImageShowsEachEntryOnItsColour) {
+  Report r;
+  const std::vector<KeyEntry> key{{"0", {255, 255, 0}}, {"1", {0, 0, 128}}, {"<2>", {10, 200, 30}}};
+  r.sections.push_back({"owners", {ImageFigure{"owners", tracer::Image(4, 3), key}}});
+  const fs::path html = dir_ / "r.html";
+  write(html, r);
+  const test::XmlCheck doc = test::check_xml(read(html));
+  ASSERT_TRUE(doc.ok) << doc.error;
+  ASSERT_EQ(test::count_class(doc, "key"), 1u);
+  std::vector<test::XmlElement> items;
+  for (const auto& e : doc.elements)
+    if (e.tag == "li") items.push_back(e);
+  ASSERT_EQ(items.size(), 3u);
+  EXPECT_EQ(items[0].text, "0");
+  EXPECT_EQ(items[2].text, "&lt;2&gt;");
+  EXPECT_NE(items[0].attrs.at("style").find("background:#ffff00"), std::string::npos);
+  EXPECT_NE(items[0].attrs.at("style").find("color:#000000"), std::string::npos);  // dark on light
+  EXPECT_NE(items[1].attrs.at("style").find("background:#000080"), std::string::npos);
+  EXPECT_NE(items[1].attrs.at("style").find("color:#ffffff"), std::string::npos);  // light on dark
+}
+
+// Small images are shown enlarged by a whole factor, to at least 256 px;
+// the PNG keeps the image's size.
+TEST_F(ReportTest, SmallImagesAreShownEnlarged) {
+  const fs::path html = dir_ / "r.html";
+  const std::vector<fs::path> written = write(html, sample_report());
+  const test::XmlCheck doc = test::check_xml(read(html));
+  ASSERT_TRUE(doc.ok) << doc.error;
+  std::size_t images = 0;
+  for (const auto& e : doc.elements) {
+    if (e.tag != "img") continue;
+    ++images;
+    EXPECT_EQ(e.attrs.at("width"), "256");  // 4 x 3 pixels, 64 times
+    EXPECT_EQ(e.attrs.at("height"), "192");
+  }
+  EXPECT_EQ(images, 2u);
+  EXPECT_EQ(tracer::read_png(written[0].string()).width, 4);
+  EXPECT_NE(read(html).find("image-rendering: pixelated"), std::string::npos);
+}
+
 TEST_F(ReportTest, NeedsNoNetwork) {
   const fs::path html = dir_ / "r.html";
   write(html, sample_report());

@@ -59,7 +59,7 @@ class Checker {
     if (s_.compare(i_, 8, "!DOCTYPE") == 0) return skip_to(">");
     if (s_.compare(i_, 3, "!--") == 0) return skip_to("-->");
     if (i_ < s_.size() && s_[i_] == '/') return end_tag();
-    XmlElement e{name(), {}};
+    XmlElement e{name(), {}, {}};
     if (e.tag.empty()) return fail("empty tag name");
     for (;;) {
       skip_space();
@@ -68,6 +68,7 @@ class Checker {
       if (s_[i_] == '>') {
         ++i_;
         if (std::find(void_.begin(), void_.end(), e.tag) == void_.end()) stack_.push_back(e.tag);
+        e.text = s_.substr(i_, std::min(s_.find('<', i_), s_.size()) - i_);
         break;
       }
       if (!attribute(e)) return;

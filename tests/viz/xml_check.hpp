@@ -1,7 +1,8 @@
 // Test helper: a minimal XML well-formedness checker for the SVG and HTML the
 // viz library writes. It tracks element nesting, requires quoted attribute
 // values and known entities, and collects every attribute so tests can look
-// for NaN/inf in coordinates or at referenced files.
+// for NaN/inf in coordinates or at referenced files, and the text that opens
+// each element (e.g. what a <text> says).
 #pragma once
 
 #include <map>
@@ -13,6 +14,7 @@ namespace viz::test {
 struct XmlElement {
   std::string tag;
   std::map<std::string, std::string> attrs;
+  std::string text;  // character data up to the first child or end tag, entities as written
 };
 
 struct XmlCheck {
