@@ -189,6 +189,7 @@ int sweep_main(int argc, const char* const argv[]) {
     const auto files = write_sweep(table, options.out_dir, outputs);
     if (!options.quiet) {
       std::cout << sweep_csv(table);
+      std::cout << "machine model " << table.model.describe() << "\n";  // with a fitted unit, the fit
       std::cout << "wrote " << files.size() << " files in " << options.out_dir.string() << "\n";
     }
     if (!std::cout.flush()) throw std::runtime_error("standard output: cannot write the table");
