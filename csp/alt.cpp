@@ -12,6 +12,7 @@
 namespace csp {
 
 using detail::Clock;
+using detail::deadline_after;
 using detail::WaitState;
 
 Alt::Alt(Waiting waiting) {
@@ -29,6 +30,8 @@ Alt::~Alt() {
 void Alt::watch(const Guard& g, detail::BellMark mark) {
   detail::ChannelLock lk(g.channel->lock_);
   detail::BellMark& slot = g.kind == Kind::room ? g.channel->room_bell_ : g.channel->data_bell_;
+  if (mark.bell && slot.bell == mark.bell)
+    throw std::logic_error("Alt: '" + g.channel->name() + "' is guarded twice by one doorbell ALT, which takes a channel once");
   if (mark.bell && slot.bell)
     throw std::logic_error("Alt: '" + g.channel->name() + "' is already watched by another doorbell ALT");
   slot = mark;
@@ -60,7 +63,7 @@ std::size_t Alt::pri_select() { return select_from(0); }
 std::size_t Alt::select_from(std::size_t first) {
   if (dirty_) prepare();
   if (channels_.empty() && timeout_guard_ == none && !has_skip_) {
-    throw std::logic_error("Alt::select: every guard is disabled (occam STOP)");
+    throw std::logic_error("Alt::select: no guard is enabled, so it would wait forever (occam STOP)");
   }
   if (bell_) return select_by_bell(first);
   const std::size_t by_hint = poll_hints(first);
@@ -73,7 +76,7 @@ std::size_t Alt::select_from(std::size_t first) {
     return ready;
   }
   const Clock::time_point deadline =
-      timeout_guard_ == none ? Clock::time_point::max() : start + guards_[timeout_guard_].after;
+      timeout_guard_ == none ? Clock::time_point::max() : deadline_after(start, guards_[timeout_guard_].after);
   return wait_locked(timeout_guard_, deadline);
 }
 
@@ -151,7 +154,7 @@ std::size_t Alt::poll_locked(std::size_t first) const {
 // ring (at once if one came during the poll) and start again.
 std::size_t Alt::select_by_bell(std::size_t first) {
   const Clock::time_point deadline =
-      timeout_guard_ == none ? Clock::time_point::max() : Clock::now() + guards_[timeout_guard_].after;
+      timeout_guard_ == none ? Clock::time_point::max() : deadline_after(Clock::now(), guards_[timeout_guard_].after);
   for (;;) {
     bell_->clear();
     const std::size_t ready = poll_each(first);

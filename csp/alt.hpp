@@ -17,6 +17,10 @@
 // single reader, the read does not block. Likewise a room guard is for the
 // channel's only writer, whose next write then does not block.
 // A poisoned channel counts as ready; the read or write throws Poisoned.
+// A select with no enabled guard (occam STOP) is a program error: it throws
+// std::logic_error rather than wait forever. A timeout is wall time, also
+// under the virtual-time scheduler (virtual_time.hpp), and one of
+// duration::max() never fires.
 //
 // Waiting::doorbell trades that linking for a bell: each channel guard
 // registers this ALT's bell, and its own mark bit in it, with its channel
@@ -28,7 +32,8 @@
 // how many guards there are, and the channels' other ends one bell ring per
 // write or freed slot. For a process that selects over many busy channels
 // and often finds none ready, such as a router. A channel has one reader and
-// one writer, so at most one doorbell ALT per end may watch it; the ALT
+// one writer, so at most one doorbell ALT per end may watch it, and it takes
+// each channel once (a second guard on it is a std::logic_error); the ALT
 // unregisters when destroyed.
 #pragma once
 

@@ -248,7 +248,7 @@ class In {
   T read() { return state_->read(); }
   std::optional<T> try_read() { return state_->try_read(); }
   std::optional<T> read_for(std::chrono::steady_clock::duration d) {
-    return state_->read_until(std::chrono::steady_clock::now() + d);
+    return state_->read_until(detail::deadline_after(std::chrono::steady_clock::now(), d));
   }
   bool poisoned() const { return state_->poisoned(); }
   void poison() { state_->poison(); }

@@ -3,8 +3,9 @@
 // machine with given costs, whatever the host's speed.
 //
 // Model. There is one global virtual clock, "now". A process spends virtual
-// time only by this_process::advance(d) (csp::sleep_for(d) does the same under
-// this scheduler); every channel operation takes zero virtual time, and a
+// time only by this_process::advance(d) (this_process::delay(d) does the same
+// under this scheduler; csp::sleep_for always sleeps in wall time); every
+// channel operation takes zero virtual time, and a
 // process that blocks resumes at the virtual time of the process that woke it.
 //
 // VirtualTimeScheduler keeps every ready fiber under a key and always resumes
@@ -28,8 +29,9 @@
 // (RuntimeOptions{.threads = 1}). The ready order is then a function of the
 // program alone — no OS scheduling, no cross-thread wake — so the same program
 // gives the same virtual times and statistics on every run. Wall time is not
-// the point of this mode. Real timers (read_until deadlines) still use the
-// wall clock and would break determinism: virtual-time programs must not use them.
+// the point of this mode. Real timers (read_for and read_until deadlines, ALT
+// timeout guards, csp::sleep_for) still use the wall clock and would break
+// determinism: virtual-time programs must not use them.
 #pragma once
 
 #include <atomic>

@@ -54,6 +54,13 @@ class Spinlock {
 using SpinlockLock = std::unique_lock<Spinlock>;
 using Clock = std::chrono::steady_clock;
 
+// `after` from `from`, saturating at the end of time: a timeout of
+// duration::max() ("forever") must not wrap into the past and fire at once.
+inline Clock::time_point deadline_after(Clock::time_point from, Clock::duration after) {
+  if (after > Clock::time_point::max() - from) return Clock::time_point::max();
+  return from + after;
+}
+
 struct Process;
 class ChannelBase;
 class Bell;

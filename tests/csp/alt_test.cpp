@@ -244,6 +244,28 @@ TEST_P(Alt, InputBeatsLaterTimeout) {
   EXPECT_EQ(got, 5);
 }
 
+// "Forever" as a timeout must not wrap around into the past and fire at once.
+TEST_P(Alt, ATimeoutOfTheLongestDurationNeverFires) {
+  const csp::Alt::Waiting waiting = GetParam();
+  csp::Channel<int> c("c");
+  int got = 0;
+  csp::Runtime rt(1);
+  rt.spawn("writer", 0, [out = c.writer()]() mutable {
+    csp::sleep_for(2ms);
+    out.write(5);
+  });
+  rt.spawn("alt", 0, [&] {
+    csp::Alt alt(waiting);
+    auto in = c.reader();
+    alt.add_input(in);
+    alt.add_timeout(std::chrono::steady_clock::duration::max());
+    ASSERT_EQ(alt.select(), 0u);
+    got = in.read();
+  });
+  rt.run();
+  EXPECT_EQ(got, 5);
+}
+
 TEST_P(Alt, SkipIsAlwaysReady) {
   const csp::Alt::Waiting waiting = GetParam();
   csp::Channel<int> c("c");
@@ -422,6 +444,20 @@ TEST(AltDoorbell, OneDoorbellAltPerChannelEnd) {
   csp::Alt writer(csp::Alt::Waiting::doorbell);
   EXPECT_NO_THROW(writer.add_room(c.writer()));
   EXPECT_THROW(other.add_room(c.writer()), std::logic_error);
+}
+
+// A doorbell ALT registers one mark per channel end, so it takes a channel
+// once; the error says so rather than blame another ALT.
+TEST(AltDoorbell, AChannelGuardedTwiceIsAnErrorThatSaysSo) {
+  csp::Channel<int> c("c");
+  csp::Alt alt(csp::Alt::Waiting::doorbell);
+  alt.add_input(c.reader());
+  try {
+    alt.add_input(c.reader());
+    ADD_FAILURE() << "a second guard on 'c' was accepted";
+  } catch (const std::logic_error& e) {
+    EXPECT_NE(std::string(e.what()).find("guarded twice by one doorbell ALT"), std::string::npos) << e.what();
+  }
 }
 
 TEST(AltDoorbell, DestroyedAltReleasesItsChannels) {

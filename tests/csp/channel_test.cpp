@@ -2,6 +2,7 @@
 #include <gtest/gtest.h>
 
 #include <memory>
+#include <optional>
 #include <vector>
 
 #include "csp/csp.hpp"
@@ -125,6 +126,20 @@ TEST(Channel, ReadForReturnsValueWrittenInTime) {
   });
   rt.run();
   EXPECT_EQ(got, 9);
+}
+
+// "Forever" as a timeout must not wrap around into the past and time out at once.
+TEST(Channel, ReadForTheLongestDurationWaitsForTheValue) {
+  csp::Channel<int> c("c");
+  std::optional<int> got;
+  csp::Runtime rt(1);
+  rt.spawn("writer", 0, [out = c.writer()]() mutable {
+    csp::sleep_for(2ms);
+    out.write(7);
+  });
+  rt.spawn("reader", 0, [&, in = c.reader()]() mutable { got = in.read_for(std::chrono::steady_clock::duration::max()); });
+  rt.run();
+  EXPECT_EQ(got, 7);
 }
 
 TEST(Channel, MovesMoveOnlyValues) {
