@@ -4,12 +4,11 @@
 
 #include <algorithm>
 #include <boost/program_options.hpp>
-#include <cctype>
-#include <filesystem>
 #include <sstream>
 
 #include "topology/spec.hpp"
 #include "tracer/generators.hpp"
+#include "tracer/image.hpp"
 
 namespace app {
 namespace po = boost::program_options;
@@ -189,9 +188,7 @@ void check_output_names(const Options& o, const po::variables_map& vm) {
     const std::string option = std::string("--") + n.option;
     if (n.path.empty()) throw UsageError(option + ": needs a file name");
     if (n.extensions.empty()) continue;
-    std::string extension = std::filesystem::path(n.path).extension().string();
-    std::transform(extension.begin(), extension.end(), extension.begin(),
-                   [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+    const std::string extension = tracer::lower_extension(n.path);
     if (std::find(n.extensions.begin(), n.extensions.end(), extension) == n.extensions.end()) {
       std::string kinds;
       for (const std::string& e : n.extensions) kinds += (kinds.empty() ? "" : " or ") + e;

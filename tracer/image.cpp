@@ -29,14 +29,6 @@ struct FileCloser {
 };
 using FilePtr = std::unique_ptr<std::FILE, FileCloser>;
 
-std::string lower_extension(const std::string& path) {
-  auto slash = path.find_last_of('/');
-  auto dot = path.find_last_of('.');
-  if (dot == std::string::npos || (slash != std::string::npos && dot < slash)) return "";
-  std::string ext = path.substr(dot);
-  std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return std::tolower(c); });
-  return ext;
-}
 
 // Reads the next PPM header field (a token), skipping blanks and # comments.
 bool ppm_header_int(std::FILE* f, int& value) {
@@ -96,6 +88,15 @@ void Image::write_ppm(const std::string& path) const {
     return std::fwrite(header.data(), 1, header.size(), file) == header.size() &&
            std::fwrite(bytes.rgb.data(), 1, bytes.rgb.size(), file) == bytes.rgb.size();
   });
+}
+
+std::string lower_extension(const std::string& path) {
+  auto slash = path.find_last_of('/');
+  auto dot = path.find_last_of('.');
+  if (dot == std::string::npos || (slash != std::string::npos && dot < slash)) return "";
+  std::string ext = path.substr(dot);
+  std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return std::tolower(c); });
+  return ext;
 }
 
 void Image::write_image(const std::string& path) const {

@@ -56,4 +56,7 @@ std::uint8_t to_byte(float linear);
 Rgb8Image read_png(const std::string& path);
 Rgb8Image read_ppm(const std::string& path);
 
+// The extension of the file name in `path`, lower case, with its dot ("" if none).
+std::string lower_extension(const std::string& path);
+
 }  // namespace tracer
