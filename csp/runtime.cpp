@@ -148,7 +148,10 @@ struct Runtime::Impl {
 
 void Runtime::Impl::worker_main(unsigned index, std::barrier<>& finished) {
   const auto started = std::chrono::steady_clock::now();
-  Scheduler* algo = options.scheduler ? options.scheduler(index) : new FifoScheduler(&idle[index]);
+  Scheduler* algo =
+      options.scheduler
+          ? options.scheduler(index)
+          : new FifoScheduler(&idle[index], idle_spin(options.threads, std::thread::hardware_concurrency()));
   boost::fibers::scheduler* scheduler = boost::fibers::context::active()->get_scheduler();
   scheduler->set_algo(boost::fibers::algo::algorithm::ptr_t(algo));
   detail::set_thread_scheduler(scheduler);

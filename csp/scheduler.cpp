@@ -10,6 +10,11 @@
 
 namespace csp {
 
+std::chrono::microseconds idle_spin(unsigned threads, unsigned hardware_threads) {
+  if (hardware_threads != 0 && threads > hardware_threads) return std::chrono::microseconds{0};
+  return std::chrono::microseconds{50};
+}
+
 // A process's fiber is bound to its record when it first runs, so its first
 // wake-up, at spawn, takes the high-priority queue.
 void FifoScheduler::awakened(boost::fibers::context* ctx, ProcessProps& props) noexcept {
@@ -47,11 +52,12 @@ bool FifoScheduler::take_notification() noexcept {
   return notified_.load(std::memory_order_relaxed) && notified_.exchange(false, std::memory_order_acq_rel);
 }
 
-// Spins until notified (true), the spin limit or `when`, whichever first.
+// Spins until notified (true), the spin limit or `when`, whichever first;
+// with no spin limit, looks once.
 // Reads before it claims, so the spinning thread does not keep taking the
 // flag's cache line from the notifier.
 bool FifoScheduler::spin_until_notified(std::chrono::steady_clock::time_point when) noexcept {
-  const auto end = std::min(when, std::chrono::steady_clock::now() + spin_limit);
+  const auto end = std::min(when, std::chrono::steady_clock::now() + spin_limit_);
   do {
     for (int i = 0; i < 64; ++i) {
       if (take_notification()) return true;

@@ -15,12 +15,14 @@
 // for a few microseconds watching for notify() (a wake from another thread:
 // waking a sleeping thread costs a system call on both sides, several times
 // a message's own cost), then sleeps on a condition variable until notify()
-// or the next timer deadline. Boost's dispatcher fiber (which moves
-// timed-out and remotely woken fibers to the ready queue, and reads the
-// clock to do so) is kept aside and run at the next switch after notify(),
-// when nothing else is ready, or after every `dispatch_period` picks: a
-// process woken from another thread waits for one switch, not for a round
-// of the queue, and most switches read no clock.
+// or the next timer deadline. It does not spin when the runtime has more
+// threads than the machine has hardware threads: there the spinning thread
+// would take the core from one that has work (see idle_spin()). Boost's
+// dispatcher fiber (which moves timed-out and remotely woken fibers to the
+// ready queue, and reads the clock to do so) is kept aside and run at the
+// next switch after notify(), when nothing else is ready, or after every
+// `dispatch_period` picks: a process woken from another thread waits for one
+// switch, not for a round of the queue, and most switches read no clock.
 #pragma once
 
 #include <atomic>
@@ -62,11 +64,18 @@ using Scheduler = boost::fibers::algo::algorithm_with_properties<ProcessProps>;
 // Called once on each runtime thread, with that thread's index.
 using SchedulerFactory = std::function<Scheduler*(unsigned thread)>;
 
+// How long an idle thread of a runtime of `threads` threads watches for a
+// wake before it sleeps, on a machine of `hardware_threads` (0: unknown,
+// taken as enough): 50 us, or none when the threads outnumber the hardware.
+std::chrono::microseconds idle_spin(unsigned threads, unsigned hardware_threads);
+
 class FifoScheduler final : public Scheduler {
  public:
   // `idle`, if given, gathers the time the thread waits with nothing to
-  // run; only this thread writes it.
-  explicit FifoScheduler(std::chrono::steady_clock::duration* idle = nullptr) : idle_(idle) {}
+  // run; only this thread writes it. `spin`: see idle_spin().
+  explicit FifoScheduler(std::chrono::steady_clock::duration* idle = nullptr,
+                         std::chrono::microseconds spin = idle_spin(1, 1))
+      : spin_limit_(spin), idle_(idle) {}
 
   void awakened(boost::fibers::context* ctx, ProcessProps& props) noexcept override;
   boost::fibers::context* pick_next() noexcept override;
@@ -76,7 +85,6 @@ class FifoScheduler final : public Scheduler {
 
  private:
   static constexpr unsigned dispatch_period = 32;
-  static constexpr std::chrono::microseconds spin_limit{50};
 
   bool take_notification() noexcept;
   bool spin_until_notified(std::chrono::steady_clock::time_point when) noexcept;
@@ -90,6 +98,7 @@ class FifoScheduler final : public Scheduler {
   std::mutex mutex_;  // orders notify() against the check before sleeping
   std::condition_variable wakeup_;
   std::atomic<bool> notified_{false};  // a wake from another thread not yet dispatched
+  const std::chrono::microseconds spin_limit_;
   std::chrono::steady_clock::duration* idle_;
 };
 

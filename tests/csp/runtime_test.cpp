@@ -6,6 +6,7 @@
 #include <cstdint>
 #include <stdexcept>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include "csp/csp.hpp"
@@ -224,6 +225,48 @@ TEST(Runtime, CrossThreadStressDeliversEverything) {
   const std::uint64_t n = std::uint64_t{producers} * per_producer;
   EXPECT_EQ(count, n);
   EXPECT_EQ(sum, n * (n - 1) / 2);
+}
+
+// An idle thread watches for a wake only while every thread has a hardware
+// thread of its own; with more threads than that, a spinning thread would
+// hold the core a thread with work is waiting for.
+TEST(Runtime, IdleThreadsSpinOnlyWhenEveryThreadHasAHardwareThread) {
+  EXPECT_GT(csp::idle_spin(1, 2).count(), 0);
+  EXPECT_GT(csp::idle_spin(2, 2).count(), 0);
+  EXPECT_GT(csp::idle_spin(8, 0).count(), 0);  // the machine's size unknown
+  EXPECT_EQ(csp::idle_spin(3, 2).count(), 0);
+  EXPECT_EQ(csp::idle_spin(16, 4).count(), 0);
+}
+
+// More runtime threads than hardware threads: idle threads go straight to
+// sleep, and every wake across threads must still reach them.
+TEST(Runtime, MoreThreadsThanTheMachineDeliverEverything) {
+  const unsigned threads = std::max(1u, std::thread::hardware_concurrency()) + 2;
+  constexpr int stages = 12;
+  constexpr int messages = 2000;
+  std::vector<csp::Channel<int>> links;
+  for (int i = 0; i <= stages; ++i) links.emplace_back("link" + std::to_string(i));
+  csp::Runtime rt(threads);
+  rt.spawn("source", 0, [out = links[0].writer()]() mutable {
+    for (int k = 0; k < messages; ++k) out.write(k);
+  });
+  for (int i = 0; i < stages; ++i)
+    rt.spawn("stage" + std::to_string(i), static_cast<unsigned>(i + 1),
+             [in = links[i].reader(), out = links[i + 1].writer()]() mutable {
+               for (int k = 0; k < messages; ++k) out.write(in.read() + 1);
+             });
+  std::int64_t sum = 0;
+  int count = 0;
+  rt.spawn("sink", static_cast<unsigned>(stages + 1), [in = links[stages].reader(), &sum, &count]() mutable {
+    for (int k = 0; k < messages; ++k) {
+      sum += in.read();
+      ++count;
+    }
+  });
+  rt.run();
+  EXPECT_EQ(rt.threads(), threads);
+  EXPECT_EQ(count, messages);
+  EXPECT_EQ(sum, std::int64_t{messages} * (messages - 1) / 2 + std::int64_t{messages} * stages);
 }
 
 TEST(Deadlock, DetectedInARingNamingEveryProcess) {
