@@ -147,8 +147,7 @@ void check_machine(Options& o, const Raw& raw, const po::variables_map& vm) {
   else throw UsageError("--distribution: expected modulo or block, got '" + raw.distribution + "'");
   m.timing = timing_from(raw.timing);
   // Options that would change nothing here are errors, as with --single.
-  if (m.schedule == nodes::Schedule::static_split && !vm["grain"].defaulted())
-    throw UsageError("--grain: the static schedule hands out fixed shares, not tiles of a grain");
+  check_grain(m.schedule, !vm["grain"].defaulted());
   if (m.timing && o.compare_serial)
     throw UsageError("--compare-serial: a virtual-time run always reports speedup against the 1-node machine");
   // The tile CSV, the timeline and the report (which shows the timeline) need the tiles.
@@ -230,6 +229,11 @@ nodes::PixelOrder parse_pixel_order(const std::string& name) {
   for (auto order : {nodes::PixelOrder::scanline, nodes::PixelOrder::hilbert})
     if (name == nodes::pixel_order_name(order)) return order;
   throw UsageError("--pixel-order: expected scanline or hilbert, got '" + name + "'");
+}
+
+void check_grain(nodes::Schedule schedule, bool grain_given) {
+  if (schedule == nodes::Schedule::static_split && grain_given)
+    throw UsageError("--grain: the static schedule hands out fixed shares, not tiles of a grain");
 }
 
 const char* accel_name(tracer::Accel accel) { return accel == tracer::Accel::bvh ? "bvh" : "grid"; }

@@ -78,6 +78,9 @@ tracer::BuildOptions build_options(const Options& o);
 nodes::Schedule parse_schedule(const std::string& name);
 // --pixel-order: "scanline" or "hilbert"; UsageError otherwise.
 nodes::PixelOrder parse_pixel_order(const std::string& name);
+// --grain given (grain_given) with the static schedule: UsageError, since
+// that schedule hands out fixed shares and the grain would change nothing.
+void check_grain(nodes::Schedule schedule, bool grain_given);
 
 // The --help text (options and built-in scenes).
 std::string usage_text();

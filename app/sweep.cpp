@@ -125,8 +125,7 @@ void check_sweep(SweepOptions& o, const RawSweep& raw, const po::variables_map& 
   o.accel = parse_accel(raw.accel);
   o.bvh_layout = parse_bvh_layout(raw.bvh_layout);
   o.schedule = parse_schedule(raw.schedule);
-  if (o.schedule == nodes::Schedule::static_split && vm.count("grain"))
-    throw UsageError("--grain: the static schedule hands out fixed shares, not tiles of a grain");
+  check_grain(o.schedule, vm.count("grain") > 0);
   o.pixel_order = parse_pixel_order(raw.pixel_order);
   o.trace.shadow_rays_to_all_lights = parse_shadow_rays(raw.shadow_rays);
 }
