@@ -53,9 +53,8 @@ int run(const app::Options& o) {
       std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   app::RenderResult result = o.single ? app::render_single(o, scene) : app::render_machine(o, scene);
   result.report.load_seconds = load_seconds;
-  // Ends after the outputs are removed, if they are, letting a held signal through.
   app::OutputPhase phase;
-  app::OutputFiles outputs;  // removed again if a later step fails
+  app::OutputFiles& outputs = phase.files();  // removed again if a later step fails
   outputs.write(o.output, [&](const auto& path) { result.image.write_image(path.string()); });
   if (!o.stats_path.empty()) outputs.write_text(o.stats_path, app::stats_json(result.report));
   if (!o.quiet) app::print_report(std::cout, result.report);
@@ -67,10 +66,7 @@ int run(const app::Options& o) {
     for (const auto& path :
          app::write_machine_pictures(picture_files(o), result.report.scene, result.image, result.report.machine->report))
       outputs.add(path);
-  if (!std::cout.flush()) throw std::runtime_error("standard output: cannot write the report");
-  if (phase.interrupted()) return 1;
-  outputs.keep();
-  return 0;
+  return phase.finish(std::cout, "report");
 }
 
 }  // namespace

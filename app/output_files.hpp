@@ -6,11 +6,13 @@
 // Removal goes in reverse order, so a directory added before the files made
 // in it goes last, once it is empty (a directory that is not empty stays).
 //
-// OutputPhase holds back, while a command writes its outputs, the signals
-// that would end it half-way (SIGINT, SIGTERM, SIGHUP, and SIGPIPE from a
-// closed standard output): the command looks at interrupted() once every
-// file is in place, and gives up its files if one came. Ending the phase
-// lets a held signal through, so the command still ends as it asked.
+// OutputPhase is a command writing its outputs: it holds back the signals
+// that would end the command half-way (SIGINT, SIGTERM, SIGHUP, and SIGPIPE
+// from a closed standard output) and owns the OutputFiles written meanwhile.
+// Once every file is in place, finish() checks the standard output and
+// keeps the files unless a signal came. Ending the phase removes the files
+// not kept, then lets a held signal through, so the command still ends as
+// it asked, leaving nothing behind.
 // Only for a single-threaded process: other threads would take the signals.
 #pragma once
 
@@ -20,6 +22,8 @@
 
 #include <filesystem>
 #include <functional>
+#include <ostream>
+#include <stdexcept>
 #include <string>
 #include <system_error>
 #include <utility>
@@ -68,27 +72,55 @@ class OutputFiles {
 
 class OutputPhase {
  public:
-  OutputPhase() {
-    sigemptyset(&held_);
-    for (int signal : {SIGINT, SIGTERM, SIGHUP, SIGPIPE}) sigaddset(&held_, signal);
-    pthread_sigmask(SIG_BLOCK, &held_, &before_);
-  }
+  OutputPhase() = default;
   OutputPhase(const OutputPhase&) = delete;
   OutputPhase& operator=(const OutputPhase&) = delete;
-  ~OutputPhase() { pthread_sigmask(SIG_SETMASK, &before_, nullptr); }
+
+  // Where the command records what it writes.
+  OutputFiles& files() { return files_; }
 
   // Whether a signal asked the command to stop while it wrote.
   bool interrupted() const {
     sigset_t pending;
     sigpending(&pending);
-    for (int signal : {SIGINT, SIGTERM, SIGHUP, SIGPIPE})
+    for (int signal : held_signals)
       if (sigismember(&pending, signal)) return true;
     return false;
   }
 
+  // Ends the writing once every output is in place: std::runtime_error
+  // "standard output: cannot write the WHAT" if `out` cannot be flushed;
+  // else the command's exit status, 1 if a signal came (its files go as the
+  // phase ends), or 0 with every file kept.
+  int finish(std::ostream& out, const std::string& what) {
+    if (!out.flush()) throw std::runtime_error("standard output: cannot write the " + what);
+    if (interrupted()) return 1;
+    files_.keep();
+    return 0;
+  }
+
  private:
-  sigset_t held_;
-  sigset_t before_;
+  static constexpr int held_signals[] = {SIGINT, SIGTERM, SIGHUP, SIGPIPE};
+
+  // Blocks the signals while it lives; restores the mask of before as it ends.
+  class HeldSignals {
+   public:
+    HeldSignals() {
+      sigset_t held;
+      sigemptyset(&held);
+      for (int signal : held_signals) sigaddset(&held, signal);
+      pthread_sigmask(SIG_BLOCK, &held, &before_);
+    }
+    HeldSignals(const HeldSignals&) = delete;
+    HeldSignals& operator=(const HeldSignals&) = delete;
+    ~HeldSignals() { pthread_sigmask(SIG_SETMASK, &before_, nullptr); }
+
+   private:
+    sigset_t before_;
+  };
+
+  HeldSignals held_;   // first, so it ends last: a signal goes through once files_ is done
+  OutputFiles files_;
 };
 
 }  // namespace app

@@ -183,19 +183,14 @@ int sweep_main(int argc, const char* const argv[]) {
   }
   try {
     const SweepTable table = run_sweep(options, options.quiet ? nullptr : &std::cerr);
-    // Ends after the outputs are removed, if they are, letting a held signal through.
-    const OutputPhase phase;
-    OutputFiles outputs;
-    const auto files = write_sweep(table, options.out_dir, outputs);
+    OutputPhase phase;
+    const auto files = write_sweep(table, options.out_dir, phase.files());
     if (!options.quiet) {
       std::cout << sweep_csv(table);
       std::cout << "machine model " << table.model.describe() << "\n";  // with a fitted unit, the fit
       std::cout << "wrote " << files.size() << " files in " << options.out_dir.string() << "\n";
     }
-    if (!std::cout.flush()) throw std::runtime_error("standard output: cannot write the table");
-    if (phase.interrupted()) return 1;
-    outputs.keep();
-    return 0;
+    return phase.finish(std::cout, "table");
   } catch (const std::exception& e) {
     std::cerr << "vmpray sweep: " << e.what() << "\n";
     return 1;

@@ -1,6 +1,6 @@
 // The vmpray executable end to end: exit codes, one-line errors, no partial
 // output on failure, image and JSON on success, scenes from FIFOs, and
-// signals held back while the outputs are written.
+// signals held back while the outputs are written, and how that phase ends.
 #include <fcntl.h>
 #include <gtest/gtest.h>
 #include <sys/stat.h>
@@ -146,6 +146,68 @@ TEST(OutputPhase, HoldsAnInterruptUntilItEnds) {
   }
   EXPECT_EQ(delivered, 1);
   std::signal(SIGINT, before);
+}
+
+class OutputPhaseFiles : public test::ScratchTest {
+ protected:
+  OutputPhaseFiles() : ScratchTest("vmpray_output_phase_") {}
+  // A file written and added to `phase`, as a command's output.
+  fs::path output(app::OutputPhase& phase, const std::string& name) {
+    return phase.files().write_text(dir_ / name, "output\n");
+  }
+};
+
+TEST_F(OutputPhaseFiles, FinishKeepsTheFiles) {
+  fs::path path;
+  {
+    app::OutputPhase phase;
+    path = output(phase, "kept.txt");
+    std::ostringstream out;
+    EXPECT_EQ(phase.finish(out, "report"), 0);
+  }
+  EXPECT_TRUE(fs::exists(path));
+}
+
+// The files go first, then the held signal: whatever the signal does next,
+// nothing of the command is left.
+TEST_F(OutputPhaseFiles, AfterASignalFinishRemovesTheFilesThenLetsItThrough) {
+  static const char* watched = nullptr;
+  static volatile std::sig_atomic_t delivered = 0, file_there_at_delivery = 0;
+  const auto before = std::signal(SIGINT, [](int) {
+    delivered = 1;
+    file_there_at_delivery = ::access(watched, F_OK) == 0;
+  });
+  fs::path path;
+  {
+    app::OutputPhase phase;
+    path = output(phase, "removed.txt");
+    watched = path.c_str();
+    std::raise(SIGINT);
+    std::ostringstream out;
+    EXPECT_EQ(phase.finish(out, "report"), 1);
+    EXPECT_TRUE(fs::exists(path));  // until the phase ends
+    EXPECT_EQ(delivered, 0);
+  }
+  EXPECT_EQ(delivered, 1);
+  EXPECT_EQ(file_there_at_delivery, 0);
+  EXPECT_FALSE(fs::exists(path));
+  std::signal(SIGINT, before);
+}
+
+TEST_F(OutputPhaseFiles, AnUnwritableStandardOutputFailsAndRemovesTheFiles) {
+  fs::path path;
+  {
+    app::OutputPhase phase;
+    path = output(phase, "removed.txt");
+    std::ostream out(nullptr);  // bad from the start, as a stream whose writes failed
+    try {
+      phase.finish(out, "table");
+      ADD_FAILURE() << "finish() accepted a standard output that cannot be written";
+    } catch (const std::runtime_error& e) {
+      EXPECT_STREQ(e.what(), "standard output: cannot write the table");
+    }
+  }
+  EXPECT_FALSE(fs::exists(path));
 }
 
 }  // namespace
