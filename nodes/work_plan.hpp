@@ -49,12 +49,13 @@ class WorkPlan {
   std::uint32_t handed_out() const { return handed_out_; }  // items given so far
   std::uint32_t steals() const { return steals_; }          // affinity: tiles taken from another's share
 
- private:
-  Tile static_share(int node, int worker) const;
   // Affinity tiles are 1/parts of what is left; at least this many parts,
   // so that a share on a small machine still comes back in pieces the
   // progress display and the balancing can use.
   static constexpr std::size_t min_affinity_parts = 16;
+
+ private:
+  Tile static_share(int node, int worker) const;
 
   std::uint32_t affinity_chunk(std::uint32_t left) const;
   Tile take_front(Tile& share, std::uint32_t most);

@@ -1,0 +1,119 @@
+// The up-front memory check: the estimate against peak resident sizes
+// measured on real renders, and the refusal with its one-line message,
+// under limits given here, so no test needs (or allocates) a large image.
+#include <gtest/gtest.h>
+#include <sys/resource.h>
+#include <unistd.h>
+
+#include <cmath>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "app/memory_check.hpp"
+
+namespace {
+
+app::Options options_of(const std::string& command_line) {
+  std::vector<std::string> words{"vmpray"};
+  std::istringstream in(command_line);
+  for (std::string word; in >> word;) words.push_back(word);
+  std::vector<const char*> argv;
+  for (const std::string& w : words) argv.push_back(w.c_str());
+  return app::parse_options(static_cast<int>(argv.size()), argv.data());
+}
+
+// Peak resident sizes of `vmpray teapot --width N --height N -q OPTIONS`
+// (/usr/bin/time -f %M, 2 threads), less that of the same command at 64x64:
+// what the image's buffers took. The estimate is to be within 5% of it, or
+// 10% where tile records weigh: the vectors that hold them grow by
+// doubling, to between once and twice their size, as the run falls.
+struct Measured {
+  int size;
+  const char* options;
+  std::uint64_t kb, kb_at_64;
+  double tolerance = 0.05;
+};
+
+const Measured measured[] = {
+    {1024, "", 54012, 9888},
+    {2048, "", 186204, 10040},
+    {4096, "", 701736, 10024},
+    {8192, "", 2778996, 10324},
+    {16384, "", 11099816, 10024},
+    {1024, "--single", 32020, 8408},
+    {2048, "--single", 105900, 8448},
+    {4096, "--single", 400852, 8392},
+    {8192, "--single", 1580528, 8316},
+    {16384, "--single", 6298980, 8316},
+    {4096, "--pixel-order scanline", 636904, 10564},
+    {4096, "--spd-procedure", 703728, 10168},
+    {4096, "--schedule static --nodes 1", 894652, 8524},
+    {4096, "--schedule static --nodes 2", 796488, 8932},
+    {4096, "--ownership o.png", 703068, 10484},
+    {4096, "--report r.html", 1668292, 10784},
+    {4096, "--compare-serial --schedule static", 894896, 10336},
+    {4096, "--timing virtual", 726364, 11916},
+    {4096, "--schedule dynamic --grain 1024 --nodes 1", 698104, 8388},
+    {2048, "--schedule dynamic --grain 1 --tiles t.csv", 696892, 11232, 0.10},
+    {2048, "--schedule dynamic --grain 4 --tiles t.csv", 283276, 10764, 0.10},
+    {2048, "--schedule dynamic --grain 1 --timeline t.svg --report r.html", 664248, 12168, 0.10},
+};
+
+TEST(MemoryEstimate, MatchesTheMeasuredPeaks) {
+  for (const Measured& m : measured) {
+    const double bytes = 1024.0 * static_cast<double>(m.kb - m.kb_at_64);
+    const double estimate = static_cast<double>(app::image_memory_bytes(options_of(m.options), m.size, m.size));
+    EXPECT_LT(std::abs(estimate - bytes), m.tolerance * bytes)
+        << m.size << "x" << m.size << " " << m.options << ": estimated " << estimate << ", measured " << bytes;
+  }
+}
+
+TEST(MemoryEstimate, CountsCornerSamplesAndTheNodes) {
+  const std::uint64_t pixels = 1000 * 1000, corners = 1001 * 1001;
+  // Scanline order keeps no pixel order; the corner samples each take their colour, bit and owner.
+  EXPECT_EQ(image_memory_bytes(options_of("--pixel-order scanline --spd-procedure"), 1000, 1000) -
+                image_memory_bytes(options_of("--pixel-order scanline"), 1000, 1000),
+            (corners - pixels) * 14 + corners / 8 - pixels / 8);
+  // Static shares: every processor's share at once, and one of them on its way as a result.
+  EXPECT_GT(image_memory_bytes(options_of("--schedule static --nodes 1"), 1000, 1000),
+            image_memory_bytes(options_of("--schedule static --nodes 4"), 1000, 1000));
+  EXPECT_EQ(image_memory_bytes(options_of("--single"), 1000, 1000), 24 * pixels);
+}
+
+TEST(MemoryCheck, RefusesAnImageAboveTheLimitNamingTheOptions) {
+  const app::Options o = options_of("");
+  try {
+    app::check_image_memory(o, 16384, 16384, {4'000'000'000});
+    ADD_FAILURE() << "a 16384x16384 image passed a 4 GB limit";
+  } catch (const app::UsageError& e) {
+    EXPECT_STREQ(e.what(), "--width/--height: a 16384x16384 image needs about 11.3 GB, more than this machine's 4.0 GB");
+  }
+  const std::uint64_t needed = app::image_memory_bytes(o, 4096, 3000);
+  EXPECT_NO_THROW(app::check_image_memory(o, 4096, 3000, {needed}));
+  EXPECT_THROW(app::check_image_memory(o, 4096, 3000, {needed - 1}), app::UsageError);
+  try {
+    app::check_image_memory(options_of("--single"), 4096, 4096, {300'000'000, true});
+    ADD_FAILURE() << "a 4096x4096 image passed a 300 MB limit";
+  } catch (const app::UsageError& e) {
+    EXPECT_STREQ(e.what(),
+                 "--width/--height: a 4096x4096 image needs about 403 MB, more than the 300 MB this process may map "
+                 "(ulimit -v)");
+  }
+}
+
+TEST(MemoryCheck, TheLimitIsThePhysicalMemoryOrTheAddressSpaceIfLess) {
+  const std::uint64_t physical = static_cast<std::uint64_t>(sysconf(_SC_PHYS_PAGES)) * sysconf(_SC_PAGE_SIZE);
+  rlimit space{};
+  ASSERT_EQ(getrlimit(RLIMIT_AS, &space), 0);
+  const app::MemoryLimit limit = app::memory_limit();
+  if (space.rlim_cur == RLIM_INFINITY || space.rlim_cur >= physical) {
+    EXPECT_EQ(limit.bytes, physical);
+    EXPECT_FALSE(limit.process_limit);
+  } else {
+    EXPECT_EQ(limit.bytes, space.rlim_cur);
+    EXPECT_TRUE(limit.process_limit);
+  }
+}
+
+}  // namespace
