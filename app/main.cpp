@@ -3,8 +3,9 @@
 // database) or, with --single, in this process; write the image and report
 // rays, page accesses and traffic, the network and per-node work (JSON with
 // --stats). `vmpray sweep ...` runs the paper's experiments (app/sweep.hpp).
-// Exit 0 on success, 2 for a bad command line, 1 for a runtime error; errors
-// are one line on stderr, and a failed run leaves no output file.
+// Exit 0 on success, 2 for a bad command line (or an image too large for
+// this machine's memory, found once the scene is read), 1 for a runtime
+// error; errors are one line on stderr, and a failed run leaves no output file.
 #include <chrono>
 #include <filesystem>
 #include <iostream>
@@ -14,6 +15,7 @@
 
 #include "app/machine_run.hpp"
 #include "app/machine_pictures.hpp"
+#include "app/memory_check.hpp"
 #include "app/options.hpp"
 #include "app/output_files.hpp"
 #include "app/report.hpp"
@@ -51,6 +53,8 @@ int run(const app::Options& o) {
   const tracer::Scene scene = app::load_scene(o);
   const double load_seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  // Before the minutes of work that an image too large for the memory would waste.
+  app::check_image_memory(o, scene.camera.width, scene.camera.height, app::memory_limit());
   app::RenderResult result = o.single ? app::render_single(o, scene) : app::render_machine(o, scene);
   result.report.load_seconds = load_seconds;
   app::OutputPhase phase;
@@ -91,6 +95,9 @@ int main(int argc, char** argv) {
   }
   try {
     return run(options);
+  } catch (const app::UsageError& e) {  // an image too large: no help to see
+    std::cerr << "vmpray: " << e.what() << "\n";
+    return 2;
   } catch (const std::exception& e) {
     std::cerr << "vmpray: " << e.what() << "\n";
     return 1;

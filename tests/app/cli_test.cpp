@@ -1,6 +1,7 @@
 // The vmpray executable end to end: exit codes, one-line errors, no partial
-// output on failure, image and JSON on success, scenes from FIFOs, and
-// signals held back while the outputs are written, and how that phase ends.
+// output on failure, an image too large for the memory refused up front,
+// image and JSON on success, scenes from FIFOs, and signals held back while
+// the outputs are written, and how that phase ends.
 #include <fcntl.h>
 #include <gtest/gtest.h>
 #include <sys/stat.h>
@@ -130,6 +131,31 @@ TEST_F(Cli, ReportNamesTheShadowRayPolicyInTextAndJson) {
   ASSERT_EQ(r.exit_code, 0) << r.err;
   EXPECT_NE(r.out.find("(shadow rays to every light)"), std::string::npos) << r.out;
   EXPECT_NE(test::read_file(dir_ / "s.json").find("\"shadow_rays\": \"all\""), std::string::npos);
+}
+
+// A process that may map 2 GB (ulimit -v) is told at once that the largest
+// image needs more, instead of failing to allocate it once the scene is
+// built; a small image still renders under the same limit.
+TEST_F(Cli, AnImageTooLargeForTheMemoryIsRefusedBeforeTheRender) {
+#if defined(__SANITIZE_ADDRESS__) || defined(__SANITIZE_THREAD__)
+  GTEST_SKIP() << "a sanitizer's shadow memory does not fit in 2 GB of address space";
+#endif
+  const auto limited = [&](const std::string& args) {
+    const std::string cmd = "cd '" + dir_.string() + "' && ulimit -v 2000000 && exec " + VMPRAY_BINARY + " " + args +
+                            " >stdout.txt 2>stderr.txt </dev/null";
+    const int status = std::system(cmd.c_str());
+    return Outcome{WEXITSTATUS(status), test::read_file(dir_ / "stdout.txt"), test::read_file(dir_ / "stderr.txt")};
+  };
+  const Outcome refused = limited("teapot --width 16384 --height 16384 -o out.png");
+  EXPECT_EQ(refused.exit_code, 2);
+  EXPECT_EQ(refused.err,
+            "vmpray: --width/--height: a 16384x16384 image needs about 11.3 GB, more than the 2.0 GB this process may "
+            "map (ulimit -v)\n");
+  EXPECT_EQ(refused.out, "");
+  EXPECT_FALSE(fs::exists(dir_ / "out.png"));
+  const Outcome rendered = limited("teapot --width 64 --height 64 -q -o out.png");
+  EXPECT_EQ(rendered.exit_code, 0) << rendered.err;
+  EXPECT_TRUE(fs::exists(dir_ / "out.png"));
 }
 
 // A signal that would end the command while it writes its outputs waits
