@@ -38,6 +38,9 @@ void Alt::watch(const Guard& g, detail::BellMark mark) {
 }
 
 std::size_t Alt::add(Guard g) {
+  if (on_channel(g.kind)) g.channel->require_bound(g.kind == Kind::room ? "Alt::add_room" : "Alt::add_input");
+  if (g.kind == Kind::room && g.channel->capacity() == 0)
+    throw std::logic_error("Alt::add_room: '" + g.channel->name() + "' is unbuffered");
   if (bell_ && on_channel(g.kind)) watch(g, bell_->mark(guards_.size()));
   guards_.push_back(std::move(g));
   dirty_ = true;

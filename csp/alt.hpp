@@ -17,6 +17,8 @@
 // single reader, the read does not block. Likewise a room guard is for the
 // channel's only writer, whose next write then does not block.
 // A poisoned channel counts as ready; the read or write throws Poisoned.
+// An unbound end (a default-constructed In or Out) is no guard: adding one is
+// a std::logic_error, as is a room guard on an unbuffered channel.
 // A select with no enabled guard (occam STOP) is a program error: it throws
 // std::logic_error rather than wait forever. A timeout is wall time, also
 // under the virtual-time scheduler (virtual_time.hpp), and one of
@@ -41,7 +43,6 @@
 #include <cstddef>
 #include <cstdint>
 #include <memory>
-#include <stdexcept>
 #include <vector>
 
 #include "csp/channel.hpp"
@@ -63,7 +64,6 @@ class Alt {
   // For a buffered channel written only by this ALT's owner.
   template <class T>
   std::size_t add_room(Out<T> out) {
-    if (out.state_->capacity() == 0) throw std::logic_error("Alt::add_room: '" + out.name() + "' is unbuffered");
     return add(Guard{Kind::room, std::move(out.state_), {}, true});
   }
   std::size_t add_timeout(std::chrono::steady_clock::duration after) {

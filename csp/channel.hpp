@@ -28,6 +28,12 @@
 //   slot that no parked writer refills (room_bell_), and by poison.
 // Who wakes whom: writers wake readers (and fire ALTs), readers wake writers
 // (and fire room guards), poison wakes all; see detail/wait.hpp for the claiming rules.
+//
+// Unbound ends: a default-constructed In or Out refers to the unbound channel
+// of its type, poisoned from the start, so that each of its operations stops
+// at the poison check it makes anyway and only there, off the fast path,
+// finds the channel unbound and throws std::logic_error instead of Poisoned.
+// Its other members check first; an ALT refuses it as a guard.
 #pragma once
 
 #include <algorithm>
@@ -56,6 +62,7 @@ class ChannelState final : public ChannelBase {
       : ChannelBase(std::move(name), capacity), ring_(std::min(capacity, kFirstRingSlots)) {
     publish_hints(false, capacity > 0);
   }
+  explicit ChannelState(Unbound u) : ChannelBase(u) {}
 
   bool ready_locked() const override {
     return poisoned() || count_ > 0 || !writers_.empty();
@@ -64,7 +71,7 @@ class ChannelState final : public ChannelBase {
 
   T read() {
     ChannelLock lk(lock_);
-    check_poison();
+    check_poison("In::read");
     if (std::optional<T> v = take_locked()) return std::move(*v);
     std::optional<T> slot;
     Waiter w;
@@ -80,13 +87,13 @@ class ChannelState final : public ChannelBase {
 
   std::optional<T> try_read() {
     ChannelLock lk(lock_);
-    check_poison();
+    check_poison("In::try_read");
     return take_locked();
   }
 
   std::optional<T> read_until(Clock::time_point deadline) {
     ChannelLock lk(lock_);
-    check_poison();
+    check_poison("In::read_for");
     if (std::optional<T> v = take_locked()) return v;
     std::optional<T> slot;
     Waiter w;
@@ -106,7 +113,7 @@ class ChannelState final : public ChannelBase {
 
   void write(T value) {
     ChannelLock lk(lock_);
-    check_poison();
+    check_poison("Out::write");
     if (give_locked(value, false)) return;
     Waiter w;
     w.op = "writing";
@@ -122,13 +129,13 @@ class ChannelState final : public ChannelBase {
 
   bool try_write(T& value) {
     ChannelLock lk(lock_);
-    check_poison();
+    check_poison("Out::try_write");
     return give_locked(value, true);
   }
 
  private:
-  void check_poison() const {
-    if (poisoned()) throw Poisoned(name_);
+  void check_poison(const char* use) const {
+    if (poisoned()) throw_poisoned(use);
   }
 
   // Lock held: a value without waiting (buffer first, then a parked writer).
@@ -224,6 +231,13 @@ class ChannelState final : public ChannelBase {
   std::size_t count_ = 0;
 };
 
+// The channel of every unbound end of type T (see the top of this file).
+template <class T>
+const std::shared_ptr<ChannelState<T>>& unbound_channel() {
+  static const std::shared_ptr<ChannelState<T>> channel = std::make_shared<ChannelState<T>>(ChannelBase::Unbound{});
+  return channel;
+}
+
 }  // namespace detail
 
 template <class T>
@@ -244,15 +258,24 @@ class Channel {
 template <class T>
 class In {
  public:
-  In() = default;  // unbound: assign an end from a Channel before use
+  In() : state_(detail::unbound_channel<T>()) {}  // unbound: assign an end from a Channel before use
   T read() { return state_->read(); }
   std::optional<T> try_read() { return state_->try_read(); }
   std::optional<T> read_for(std::chrono::steady_clock::duration d) {
     return state_->read_until(detail::deadline_after(std::chrono::steady_clock::now(), d));
   }
-  bool poisoned() const { return state_->poisoned(); }
-  void poison() { state_->poison(); }
-  const std::string& name() const { return state_->name(); }
+  bool poisoned() const {
+    state_->require_bound("In::poisoned");
+    return state_->poisoned();
+  }
+  void poison() {
+    state_->require_bound("In::poison");
+    state_->poison();
+  }
+  const std::string& name() const {
+    state_->require_bound("In::name");
+    return state_->name();
+  }
 
  private:
   friend class Channel<T>;
@@ -264,12 +287,21 @@ class In {
 template <class T>
 class Out {
  public:
-  Out() = default;  // unbound: assign an end from a Channel before use
+  Out() : state_(detail::unbound_channel<T>()) {}  // unbound: assign an end from a Channel before use
   void write(T value) { state_->write(std::move(value)); }
   bool try_write(T& value) { return state_->try_write(value); }
-  bool poisoned() const { return state_->poisoned(); }
-  void poison() { state_->poison(); }
-  const std::string& name() const { return state_->name(); }
+  bool poisoned() const {
+    state_->require_bound("Out::poisoned");
+    return state_->poisoned();
+  }
+  void poison() {
+    state_->require_bound("Out::poison");
+    state_->poison();
+  }
+  const std::string& name() const {
+    state_->require_bound("Out::name");
+    return state_->name();
+  }
 
  private:
   friend class Channel<T>;

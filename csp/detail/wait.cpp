@@ -4,11 +4,14 @@
 #include <array>
 #include <cstddef>
 #include <cstdint>
+#include <stdexcept>
+#include <string>
 #include <thread>
 
 #include <boost/fiber/detail/cpu_relax.hpp>
 
 #include "csp/detail/process.hpp"
+#include "csp/errors.hpp"
 #include "csp/scheduler.hpp"
 
 namespace csp::detail {
@@ -67,6 +70,16 @@ void RecordQueue::erase(Record& r) {
   (r.next ? r.next->prev : tail_) = r.prev;
   r.prev = r.next = nullptr;
   r.linked = false;
+}
+
+void ChannelBase::throw_unbound(const char* use) {
+  throw std::logic_error(std::string(use) +
+                         ": the end is bound to no channel (default-constructed); assign it an end of a Channel first");
+}
+
+void ChannelBase::throw_poisoned(const char* use) const {
+  if (unbound_) throw_unbound(use);
+  throw Poisoned(name_);
 }
 
 void ChannelBase::poison() {

@@ -117,9 +117,13 @@ class RecordQueue {
 };
 
 // The type-independent half of a channel: lock, poison flag, wait queues.
+// The unbound channel (channel.hpp) is one made poisoned and marked unbound;
+// nothing ever changes either.
 class ChannelBase {
  public:
+  struct Unbound {};
   ChannelBase(std::string name, std::size_t capacity) : name_(std::move(name)), capacity_(capacity) {}
+  explicit ChannelBase(Unbound) : capacity_(0), poisoned_(true), unbound_(true) {}
   virtual ~ChannelBase() = default;
   ChannelBase(const ChannelBase&) = delete;
   ChannelBase& operator=(const ChannelBase&) = delete;
@@ -127,6 +131,14 @@ class ChannelBase {
   const std::string& name() const { return name_; }
   bool poisoned() const { return poisoned_.load(std::memory_order_acquire); }
   void poison();
+  // std::logic_error for `use` (the member of an end, or of Alt, that was
+  // called) of the unbound channel.
+  void require_bound(const char* use) const {
+    if (unbound_) throw_unbound(use);
+  }
+  // The poison check's slow path, which every operation on an unbound end
+  // takes: std::logic_error for `use` of the unbound channel, else Poisoned.
+  [[noreturn]] void throw_poisoned(const char* use) const;
 
   // Lock must be held. True if a read would not block (data, or poison).
   virtual bool ready_locked() const = 0;
@@ -160,12 +172,14 @@ class ChannelBase {
     room_hint_.store(room, std::memory_order_relaxed);
   }
   void wake_all_locked(RecordQueue& q, WaitState outcome);
+  [[noreturn]] static void throw_unbound(const char* use);
 
   std::string name_;
   std::size_t capacity_;
   std::atomic<bool> poisoned_{false};
   std::atomic<bool> ready_hint_{false};
   std::atomic<bool> room_hint_{false};
+  const bool unbound_ = false;
 };
 
 // The bell of a doorbell ALT: a one-bit event with one waiter, the ALT's

@@ -391,6 +391,24 @@ TEST_P(Alt, RoomGuardOnAnUnbufferedChannelIsAnError) {
   EXPECT_THROW(alt.add_room(rendezvous.writer()), std::logic_error);
 }
 
+TEST_P(Alt, AnUnboundEndIsNoGuard) {
+  const csp::Alt::Waiting waiting = GetParam();
+  csp::Alt alt(waiting);
+  try {
+    alt.add_input(csp::In<int>());
+    ADD_FAILURE() << "an unbound input was accepted";
+  } catch (const std::logic_error& e) {
+    EXPECT_EQ(std::string(e.what()).rfind("Alt::add_input: the end is bound to no channel", 0), 0u) << e.what();
+  }
+  try {
+    alt.add_room(csp::Out<int>());
+    ADD_FAILURE() << "an unbound room guard was accepted";
+  } catch (const std::logic_error& e) {
+    EXPECT_EQ(std::string(e.what()).rfind("Alt::add_room: the end is bound to no channel", 0), 0u) << e.what();
+  }
+  EXPECT_EQ(alt.guard_count(), 0u);
+}
+
 TEST_P(Alt, PoisonedRoomGuardIsReadyAndTheWriteThrows) {
   const csp::Alt::Waiting waiting = GetParam();
   csp::Channel<int> full("full", 1);

@@ -1,8 +1,12 @@
-// Channel semantics: rendezvous, ordering, buffering, poison, move-only values.
+// Channel semantics: rendezvous, ordering, buffering, poison, move-only
+// values, ends bound to no channel.
 #include <gtest/gtest.h>
 
+#include <functional>
 #include <memory>
 #include <optional>
+#include <stdexcept>
+#include <string>
 #include <vector>
 
 #include "csp/csp.hpp"
@@ -188,6 +192,58 @@ TEST(Channel, PoisonedBufferStillThrows) {
   int v = 2;
   EXPECT_THROW(out.try_write(v), csp::Poisoned);
   EXPECT_TRUE(c.reader().poisoned());
+}
+
+// The message of the std::logic_error that use() throws ("" if none).
+std::string logic_error_of(const std::function<void()>& use) {
+  try {
+    use();
+  } catch (const std::logic_error& e) {
+    return e.what();
+  }
+  return "";
+}
+
+// Every member of a default-constructed end says what was used unbound,
+// again and again (the first error leaves nothing locked or poisoned).
+TEST(Channel, UsingAnUnboundEndIsAnErrorThatNamesTheUse) {
+  csp::In<int> in;
+  csp::Out<int> out;
+  int v = 1;
+  const std::vector<std::pair<std::string, std::function<void()>>> uses = {
+      {"In::read", [&] { in.read(); }},
+      {"In::try_read", [&] { in.try_read(); }},
+      {"In::read_for", [&] { in.read_for(1ms); }},
+      {"In::poisoned", [&] { (void)in.poisoned(); }},
+      {"In::poison", [&] { in.poison(); }},
+      {"In::name", [&] { (void)in.name(); }},
+      {"Out::write", [&] { out.write(1); }},
+      {"Out::try_write", [&] { out.try_write(v); }},
+      {"Out::poisoned", [&] { (void)out.poisoned(); }},
+      {"Out::poison", [&] { out.poison(); }},
+      {"Out::name", [&] { (void)out.name(); }},
+  };
+  for (int round = 0; round < 2; ++round) {
+    for (const auto& [use, call] : uses) {
+      const std::string what = logic_error_of(call);
+      EXPECT_EQ(what.rfind(use + ": the end is bound to no channel", 0), 0u) << use << ": " << what;
+    }
+  }
+}
+
+// An end assigned from a channel after default construction is that
+// channel's end, whatever ends of its type were used unbound before.
+TEST(Channel, AnEndAssignedAfterDefaultConstructionIsBound) {
+  csp::In<int> in;
+  csp::Out<int> out;
+  EXPECT_THROW(in.try_read(), std::logic_error);
+  csp::Channel<int> c("c", 1);
+  in = c.reader();
+  out = c.writer();
+  out.write(5);
+  EXPECT_EQ(in.read(), 5);
+  EXPECT_EQ(in.name(), "c");
+  EXPECT_FALSE(out.poisoned());
 }
 
 }  // namespace
