@@ -2,7 +2,6 @@
 #include <algorithm>
 #include <sstream>
 
-#include "csp/channel.hpp"
 #include "csp/detail/process.hpp"
 
 namespace csp::detail {
@@ -62,30 +61,13 @@ void Tracker::abort_run(const Process* self) {
   flush_wakes();
 }
 
-namespace {
-
-void describe_wait(std::ostringstream& out, const Waiter& w) {
-  out << w.op;
-  if (w.channel) out << " channel '" << w.channel->name() << "'";
-  if (w.channels) {
-    out << " channels";
-    const char* sep = " ";
-    for (const ChannelBase* c : *w.channels) {
-      out << sep << "'" << c->name() << "'";
-      sep = ", ";
-    }
-  }
-}
-
-}  // namespace
-
 std::string Tracker::describe_locked() const {
   std::ostringstream out;
   out << "deadlock: all " << processes_.size() << " live processes wait on channels, no timer pending";
   for (const Process* q : processes_) {
     out << "\n  process '" << q->name << "' (thread " << q->thread << "): ";
     if (const Waiter* w = q->waiting.load(std::memory_order_acquire)) {
-      describe_wait(out, *w);
+      out << describe_wait(*w);
     } else {
       out << "ending";
     }

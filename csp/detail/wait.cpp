@@ -242,6 +242,21 @@ WaitState resolve_timeout(Waiter& w) {
   return s;
 }
 
+std::string describe_wait(const Waiter& w) {
+  std::string text = w.op;
+  if (w.channel) text += " channel '" + w.channel->name() + "'";
+  if (w.channels) {
+    text += " channels";
+    const char* sep = " ";
+    for (const ChannelBase* c : *w.channels) {
+      text += sep;
+      text += "'" + c->name() + "'";
+      sep = ", ";
+    }
+  }
+  return text;
+}
+
 void unwind_deadlock() { throw DeadlockUnwind{}; }
 
 }  // namespace csp::detail

@@ -300,6 +300,9 @@ WaitState park(Waiter& w, SpinlockLock& lk);
 void park_until(Waiter& w, SpinlockLock& lk, Clock::time_point deadline);
 WaitState resolve_timeout(Waiter& w);  // caller holds every lock w's records live under
 
+// What w waits on, as the deadlock dump says it: "reading channel 'c'".
+std::string describe_wait(const Waiter& w);
+
 // Throws the internal unwinding signal that ends a process of a deadlocked run.
 [[noreturn]] void unwind_deadlock();
 
