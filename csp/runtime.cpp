@@ -245,7 +245,7 @@ void Runtime::run() {
 struct ParGroup {
   detail::Spinlock lock;
   std::size_t remaining = 0;
-  detail::Waiter* parent = nullptr;  // the parent, parked until remaining == 0
+  detail::Waiter* parent = nullptr;  // a parent process, parked until remaining == 0
   std::vector<Failure> failures;     // in the order the children ended
   std::vector<Failure> poisons;
   bool deadlock = false;
@@ -293,17 +293,20 @@ void par(std::vector<std::function<void()>> processes) {
         parent ? parent->stack_size : RuntimeOptions{}.stack_size,
         [&g, child, name, body = std::move(processes[i])] { run_child(g, child.get(), name, body); }));
   }
-  SpinlockLock lk(g.lock);
-  while (g.remaining > 0) {
-    detail::Waiter w;
-    w.op = "in PAR, waiting for its children";
-    w.abortable = false;  // the children unwind first and then wake it
-    g.parent = &w;
-    detail::park(w, lk);
-    lk.lock();
-    g.parent = nullptr;
+  // A process parks, counted as blocked, until its children have ended.
+  // Outside a Runtime nothing counts, and the joins below are the wait.
+  if (parent) {
+    SpinlockLock lk(g.lock);
+    while (g.remaining > 0) {
+      detail::Waiter w;
+      w.op = "in PAR, waiting for its children";
+      w.abortable = false;  // the children unwind first and then wake it
+      g.parent = &w;
+      detail::park(w, lk);
+      lk.lock();
+      g.parent = nullptr;
+    }
   }
-  lk.unlock();
   for (boost::fibers::fiber& f : fibers) f.join();
   if (g.deadlock) detail::unwind_deadlock();
   if (!g.failures.empty()) detail::rethrow_failures(g.failures);

@@ -60,6 +60,8 @@ class Runtime {
 
 // PAR: runs every process as a fiber on the calling thread and waits for all.
 // Rethrows the first failure after all have ended (ProcessesFailed if several).
+// Outside a Runtime the children are no processes, so no deadlock among them
+// is detected.
 void par(std::vector<std::function<void()>> processes);
 
 // Fiber-aware sleep; never counted as blocked by the deadlock detector.
