@@ -227,7 +227,7 @@ std::size_t Alt::wait_locked(std::size_t timeout_guard, Clock::time_point deadli
   if (!detail::arm(w, timed)) {
     unlink_records();
     unlock_channels();
-    detail::unwind_deadlock();
+    detail::unwind_wait(w);
   }
   detail::Spinlock no_channel;
   detail::Spinlock& last = channels_.empty() ? no_channel : channels_.back()->lock_;

@@ -97,6 +97,8 @@ class ChannelState final : public ChannelBase {
     if (std::optional<T> v = take_locked()) return v;
     std::optional<T> slot;
     Waiter w;
+    w.op = "reading";
+    w.channel = this;
     Record rec;
     rec.waiter = &w;
     rec.slot = &slot;
@@ -108,6 +110,7 @@ class ChannelState final : public ChannelBase {
     lk.unlock();
     if (s == WaitState::timed_out) return std::nullopt;
     if (s == WaitState::poisoned) throw Poisoned(name_);
+    if (s == WaitState::refused) unwind_wait(w);
     return slot;
   }
 
@@ -202,7 +205,8 @@ class ChannelState final : public ChannelBase {
   // The hints ready_hint()/room_hint() read without the lock.
   void publish_hints_locked() { publish_hints(count_ > 0 || !writers_.empty(), count_ < capacity_); }
 
-  // After park(): throws for poison and deadlock; data needs nothing more.
+  // After park(): throws for poison, deadlock and a refused wait; data needs
+  // nothing more.
   void finish_wait(WaitState s, Record& rec, RecordQueue& q) {
     if (s == WaitState::data) return;
     if (s == WaitState::poisoned) throw Poisoned(name_);
@@ -210,7 +214,7 @@ class ChannelState final : public ChannelBase {
     q.erase(rec);
     publish_hints_locked();
     lk.unlock();
-    unwind_deadlock();
+    unwind_wait(*rec.waiter);
   }
 
   // Room for twice the values, at most capacity_ (a buffer allowed many

@@ -294,7 +294,8 @@ void par(std::vector<std::function<void()>> processes) {
         [&g, child, name, body = std::move(processes[i])] { run_child(g, child.get(), name, body); }));
   }
   // A process parks, counted as blocked, until its children have ended.
-  // Outside a Runtime nothing counts, and the joins below are the wait.
+  // Outside a Runtime nothing counts, and the joins below are the wait (the
+  // caller may be a thread, which may not park: see detail/wait.hpp).
   if (parent) {
     SpinlockLock lk(g.lock);
     while (g.remaining > 0) {

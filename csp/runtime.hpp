@@ -6,6 +6,11 @@
 // of its fibers or a timer is due. run() ends when the last process ends, or
 // reports a deadlock once every live process waits on a channel with no timer
 // pending — after unwinding them all. par() is occam PAR inside a process.
+// Blocking on a channel (a read, write, ALT or timed read that must wait) is
+// for processes: a thread outside any Runtime that would block gets
+// std::logic_error instead of a wait nothing may end. It may still use
+// channels without blocking, and run processes with par(), whose children
+// may block.
 //
 // Who wakes whom: spawn() wakes the target thread's main fiber (it waits on an
 // inbox of new processes); the last process to end wakes every thread's main

@@ -124,6 +124,7 @@ WaitState Bell::wait(Waiter& w, Clock::time_point deadline) {
     s = resolve_timeout(w);
   }
   readers_.erase(rec);
+  if (s == WaitState::refused) unwind_wait(w);
   return s;
 }
 
@@ -185,16 +186,28 @@ Process* current_process() {
   return process_of(boost::fibers::context::active());
 }
 
+namespace {
+
+// For a timed wait, or an untimed one of no process: false, with w refused,
+// for a thread outside any Runtime; fibers there (par()'s children) may park.
+bool may_park(Waiter& w, boost::fibers::context* ctx) {
+  if (runtime_scheduler || !ctx->is_context(boost::fibers::type::main_context)) return true;
+  w.state.store(WaitState::refused, std::memory_order_relaxed);
+  return false;
+}
+
+}  // namespace
+
 bool arm(Waiter& w, bool timed) {
   boost::fibers::context* ctx = boost::fibers::context::active();
   w.ctx = ctx;
   if (timed) {
     ctx->twstatus.store(timed_token(w), std::memory_order_release);
-    return true;
+    return may_park(w, ctx);
   }
   ctx->twstatus.store(0, std::memory_order_release);
   Process* p = process_of(ctx);
-  if (!p) return true;
+  if (!p) return may_park(w, ctx);
   const bool runnable = !p->tracker->aborting() && p->tracker->block(*p, w);
   if (runnable || !w.abortable) return true;
   // Nobody can wake us (or the run is unwinding): do not park.
@@ -226,12 +239,16 @@ WaitState park(Waiter& w, SpinlockLock& lk) {
   if (arm(w, false)) return sleep(w, lk);
   lk.unlock();
   flush_wakes();
-  return WaitState::aborted;
+  return w.state.load(std::memory_order_relaxed);
 }
 
 void park_until(Waiter& w, SpinlockLock& lk, Clock::time_point deadline) {
-  arm(w, true);
-  sleep_until(w, lk, deadline);
+  if (arm(w, true)) {
+    sleep_until(w, lk, deadline);
+  } else {
+    lk.unlock();
+    flush_wakes();
+  }
 }
 
 WaitState resolve_timeout(Waiter& w) {
@@ -246,7 +263,7 @@ std::string describe_wait(const Waiter& w) {
   std::string text = w.op;
   if (w.channel) text += " channel '" + w.channel->name() + "'";
   if (w.channels) {
-    text += " channels";
+    text += w.channels->empty() ? " no channel" : " channels";
     const char* sep = " ";
     for (const ChannelBase* c : *w.channels) {
       text += sep;
@@ -258,5 +275,13 @@ std::string describe_wait(const Waiter& w) {
 }
 
 void unwind_deadlock() { throw DeadlockUnwind{}; }
+
+void unwind_wait(const Waiter& w) {
+  if (w.state.load(std::memory_order_relaxed) == WaitState::refused) {
+    throw std::logic_error("a thread outside any csp::Runtime would block " + describe_wait(w) +
+                           "; only processes and par() children may wait");
+  }
+  unwind_deadlock();
+}
 
 }  // namespace csp::detail

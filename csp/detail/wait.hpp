@@ -18,6 +18,14 @@
 //
 // Deadlock accounting: an untimed park of a process counts it as blocked; the
 // claimer uncounts it before rescheduling (see Tracker in detail/process.hpp).
+//
+// Who may park: the fibers of a runtime thread, and outside any Runtime the
+// fibers that par() starts, which wake each other. A thread outside any
+// Runtime (main(), a std::thread) may not: no process can be relied on to
+// wake it, and no deadlock detector sees it, so it would hang. arm() refuses
+// it (on the branch it takes anyway for a wait of no process, so that a
+// process's untimed wait pays nothing for the check, and for timed waits),
+// and the caller unlinks and throws std::logic_error (unwind_wait()).
 #pragma once
 
 #include <atomic>
@@ -76,15 +84,16 @@ struct BellMark {
 };
 
 // How a wait ended. `claiming` is transient: held by a claimer between its CAS
-// and complete(), always under a channel lock.
-enum class WaitState : int { waiting, claiming, data, poisoned, timed_out, aborted };
+// and complete(), always under a channel lock. `refused` is set by arm() alone,
+// for a wait it would not park (see "Who may park").
+enum class WaitState : int { waiting, claiming, data, poisoned, timed_out, aborted, refused };
 
 struct Waiter {
   boost::fibers::context* ctx = nullptr;          // the parked fiber
   std::atomic<WaitState> state{WaitState::waiting};
   std::size_t fired = 0;                          // guard index of the record that won (ALT)
   Process* process = nullptr;                     // set when the park is counted as blocked
-  const char* op = "";                            // what it waits for, for the deadlock dump
+  const char* op = "";                            // what it waits for, for the deadlock dump and errors
   const ChannelBase* channel = nullptr;           // single channel waited on, or null
   const std::vector<ChannelBase*>* channels = nullptr;  // ALT: all channels waited on
   bool abortable = true;                          // false for PAR joins: children end first
@@ -212,7 +221,8 @@ class Bell final : public ChannelBase {
     if (rung_.load(std::memory_order_relaxed)) rung_.exchange(false, std::memory_order_acq_rel);
   }
   // w describes the wait for the deadlock dump. Returns data (rung),
-  // timed_out (deadline first) or aborted (deadlocked run: unwind).
+  // timed_out (deadline first) or aborted (deadlocked run: unwind); throws
+  // the error of a wait arm() refuses.
   WaitState wait(Waiter& w, Clock::time_point deadline);
 
   // Owner only. The mark of guard `guard`, set (so that the first poll looks
@@ -287,7 +297,8 @@ class ChannelLock {
 // Parking is two steps. arm(), with the lock of every channel holding a
 // record of w, makes w claimable: it records the fiber, and for an untimed
 // wait counts the process as blocked; it returns false (w is then `aborted`)
-// if the run is deadlocked and the caller must unlink and unwind instead.
+// if the run is deadlocked, or (w `refused`) if the caller may not park at
+// all, and the caller must then unlink and unwind_wait() instead.
 // sleep() / sleep_until() then release lk — the one lock still held; others
 // may be released between the steps — and suspend until claimed (or until
 // the deadline: the caller relocks and resolves a `waiting` state, a timeout
@@ -295,15 +306,21 @@ class ChannelLock {
 bool arm(Waiter& w, bool timed);
 WaitState sleep(Waiter& w, SpinlockLock& lk);
 void sleep_until(Waiter& w, SpinlockLock& lk, Clock::time_point deadline);
-// Both steps for a wait under a single lock; lk is unlocked on return.
+// Both steps for a wait under a single lock; lk is unlocked on return. If
+// arm() fails, park() returns its outcome and park_until() returns at once,
+// leaving it for resolve_timeout() to report.
 WaitState park(Waiter& w, SpinlockLock& lk);
 void park_until(Waiter& w, SpinlockLock& lk, Clock::time_point deadline);
 WaitState resolve_timeout(Waiter& w);  // caller holds every lock w's records live under
 
-// What w waits on, as the deadlock dump says it: "reading channel 'c'".
+// What w waits on, as the deadlock dump and errors say it: "reading channel 'c'".
 std::string describe_wait(const Waiter& w);
 
 // Throws the internal unwinding signal that ends a process of a deadlocked run.
 [[noreturn]] void unwind_deadlock();
+// Ends a wait that arm() failed or the deadlock detector aborted, its records
+// unlinked and its locks released: std::logic_error naming the wait if it was
+// refused, else unwind_deadlock().
+[[noreturn]] void unwind_wait(const Waiter& w);
 
 }  // namespace csp::detail

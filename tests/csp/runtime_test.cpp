@@ -1,9 +1,12 @@
-// Runtime and PAR: placement, failures, poison shutdown, deadlock diagnosis.
+// Runtime and PAR: placement, failures, poison shutdown, deadlock diagnosis,
+// blocking outside a Runtime.
 #include <gtest/gtest.h>
 
 #include <algorithm>
 #include <atomic>
 #include <cstdint>
+#include <functional>
+#include <future>
 #include <stdexcept>
 #include <string>
 #include <thread>
@@ -135,6 +138,78 @@ TEST(Par, WorksOutsideARuntime) {
   int got = 0;
   csp::par({[out = c.writer()]() mutable { out.write(3); }, [&, in = c.reader()]() mutable { got = in.read(); }});
   EXPECT_EQ(got, 3);
+}
+
+// Runs use(c) for a fresh channel "c" of the given capacity on a thread of
+// its own, outside any Runtime. Returns the message of the std::logic_error
+// it threw, or "returned"; should it wait instead, c is poisoned after a
+// while to free it and the result is "waited", so the test fails, not hangs.
+// A refused wait must leave nothing behind: c then still carries a value.
+std::string outside_any_runtime(std::size_t capacity, const std::function<void(csp::Channel<int>&)>& use) {
+  csp::Channel<int> c("c", capacity);
+  std::promise<std::string> outcome;
+  std::future<std::string> result = outcome.get_future();
+  std::thread thread([&] {
+    try {
+      use(c);
+      outcome.set_value("returned");
+    } catch (const std::logic_error& e) {
+      outcome.set_value(e.what());
+    } catch (const csp::Poisoned&) {
+      outcome.set_value("waited");
+    }
+  });
+  if (result.wait_for(10s) != std::future_status::ready) c.poison();
+  thread.join();
+  const std::string what = result.get();
+  if (!c.reader().poisoned()) {
+    int got = 0;
+    csp::par({[out = c.writer()]() mutable { out.write(7); }, [&, in = c.reader()]() mutable { got = in.read(); }});
+    EXPECT_EQ(got, 7) << "after: " << what;
+  }
+  return what;
+}
+
+// A plain thread is no process: a channel operation that would make it wait
+// is an error naming the wait; one that need not wait works.
+TEST(Runtime, AThreadOutsideAnyRuntimeThatWouldBlockGetsAnError) {
+  const std::string refused = "a thread outside any csp::Runtime would block ";
+  const std::string reading = refused + "reading channel 'c'; only processes and par() children may wait";
+  EXPECT_EQ(outside_any_runtime(0, [](csp::Channel<int>& c) { c.reader().read(); }), reading);
+  EXPECT_EQ(outside_any_runtime(0, [](csp::Channel<int>& c) { c.reader().read_for(1h); }), reading);
+  EXPECT_EQ(outside_any_runtime(0, [](csp::Channel<int>& c) { c.writer().write(1); }),
+            refused + "writing channel 'c'; only processes and par() children may wait");
+  for (csp::Alt::Waiting waiting : {csp::Alt::Waiting::relink, csp::Alt::Waiting::doorbell}) {
+    for (bool timeout : {false, true}) {
+      EXPECT_EQ(outside_any_runtime(0,
+                                    [&](csp::Channel<int>& c) {
+                                      csp::Alt alt(waiting);
+                                      alt.add_input(c.reader());
+                                      if (timeout) alt.add_timeout(1h);
+                                      alt.select();
+                                    }),
+                refused + "in ALT over channels 'c'; only processes and par() children may wait")
+          << "doorbell " << (waiting == csp::Alt::Waiting::doorbell) << ", timeout " << timeout;
+    }
+    // A timeout alone (which poisoning c cannot end, hence a short one).
+    EXPECT_EQ(outside_any_runtime(0,
+                                  [&](csp::Channel<int>&) {
+                                    csp::Alt alt(waiting);
+                                    alt.add_timeout(15s);
+                                    alt.select();
+                                  }),
+              refused + "in ALT over no channel; only processes and par() children may wait")
+        << "doorbell " << (waiting == csp::Alt::Waiting::doorbell);
+  }
+  // Buffered: the write finds room and the first read a value; the second
+  // read would wait.
+  EXPECT_EQ(outside_any_runtime(1,
+                                [](csp::Channel<int>& c) {
+                                  c.writer().write(1);
+                                  EXPECT_EQ(c.reader().read(), 1);
+                                  c.reader().read();
+                                }),
+            reading);
 }
 
 // Each stage forwards values; on poison it poisons both its ends and ends.
