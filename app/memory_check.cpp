@@ -17,15 +17,21 @@
 //                   --ownership or --report; and for --report the page's
 //                   two images copied into its section and twice more
 //                   into the report (6 x 12)
-//   tile records    with tiles recorded in the dynamic schedule: each
-//                   tile's record (48 bytes) in its pixel computer's growing
-//                   vector (half again on average) and in the report's
-//                   copy; the affinity and static schedules make too few
-//                   tiles to count
+//   tile records    with tiles recorded in the dynamic schedule: in the
+//                   run, each tile's record (48 bytes) in its pixel
+//                   computer's vector and in its node report's copy (the
+//                   vector grows by doubling, but what it has not filled
+//                   is not resident); in the outputs, the report's copy,
+//                   and for --tiles the CSV's sorted rows (16 bytes a
+//                   tile) and its text (about 40), held two and a half
+//                   times over as its buffer grows and is copied out; the
+//                   affinity and static schedules make too few tiles to
+//                   count
 // A virtual-time run, or --compare-serial, runs the 1-node machine first.
 // Measured peak resident sizes, less the 64x64 run's, match these within 5%
 // on teapot from 1024x1024 to 16384x16384, and within 10% where tile records
-// weigh, whose vectors grow by doubling (memory_check_test.cpp).
+// weigh: what their buffers' reallocations leave resident varies from run to
+// run (memory_check_test.cpp).
 #include "app/memory_check.hpp"
 
 #include <sys/resource.h>
@@ -48,6 +54,8 @@ constexpr std::uint64_t rgb8 = 3;                              // a pixel of the
 constexpr std::uint64_t owner = sizeof(std::uint16_t);         // the node that computed an item
 constexpr std::uint64_t position = sizeof(std::uint32_t);      // an item's place in the Hilbert order
 constexpr std::uint64_t tile_record = sizeof(nodes::TileSpan);
+constexpr std::uint64_t csv_row = sizeof(std::size_t) + sizeof(void*);  // a tile's place in the CSV's order
+constexpr std::uint64_t csv_line = 40;                                   // a tile's line of CSV text, about
 
 // The items of the largest tile a pixel computer gets, one of `workers`.
 std::uint64_t largest_tile(const nodes::MachineOptions& m, std::uint64_t items, std::uint64_t workers) {
@@ -77,13 +85,15 @@ std::uint64_t machine_run_bytes(const Options& o, std::uint64_t pixels, std::uin
   if (m.pixel_order == nodes::PixelOrder::hilbert) held += position * items;
   const std::uint64_t largest = largest_tile(m, items, workers);
   const std::uint64_t tiles = std::min(items, workers * largest) + largest;  // kept, and one result on its way
-  const std::uint64_t records = recorded_tiles(m, items) * tile_record * 5 / 2;
+  const std::uint64_t records = recorded_tiles(m, items) * tile_record * 2;
   return held + std::max(colour * tiles, colour * pixels) + records;
 }
 
 // Writing the outputs of a machine render.
 std::uint64_t machine_output_bytes(const Options& o, std::uint64_t pixels, std::uint64_t items) {
-  std::uint64_t bytes = (colour + rgb8) * pixels + owner * items + recorded_tiles(o.machine, items) * tile_record;
+  const std::uint64_t tiles = recorded_tiles(o.machine, items);
+  std::uint64_t bytes = (colour + rgb8) * pixels + owner * items + tiles * tile_record;
+  if (!o.tiles_csv.empty()) bytes += tiles * (csv_row + csv_line * 5 / 2);
   if (!o.pictures.ownership_png.empty() || !o.pictures.report_html.empty()) bytes += colour * pixels;
   if (!o.pictures.report_html.empty()) bytes += 6 * colour * pixels;
   return bytes;

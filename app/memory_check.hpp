@@ -8,9 +8,10 @@
 // The estimate counts what grows with the image (memory_check.cpp lists
 // each buffer): the float frames, the 8-bit copy the image writers encode,
 // the machine's pixel order, collected colours, pixel owners, the pixel
-// computers' tiles and tile records, and the pictures' copies. The scene,
-// its database and the nodes' caches grow with the scene, not the image,
-// and are left out, as is the process's own few megabytes.
+// computers' tiles, tile records and their CSV text, and the pictures'
+// copies. The scene, its database and the nodes' caches grow with the
+// scene, not the image, and are left out, as is the process's own few
+// megabytes.
 // Invariant: the estimate follows the renderers' allocations as they are;
 // a change to those buffers changes it too (memory_check_test.cpp holds it
 // to peak resident sizes measured on real runs).

@@ -26,8 +26,9 @@ app::Options options_of(const std::string& command_line) {
 // Peak resident sizes of `vmpray teapot --width N --height N -q OPTIONS`
 // (/usr/bin/time -f %M, 2 threads), less that of the same command at 64x64:
 // what the image's buffers took. The estimate is to be within 5% of it, or
-// 10% where tile records weigh: the vectors that hold them grow by
-// doubling, to between once and twice their size, as the run falls.
+// 10% where tile records weigh: what the reallocations of their vectors and
+// of the CSV's text leave resident varies from run to run (after the run,
+// 2.0 to 2.2 times the records; the text, 2.25 to 2.5 times its length).
 struct Measured {
   int size;
   const char* options;
