@@ -122,7 +122,7 @@ std::vector<std::pair<std::string, std::filesystem::path>> picture_outputs(const
 }
 
 std::vector<std::filesystem::path> write_machine_pictures(const PictureFiles& files, const std::string& title,
-                                                          const tracer::Image& image,
+                                                          tracer::Image image,
                                                           const nodes::MachineReport& report) {
   std::vector<std::filesystem::path> written;
   if (files.machine_svg.empty() && files.ownership_png.empty() && files.report_html.empty() &&
@@ -137,7 +137,7 @@ std::vector<std::filesystem::path> write_machine_pictures(const PictureFiles& fi
                                   std::to_string(report.farmer.tiles) + " tiles");
     tiles = viz::timeline_svg(t);
   }
-  const tracer::Image ownership =
+  tracer::Image ownership =
       viz::ownership_image(image.width(), image.height(), pixel_owners(report, image.width(), image.height()));
   OutputFiles outputs;
   if (!files.machine_svg.empty()) written.push_back(outputs.write_text(files.machine_svg, machine));
@@ -146,17 +146,19 @@ std::vector<std::filesystem::path> write_machine_pictures(const PictureFiles& fi
         outputs.write(files.ownership_png, [&](const auto& p) { ownership.write_image(p.string()); }));
   if (!files.timeline_svg.empty()) written.push_back(outputs.write_text(files.timeline_svg, tiles));
   if (!files.report_html.empty()) {
+    // The page takes the image and the ownership picture themselves: a copy
+    // of either would be one more image-sized buffer at the outputs' peak.
     viz::Section run{.heading = "The run on " + report.topology};
-    run.blocks.push_back(viz::ImageFigure{.caption = "rendered image", .image = image});
+    run.blocks.push_back(viz::ImageFigure{.caption = "rendered image", .image = std::move(image)});
     run.blocks.push_back(machine_statistics(report));
     run.blocks.push_back(viz::SvgFigure{.caption = "the machine after the run", .svg = machine});
     run.blocks.push_back(viz::ImageFigure{.caption = "which processor computed each pixel (key: processor numbers)",
-                                          .image = ownership,
+                                          .image = std::move(ownership),
                                           .key = ownership_key(static_cast<int>(report.nodes))});
     run.blocks.push_back(viz::SvgFigure{.caption = "when each processor traced each tile", .svg = tiles});
-    for (const auto& f : viz::write_html_report(files.report_html, viz::Report{.title = title, .sections = {run}},
-                                                   outputs.tracker()))
-      written.push_back(f);
+    viz::Report page{.title = title};
+    page.sections.push_back(std::move(run));  // a braced list of sections would copy it
+    for (const auto& f : viz::write_html_report(files.report_html, page, outputs.tracker())) written.push_back(f);
   }
   outputs.keep();
   return written;

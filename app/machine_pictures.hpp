@@ -45,9 +45,10 @@ std::vector<std::pair<std::string, std::filesystem::path>> picture_outputs(const
 // Writes the pictures asked for (none: nothing to do); returns every file written. The
 // timeline, alone or in the page, needs a run that recorded its tiles
 // (std::invalid_argument otherwise). Throws std::runtime_error naming the path if one
-// cannot be written, after removing those it had written.
+// cannot be written, after removing those it had written. The rendered image is
+// taken by value for the page to keep without a copy: a caller done with it moves it in.
 std::vector<std::filesystem::path> write_machine_pictures(const PictureFiles& files, const std::string& title,
-                                                          const tracer::Image& image,
+                                                          tracer::Image image,
                                                           const nodes::MachineReport& report);
 
 }  // namespace app

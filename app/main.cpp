@@ -66,9 +66,9 @@ int run(const app::Options& o) {
   if (result.report.machine) std::cout << nodes::format_routes(result.report.machine->report);
   if (result.report.machine && !o.tiles_csv.empty())
     outputs.write_text(o.tiles_csv, app::tiles_csv(result.report.machine->report));
-  if (result.report.machine)  // removes what it wrote if it fails
-    for (const auto& path :
-         app::write_machine_pictures(picture_files(o), result.report.scene, result.image, result.report.machine->report))
+  if (result.report.machine)  // removes what it wrote if it fails; the image is written and not needed again
+    for (const auto& path : app::write_machine_pictures(picture_files(o), result.report.scene, std::move(result.image),
+                                                        result.report.machine->report))
       outputs.add(path);
   return phase.finish(std::cout, "report");
 }

@@ -14,9 +14,8 @@
 //                   the tiles, whose processes have ended
 //   the outputs     the image and owners, and the 8-bit copy (3) each
 //                   image writer encodes; the ownership picture (12) for
-//                   --ownership or --report; and for --report the page's
-//                   two images copied into its section and twice more
-//                   into the report (6 x 12)
+//                   --ownership or --report (the page takes it and the
+//                   image themselves, not copies)
 //   tile records    with tiles recorded in the dynamic schedule: in the
 //                   run, each tile's record (48 bytes) in its pixel
 //                   computer's vector and in its node report's copy (the
@@ -95,7 +94,6 @@ std::uint64_t machine_output_bytes(const Options& o, std::uint64_t pixels, std::
   std::uint64_t bytes = (colour + rgb8) * pixels + owner * items + tiles * tile_record;
   if (!o.tiles_csv.empty()) bytes += tiles * (csv_row + csv_line * 5 / 2);
   if (!o.pictures.ownership_png.empty() || !o.pictures.report_html.empty()) bytes += colour * pixels;
-  if (!o.pictures.report_html.empty()) bytes += 6 * colour * pixels;
   return bytes;
 }
 

@@ -8,8 +8,8 @@
 // The estimate counts what grows with the image (memory_check.cpp lists
 // each buffer): the float frames, the 8-bit copy the image writers encode,
 // the machine's pixel order, collected colours, pixel owners, the pixel
-// computers' tiles, tile records and their CSV text, and the pictures'
-// copies. The scene, its database and the nodes' caches grow with the
+// computers' tiles, tile records and their CSV text, and the ownership
+// picture. The scene, its database and the nodes' caches grow with the
 // scene, not the image, and are left out, as is the process's own few
 // megabytes.
 // Invariant: the estimate follows the renderers' allocations as they are;
