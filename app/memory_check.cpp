@@ -2,8 +2,9 @@
 //
 // Items are what the machine farms out: the pixels, or with the SPD
 // procedure the (W+1) x (H+1) corner samples. Bytes per pixel or item:
-//   --single        the result's image, and the frame render_frame returns
-//                   for it to be copied into that image: 2 x 12
+//   --single        the frame render_frame returns, which becomes the
+//                   result's image (12), and as it is written the 8-bit
+//                   copy (3)
 //   machine run     the result's image (made before the run, 12 a pixel);
 //                   the collector's colours (12 an item), arrival bits
 //                   (1/8) and owners (2); the Hilbert order (4); and the
@@ -109,7 +110,7 @@ std::string about(std::uint64_t bytes) {
 
 std::uint64_t image_memory_bytes(const Options& o, int width, int height) {
   const std::uint64_t pixels = static_cast<std::uint64_t>(width) * static_cast<std::uint64_t>(height);
-  if (o.single) return 2 * colour * pixels;  // more than its outputs take: an image and its 8-bit copy
+  if (o.single) return (colour + rgb8) * pixels;  // its outputs: more than the render takes
   const std::uint64_t items =
       o.spd_procedure ? static_cast<std::uint64_t>(width + 1) * static_cast<std::uint64_t>(height + 1) : pixels;
   const std::uint64_t per_node = static_cast<std::uint64_t>(o.machine.workers_per_node);

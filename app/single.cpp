@@ -2,6 +2,8 @@
 #include "app/single.hpp"
 
 #include <chrono>
+#include <utility>
+#include <vector>
 
 #include "app/progress.hpp"
 #include "tracer/render.hpp"
@@ -31,7 +33,7 @@ RunReport describe_run(const Options& o, const tracer::Database& db) {
 
 RenderResult render_single(const Options& o, const tracer::Scene& scene) {
   const tracer::Database db = build_database(scene, build_options(o));
-  RenderResult out{tracer::Image(scene.camera.width, scene.camera.height), describe_run(o, db)};
+  RunReport report = describe_run(o, db);
   tracer::InMemoryPageSource pages(db);
   const tracer::TraceOptions trace{.max_depth = o.max_depth,
                                    .spd_procedure = o.spd_procedure,
@@ -39,14 +41,12 @@ RenderResult render_single(const Options& o, const tracer::Scene& scene) {
   const int w = scene.camera.width, h = scene.camera.height;
   ProgressBar bar(std::uint64_t(w) * h, "pixels", !o.quiet && stderr_is_terminal());
   const auto t0 = std::chrono::steady_clock::now();
-  const auto pixels = tracer::render_frame(db.header, pages, trace, out.report.rays,
-                                           [&](int rows) { bar.update(std::uint64_t(rows) * w); });
-  out.report.render_seconds =
-      std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  std::vector<tracer::Color> pixels = tracer::render_frame(db.header, pages, trace, report.rays,
+                                                           [&](int rows) { bar.update(std::uint64_t(rows) * w); });
+  report.render_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   bar.finish();
-  for (int y = 0; y < h; ++y)
-    for (int x = 0; x < w; ++x) out.image.at(x, y) = pixels[std::size_t(y) * w + x];
-  return out;
+  // The frame becomes the image: one image-sized buffer, not a second to copy it into.
+  return {tracer::Image(w, h, std::move(pixels)), std::move(report)};
 }
 
 }  // namespace app

@@ -14,6 +14,8 @@
 #include <functional>
 #include <memory>
 #include <stdexcept>
+#include <string>
+#include <utility>
 
 #include "tracer/atomic_file.hpp"
 
@@ -49,6 +51,14 @@ bool ppm_header_int(std::FILE* f, int& value) {
 Image::Image(int width, int height) : width_(width), height_(height) {
   if (width <= 0 || height <= 0) throw std::invalid_argument("image size must be positive");
   pixels_.assign(static_cast<std::size_t>(width) * static_cast<std::size_t>(height), Color{});
+}
+
+Image::Image(int width, int height, std::vector<Color> pixels)
+    : width_(width), height_(height), pixels_(std::move(pixels)) {
+  if (width <= 0 || height <= 0) throw std::invalid_argument("image size must be positive");
+  if (pixels_.size() != static_cast<std::size_t>(width) * static_cast<std::size_t>(height))
+    throw std::invalid_argument(std::to_string(pixels_.size()) + " pixels for a " + std::to_string(width) + "x" +
+                                std::to_string(height) + " image");
 }
 
 std::uint8_t to_byte(float linear) {

@@ -23,6 +23,9 @@ class Image {
  public:
   Image() = default;
   Image(int width, int height);  // black; throws std::invalid_argument if not positive
+  // Takes `pixels` (row-major from the top row) as the image's own, without a
+  // copy; std::invalid_argument unless the size is positive and they fill it.
+  Image(int width, int height, std::vector<Color> pixels);
 
   int width() const { return width_; }
   int height() const { return height_; }

@@ -42,11 +42,11 @@ const Measured measured[] = {
     {4096, "", 701736, 10024},
     {8192, "", 2778996, 10324},
     {16384, "", 11099816, 10024},
-    {1024, "--single", 32020, 8408},
-    {2048, "--single", 105900, 8448},
-    {4096, "--single", 400852, 8392},
-    {8192, "--single", 1580528, 8316},
-    {16384, "--single", 6298980, 8316},
+    {1024, "--single", 23412, 8588},
+    {2048, "--single", 69524, 8532},
+    {4096, "--single", 253816, 8488},
+    {8192, "--single", 991300, 8520},
+    {16384, "--single", 3940268, 8568},
     {4096, "--pixel-order scanline", 636904, 10564},
     {4096, "--spd-procedure", 703728, 10168},
     {4096, "--schedule static --nodes 1", 894652, 8524},
@@ -79,7 +79,8 @@ TEST(MemoryEstimate, CountsCornerSamplesAndTheNodes) {
   // Static shares: every processor's share at once, and one of them on its way as a result.
   EXPECT_GT(image_memory_bytes(options_of("--schedule static --nodes 1"), 1000, 1000),
             image_memory_bytes(options_of("--schedule static --nodes 4"), 1000, 1000));
-  EXPECT_EQ(image_memory_bytes(options_of("--single"), 1000, 1000), 24 * pixels);
+  // --single: its image, and as it is written the 8-bit copy.
+  EXPECT_EQ(image_memory_bytes(options_of("--single"), 1000, 1000), 15 * pixels);
 }
 
 TEST(MemoryCheck, RefusesAnImageAboveTheLimitNamingTheOptions) {
@@ -94,11 +95,11 @@ TEST(MemoryCheck, RefusesAnImageAboveTheLimitNamingTheOptions) {
   EXPECT_NO_THROW(app::check_image_memory(o, 4096, 3000, {needed}));
   EXPECT_THROW(app::check_image_memory(o, 4096, 3000, {needed - 1}), app::UsageError);
   try {
-    app::check_image_memory(options_of("--single"), 4096, 4096, {300'000'000, true});
-    ADD_FAILURE() << "a 4096x4096 image passed a 300 MB limit";
+    app::check_image_memory(options_of("--single"), 4096, 4096, {200'000'000, true});
+    ADD_FAILURE() << "a 4096x4096 image passed a 200 MB limit";
   } catch (const app::UsageError& e) {
     EXPECT_STREQ(e.what(),
-                 "--width/--height: a 4096x4096 image needs about 403 MB, more than the 300 MB this process may map "
+                 "--width/--height: a 4096x4096 image needs about 252 MB, more than the 200 MB this process may map "
                  "(ulimit -v)");
   }
 }

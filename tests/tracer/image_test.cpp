@@ -1,5 +1,5 @@
-// Image: the one float->byte conversion, PNG/PPM round trips, and writes
-// that never leave a partial file behind.
+// Image: the one float->byte conversion, an image taking its pixels,
+// PNG/PPM round trips, and writes that never leave a partial file behind.
 #include "tracer/image.hpp"
 
 #include <gtest/gtest.h>
@@ -7,6 +7,8 @@
 #include <cmath>
 #include <filesystem>
 #include <limits>
+#include <utility>
+#include <vector>
 
 namespace tracer {
 namespace {
@@ -51,6 +53,17 @@ TEST(Image, ToRgb8IsRowMajorFromTopLeft) {
 }
 
 TEST(Image, RejectsNonPositiveSize) { EXPECT_THROW(Image(0, 3), std::invalid_argument); }
+
+TEST(Image, TakesPixelsThatFillIt) {
+  std::vector<Color> pixels(6);
+  pixels[4] = {0.25f, 0.5f, 1.0f};  // (1,1), row-major from the top row
+  const Color* held = pixels.data();
+  const Image img(3, 2, std::move(pixels));
+  EXPECT_EQ(img.at(1, 1).g, 0.5f);
+  EXPECT_EQ(img.pixels().data(), held);  // the very buffer, not a copy
+  EXPECT_THROW(Image(3, 2, std::vector<Color>(5)), std::invalid_argument);
+  EXPECT_THROW(Image(0, 2, std::vector<Color>{}), std::invalid_argument);
+}
 
 TEST(Image, PngRoundTripIsBitExact) {
   fs::path file = scratch_dir("png") / "g.png";
