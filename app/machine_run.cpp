@@ -39,7 +39,7 @@ SerialComparison run_serial(const tracer::Database& db, const nodes::MachineOpti
 
 RenderResult render_machine(const Options& o, const tracer::Scene& scene) {
   tracer::Database db = build_database(scene, build_options(o));
-  RenderResult out{tracer::Image(scene.camera.width, scene.camera.height), describe_run(o, db)};
+  RunReport report = describe_run(o, db);
   nodes::MachineOptions machine = o.machine;
   machine.trace = {.max_depth = o.max_depth,
                    .spd_procedure = o.spd_procedure,
@@ -48,11 +48,11 @@ RenderResult render_machine(const Options& o, const tracer::Scene& scene) {
   // In virtual time T1 is cheap and deterministic: always there for speedup and efficiency.
   if (o.compare_serial || machine.timing) serial = run_serial(db, machine, o);
   nodes::MachineResult result = run_with_progress(std::move(db), machine, o);
-  out.image = std::move(result.image);
-  out.report.rays = result.report.rays();
-  out.report.render_seconds = result.report.wall_seconds;
-  out.report.machine = MachineSummary{std::move(result.report), serial, o.spd_procedure};
-  return out;
+  report.rays = result.report.rays();
+  report.render_seconds = result.report.wall_seconds;
+  report.machine = MachineSummary{std::move(result.report), serial, o.spd_procedure};
+  // The machine's image itself: the result holds no image of its own while the machine runs.
+  return {std::move(result.image), std::move(report)};
 }
 
 }  // namespace app

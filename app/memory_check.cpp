@@ -5,14 +5,14 @@
 //   --single        the frame render_frame returns, which becomes the
 //                   result's image (12), and as it is written the 8-bit
 //                   copy (3)
-//   machine run     the result's image (made before the run, 12 a pixel);
-//                   the collector's colours (12 an item), arrival bits
+//   machine run     the collector's colours (12 an item), arrival bits
 //                   (1/8) and owners (2); the Hilbert order (4); and the
 //                   pixel computers' tiles, each keeping the colours of
 //                   its largest and sending them in a result of the same
 //                   size (12 + 12 an item of tile)
 //   its assembly    the same, with the assembled image (12) in place of
-//                   the tiles, whose processes have ended
+//                   the tiles, whose processes have ended; it becomes the
+//                   result's image
 //   the outputs     the image and owners, and the 8-bit copy (3) each
 //                   image writer encodes; the ownership picture (12) for
 //                   --ownership or --report (the page takes it and the
@@ -81,7 +81,7 @@ std::uint64_t recorded_tiles(const nodes::MachineOptions& m, std::uint64_t items
 std::uint64_t machine_run_bytes(const Options& o, std::uint64_t pixels, std::uint64_t items,
                                 std::uint64_t workers) {
   const nodes::MachineOptions& m = o.machine;
-  std::uint64_t held = colour * pixels + (colour + owner) * items + items / 8;
+  std::uint64_t held = (colour + owner) * items + items / 8;
   if (m.pixel_order == nodes::PixelOrder::hilbert) held += position * items;
   const std::uint64_t largest = largest_tile(m, items, workers);
   const std::uint64_t tiles = std::min(items, workers * largest) + largest;  // kept, and one result on its way

@@ -149,7 +149,7 @@ TEST_F(Cli, AnImageTooLargeForTheMemoryIsRefusedBeforeTheRender) {
   const Outcome refused = limited("teapot --width 16384 --height 16384 -o out.png");
   EXPECT_EQ(refused.exit_code, 2);
   EXPECT_EQ(refused.err,
-            "vmpray: --width/--height: a 16384x16384 image needs about 11.3 GB, more than the 2.0 GB this process may "
+            "vmpray: --width/--height: a 16384x16384 image needs about 8.1 GB, more than the 2.0 GB this process may "
             "map (ulimit -v)\n");
   EXPECT_EQ(refused.out, "");
   EXPECT_FALSE(fs::exists(dir_ / "out.png"));
