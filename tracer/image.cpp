@@ -31,6 +31,11 @@ struct FileCloser {
 };
 using FilePtr = std::unique_ptr<std::FILE, FileCloser>;
 
+// width x height; std::invalid_argument unless both are positive.
+std::size_t pixel_count(int width, int height) {
+  if (width <= 0 || height <= 0) throw std::invalid_argument("image size must be positive");
+  return static_cast<std::size_t>(width) * static_cast<std::size_t>(height);
+}
 
 // Reads the next PPM header field (a token), skipping blanks and # comments.
 bool ppm_header_int(std::FILE* f, int& value) {
@@ -48,15 +53,11 @@ bool ppm_header_int(std::FILE* f, int& value) {
 
 }  // namespace
 
-Image::Image(int width, int height) : width_(width), height_(height) {
-  if (width <= 0 || height <= 0) throw std::invalid_argument("image size must be positive");
-  pixels_.assign(static_cast<std::size_t>(width) * static_cast<std::size_t>(height), Color{});
-}
+Image::Image(int width, int height) : width_(width), height_(height), pixels_(pixel_count(width, height)) {}
 
 Image::Image(int width, int height, std::vector<Color> pixels)
     : width_(width), height_(height), pixels_(std::move(pixels)) {
-  if (width <= 0 || height <= 0) throw std::invalid_argument("image size must be positive");
-  if (pixels_.size() != static_cast<std::size_t>(width) * static_cast<std::size_t>(height))
+  if (pixels_.size() != pixel_count(width, height))
     throw std::invalid_argument(std::to_string(pixels_.size()) + " pixels for a " + std::to_string(width) + "x" +
                                 std::to_string(height) + " image");
 }
