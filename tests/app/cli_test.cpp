@@ -140,12 +140,7 @@ TEST_F(Cli, AnImageTooLargeForTheMemoryIsRefusedBeforeTheRender) {
 #if defined(__SANITIZE_ADDRESS__) || defined(__SANITIZE_THREAD__)
   GTEST_SKIP() << "a sanitizer's shadow memory does not fit in 2 GB of address space";
 #endif
-  const auto limited = [&](const std::string& args) {
-    const std::string cmd = "cd '" + dir_.string() + "' && ulimit -v 2000000 && exec " + VMPRAY_BINARY + " " + args +
-                            " >stdout.txt 2>stderr.txt </dev/null";
-    const int status = std::system(cmd.c_str());
-    return Outcome{WEXITSTATUS(status), test::read_file(dir_ / "stdout.txt"), test::read_file(dir_ / "stderr.txt")};
-  };
+  const auto limited = [&](const std::string& args) { return run_vmpray(args, "stdout.txt", "ulimit -v 2000000"); };
   const Outcome refused = limited("teapot --width 16384 --height 16384 -o out.png");
   EXPECT_EQ(refused.exit_code, 2);
   EXPECT_EQ(refused.err,

@@ -16,6 +16,7 @@
 #include <vector>
 
 #include "app/options.hpp"
+#include "tests/support/command_line.hpp"
 #include "tests/support/scratch.hpp"
 
 namespace {
@@ -465,10 +466,7 @@ TEST_F(MachineCli, ReportShowsMissRatioPageTrafficAndPerNodeTable) {
     EXPECT_NE(r.out.find(field), std::string::npos) << field;
 }
 
-app::Options parse(std::vector<const char*> args) {
-  args.insert(args.begin(), "vmpray");
-  return app::parse_options(static_cast<int>(args.size()), args.data());
-}
+using test::parse;
 
 TEST(MachineOptions, DefaultIsASixteenNodeHypercubeWithTheDefaultCache) {
   const app::Options o = parse({});

@@ -6,22 +6,14 @@
 #include <unistd.h>
 
 #include <cmath>
-#include <sstream>
 #include <string>
-#include <vector>
 
 #include "app/memory_check.hpp"
+#include "tests/support/command_line.hpp"
 
 namespace {
 
-app::Options options_of(const std::string& command_line) {
-  std::vector<std::string> words{"vmpray"};
-  std::istringstream in(command_line);
-  for (std::string word; in >> word;) words.push_back(word);
-  std::vector<const char*> argv;
-  for (const std::string& w : words) argv.push_back(w.c_str());
-  return app::parse_options(static_cast<int>(argv.size()), argv.data());
-}
+using test::parse_words;
 
 // Peak resident sizes of `vmpray teapot --width N --height N -q OPTIONS`
 // (/usr/bin/time -f %M, 2 threads), less that of the same command at 64x64:
@@ -64,7 +56,7 @@ const Measured measured[] = {
 TEST(MemoryEstimate, MatchesTheMeasuredPeaks) {
   for (const Measured& m : measured) {
     const double bytes = 1024.0 * static_cast<double>(m.kb - m.kb_at_64);
-    const double estimate = static_cast<double>(app::image_memory_bytes(options_of(m.options), m.size, m.size));
+    const double estimate = static_cast<double>(app::image_memory_bytes(parse_words(m.options), m.size, m.size));
     EXPECT_LT(std::abs(estimate - bytes), m.tolerance * bytes)
         << m.size << "x" << m.size << " " << m.options << ": estimated " << estimate << ", measured " << bytes;
   }
@@ -73,18 +65,18 @@ TEST(MemoryEstimate, MatchesTheMeasuredPeaks) {
 TEST(MemoryEstimate, CountsCornerSamplesAndTheNodes) {
   const std::uint64_t pixels = 1000 * 1000, corners = 1001 * 1001;
   // Scanline order keeps no pixel order; the corner samples each take their colour, bit and owner.
-  EXPECT_EQ(image_memory_bytes(options_of("--pixel-order scanline --spd-procedure"), 1000, 1000) -
-                image_memory_bytes(options_of("--pixel-order scanline"), 1000, 1000),
+  EXPECT_EQ(image_memory_bytes(parse_words("--pixel-order scanline --spd-procedure"), 1000, 1000) -
+                image_memory_bytes(parse_words("--pixel-order scanline"), 1000, 1000),
             (corners - pixels) * 14 + corners / 8 - pixels / 8);
   // Static shares: every processor's share at once, and one of them on its way as a result.
-  EXPECT_GT(image_memory_bytes(options_of("--schedule static --nodes 1"), 1000, 1000),
-            image_memory_bytes(options_of("--schedule static --nodes 4"), 1000, 1000));
+  EXPECT_GT(image_memory_bytes(parse_words("--schedule static --nodes 1"), 1000, 1000),
+            image_memory_bytes(parse_words("--schedule static --nodes 4"), 1000, 1000));
   // --single: its image, and as it is written the 8-bit copy.
-  EXPECT_EQ(image_memory_bytes(options_of("--single"), 1000, 1000), 15 * pixels);
+  EXPECT_EQ(image_memory_bytes(parse_words("--single"), 1000, 1000), 15 * pixels);
 }
 
 TEST(MemoryCheck, RefusesAnImageAboveTheLimitNamingTheOptions) {
-  const app::Options o = options_of("");
+  const app::Options o = parse_words("");
   try {
     app::check_image_memory(o, 16384, 16384, {4'000'000'000});
     ADD_FAILURE() << "a 16384x16384 image passed a 4 GB limit";
@@ -95,7 +87,7 @@ TEST(MemoryCheck, RefusesAnImageAboveTheLimitNamingTheOptions) {
   EXPECT_NO_THROW(app::check_image_memory(o, 4096, 3000, {needed}));
   EXPECT_THROW(app::check_image_memory(o, 4096, 3000, {needed - 1}), app::UsageError);
   try {
-    app::check_image_memory(options_of("--single"), 4096, 4096, {200'000'000, true});
+    app::check_image_memory(parse_words("--single"), 4096, 4096, {200'000'000, true});
     ADD_FAILURE() << "a 4096x4096 image passed a 200 MB limit";
   } catch (const app::UsageError& e) {
     EXPECT_STREQ(e.what(),

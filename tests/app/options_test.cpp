@@ -5,13 +5,12 @@
 
 #include <vector>
 
+#include "tests/support/command_line.hpp"
+
 namespace app {
 namespace {
 
-Options parse(std::vector<const char*> args) {
-  args.insert(args.begin(), "vmpray");
-  return parse_options(static_cast<int>(args.size()), args.data());
-}
+using test::parse;
 
 std::string error_of(std::vector<const char*> args) {
   try {

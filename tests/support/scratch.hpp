@@ -66,9 +66,12 @@ class ScratchTest : public ::testing::Test {
 #ifdef VMPRAY_BINARY
   // Runs `vmpray args` in dir_; stdout and stderr are captured in files there
   // (stdout goes to `stdout_to` instead when given: a shell redirection target).
-  Outcome run_vmpray(const std::string& args, const std::string& stdout_to = "stdout.txt") const {
-    const std::string cmd = "cd '" + dir_.string() + "' && " + VMPRAY_BINARY + " " + args + " >" + stdout_to +
-                            " 2>stderr.txt </dev/null";
+  // `setup`, if given, is a shell command run first in the same shell, such
+  // as a ulimit for the binary.
+  Outcome run_vmpray(const std::string& args, const std::string& stdout_to = "stdout.txt",
+                     const std::string& setup = "") const {
+    const std::string cmd = "cd '" + dir_.string() + "' && " + (setup.empty() ? "" : setup + " && ") +
+                            VMPRAY_BINARY + " " + args + " >" + stdout_to + " 2>stderr.txt </dev/null";
     const int status = std::system(cmd.c_str());
     return {WEXITSTATUS(status), read_file(dir_ / "stdout.txt"),
             without_sanitizer_noise(read_file(dir_ / "stderr.txt"))};
