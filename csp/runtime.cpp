@@ -108,11 +108,16 @@ using detail::SpinlockLock;
 using detail::Worker;
 
 struct Runtime::Impl {
-  explicit Impl(RuntimeOptions o) : options(std::move(o)), tracker([this] { stop_all(); }) {
-    if (options.threads == 0) options.threads = std::max(1u, std::thread::hardware_concurrency());
+  explicit Impl(RuntimeOptions o)
+      : options(with_thread_count(std::move(o))), tracker(options.threads, [this] { stop_all(); }) {
     for (unsigned i = 0; i < options.threads; ++i) workers.push_back(std::make_unique<Worker>());
     use.resize(options.threads);
     idle.resize(options.threads);
+  }
+
+  static RuntimeOptions with_thread_count(RuntimeOptions o) {
+    if (o.threads == 0) o.threads = std::max(1u, std::thread::hardware_concurrency());
+    return o;
   }
 
   void post(unsigned thread, Spawn s) {

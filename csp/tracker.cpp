@@ -1,18 +1,27 @@
 // Tracker: alive/blocked accounting and the deadlock abort (see process.hpp).
 #include <algorithm>
+#include <stdexcept>
+#include <string>
 #include <sstream>
 
 #include "csp/detail/process.hpp"
 
 namespace csp::detail {
 
+Tracker::Tracker(unsigned threads, std::function<void()> on_all_ended)
+    : threads_(threads), counts_(std::make_unique<Counts[]>(threads)), on_all_ended_(std::move(on_all_ended)) {}
+
 void Tracker::add(Process& p) {
   p.tracker = this;
-  {
-    std::lock_guard<std::mutex> lk(mutex_);
-    processes_.push_back(&p);
-  }
-  counts_.fetch_add(one_alive, std::memory_order_acq_rel);
+  std::atomic<std::uint64_t>& counts = counts_of(p);
+  std::uint64_t word = counts.load();
+  do {
+    if (alive_of(word) == max_processes_per_thread)
+      throw std::length_error("csp: more than " + std::to_string(max_processes_per_thread) +
+                              " processes alive on runtime thread " + std::to_string(p.thread));
+  } while (!counts.compare_exchange_weak(word, word + one_alive + one_version));
+  std::lock_guard<std::mutex> lk(mutex_);
+  processes_.push_back(&p);
 }
 
 void Tracker::remove(Process& p) {
@@ -20,38 +29,70 @@ void Tracker::remove(Process& p) {
     std::lock_guard<std::mutex> lk(mutex_);
     processes_.erase(std::find(processes_.begin(), processes_.end(), &p));
   }
-  const std::uint64_t v = counts_.fetch_sub(one_alive, std::memory_order_acq_rel) - one_alive;
-  const std::uint64_t alive = v >> 32;
-  if (alive == 0) {
-    on_all_ended_();
-  } else if ((v & blocked_mask) == alive) {
-    abort_run(nullptr);
+  const std::uint64_t word = counts_of(p).fetch_add(one_version - one_alive) + one_version - one_alive;
+  if (!all_blocked(word)) return;
+  switch (survey()) {
+    case Run::going:
+      return;
+    case Run::deadlocked:
+      abort_run(nullptr);
+      return;
+    case Run::ended:
+      if (!ended_.exchange(true)) on_all_ended_();
+      return;
   }
 }
 
 bool Tracker::block(Process& p, Waiter& w) {
   w.process = &p;
   p.waiting.store(&w, std::memory_order_release);
-  const std::uint64_t v = counts_.fetch_add(1, std::memory_order_acq_rel) + 1;
-  if ((v & blocked_mask) != (v >> 32)) return true;
-  abort_run(&p);
-  return false;
+  const std::uint64_t word = counts_of(p).fetch_add(one_version + one_blocked) + one_version + one_blocked;
+  if (!all_blocked(word) || survey() != Run::deadlocked) return true;
+  // Processes of two threads may find the deadlock at once. The one whose
+  // abort starts unwinds at once; the other parks, and the abort claims it.
+  return !abort_run(&p);
 }
 
-void Tracker::unblock(Process&) { counts_.fetch_sub(1, std::memory_order_acq_rel); }
+void Tracker::unblock(Process& p) { counts_of(p).fetch_add(one_version - one_blocked); }
+
+std::uint64_t Tracker::alive() const {
+  std::uint64_t alive = 0;
+  for (unsigned t = 0; t < threads_; ++t) alive += alive_of(counts_[t].word.load());
+  return alive;
+}
+
+// Two reads of every thread's word that agree, versions and all, were all
+// true at one instant; a thread with a process able to run means the run
+// goes on (that process will survey when it blocks or ends).
+Tracker::Run Tracker::survey() const {
+  thread_local std::vector<std::uint64_t> first;
+  first.resize(threads_);
+  for (;;) {
+    std::uint64_t alive = 0;
+    for (unsigned t = 0; t < threads_; ++t) {
+      first[t] = counts_[t].word.load();
+      if (!all_blocked(first[t])) return Run::going;
+      alive += alive_of(first[t]);
+    }
+    bool agree = true;
+    for (unsigned t = 0; t < threads_ && agree; ++t) agree = counts_[t].word.load() == first[t];
+    if (agree) return alive == 0 ? Run::ended : Run::deadlocked;
+  }
+}
 
 std::string Tracker::deadlock_dump() const {
   std::lock_guard<std::mutex> lk(mutex_);
   return dump_;
 }
 
-void Tracker::abort_run(const Process* self) {
+bool Tracker::abort_run(const Process* self) {
   bool expected = false;
-  if (!aborting_.compare_exchange_strong(expected, true, std::memory_order_acq_rel)) return;
+  if (!aborting_.compare_exchange_strong(expected, true, std::memory_order_acq_rel)) return false;
   {
     std::lock_guard<std::mutex> lk(mutex_);
     dump_ = describe_locked();
-    // Everyone is parked and nobody else can claim them: wake all to unwind.
+    // Everyone waits (parked, or about to park having found the deadlock
+    // too) and nobody else can claim them: wake all to unwind.
     for (Process* q : processes_) {
       Waiter* w = q->waiting.load(std::memory_order_acquire);
       if (q == self || !w || !w->abortable) continue;
@@ -59,6 +100,7 @@ void Tracker::abort_run(const Process* self) {
     }
   }
   flush_wakes();
+  return true;
 }
 
 std::string Tracker::describe_locked() const {

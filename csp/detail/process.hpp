@@ -1,20 +1,33 @@
 // Book-keeping of a run: the processes alive and the deadlock detector.
 //
-// Tracker packs two counters into one atomic word — processes alive (high
-// half) and processes blocked on an untimed wait (low half) — so every update
-// returns a consistent snapshot. A process is counted blocked just before it
-// parks (under the lock of a channel it waits on); the party that claims it
-// uncounts it before waking it. Timed waits are never counted. Hence
-// `blocked == alive > 0` means no process can run and nobody will wake one:
-// the state is stable, and whoever observes it (the last process to block, or
-// a process ending) aborts the run. Abort is one-shot: it writes the dump,
-// then claims every parked abortable waiter with `aborted`; from then on
-// every park returns `aborted` at once, so all processes unwind.
+// Tracker counts, for each runtime thread, the processes of that thread
+// alive and those blocked on an untimed wait, in one atomic word per thread
+// (on a cache line of its own) together with a version that every update
+// advances. A process is counted blocked just before it parks (under the
+// lock of a channel it waits on); the party that claims it uncounts it
+// before waking it, in the word of the process's thread. Timed waits are
+// never counted. A process's own block and end touch only its thread's
+// word, so threads that each wake their own processes never contend for it.
+//
+// `blocked == alive > 0` over the whole run means no process can run and
+// nobody will wake one: the state is stable. Only a process that makes its
+// own thread's word all blocked (by blocking, or by ending) can complete
+// that state, so only it surveys the other words: it reads them all twice,
+// and if both reads agree, versions included, they were all true at one
+// instant (between the reads). The last thread to reach the state sees the
+// others', since its update precedes its reads in the single order of
+// sequentially consistent operations. A survey that finds every word all
+// blocked aborts the run; one that finds nothing alive ends it (once,
+// though the last processes of two threads may both see it). Abort is
+// one-shot: it writes the dump, then claims every parked abortable waiter
+// with `aborted`; from then on every park returns `aborted` at once, so all
+// processes unwind.
 #pragma once
 
 #include <atomic>
 #include <cstdint>
 #include <functional>
+#include <memory>
 #include <mutex>
 #include <string>
 #include <vector>
@@ -39,8 +52,10 @@ struct Process {
 
 class Tracker {
  public:
-  explicit Tracker(std::function<void()> on_all_ended) : on_all_ended_(std::move(on_all_ended)) {}
+  Tracker(unsigned threads, std::function<void()> on_all_ended);
 
+  // p.thread must name one of the tracker's threads. Throws
+  // std::length_error past max_processes_per_thread.
   void add(Process& p);
   void remove(Process& p);  // p has ended; may finish or abort the run
   // Counts p as blocked on w. Returns false if the run is (now) deadlocked:
@@ -48,17 +63,35 @@ class Tracker {
   bool block(Process& p, Waiter& w);
   void unblock(Process& p);
   bool aborting() const { return aborting_.load(std::memory_order_acquire); }
-  std::uint64_t alive() const { return counts_.load(std::memory_order_acquire) >> 32; }
+  std::uint64_t alive() const;
   std::string deadlock_dump() const;  // empty unless the run deadlocked
 
- private:
-  static constexpr std::uint64_t one_alive = std::uint64_t{1} << 32;
-  static constexpr std::uint64_t blocked_mask = one_alive - 1;
+  static constexpr unsigned count_bits = 21;
+  static constexpr std::uint64_t max_processes_per_thread = (std::uint64_t{1} << count_bits) - 1;
 
-  void abort_run(const Process* self);
+ private:
+  // A thread's word: blocked processes in the low count_bits, alive ones in
+  // the next count_bits, the version above them (it wraps harmlessly).
+  static constexpr std::uint64_t one_blocked = 1;
+  static constexpr std::uint64_t one_alive = std::uint64_t{1} << count_bits;
+  static constexpr std::uint64_t one_version = std::uint64_t{1} << (2 * count_bits);
+  static std::uint64_t blocked_of(std::uint64_t word) { return word & max_processes_per_thread; }
+  static std::uint64_t alive_of(std::uint64_t word) { return (word >> count_bits) & max_processes_per_thread; }
+  static bool all_blocked(std::uint64_t word) { return blocked_of(word) == alive_of(word); }
+
+  struct alignas(64) Counts {
+    std::atomic<std::uint64_t> word{0};
+  };
+  enum class Run { going, deadlocked, ended };
+
+  std::atomic<std::uint64_t>& counts_of(const Process& p) { return counts_[p.thread].word; }
+  Run survey() const;
+  bool abort_run(const Process* self);  // false if an abort had already started
   std::string describe_locked() const;
 
-  std::atomic<std::uint64_t> counts_{0};
+  const unsigned threads_;
+  std::unique_ptr<Counts[]> counts_;
+  std::atomic<bool> ended_{false};
   std::atomic<bool> aborting_{false};
   mutable std::mutex mutex_;           // guards processes_ and dump_
   std::vector<Process*> processes_;

@@ -210,7 +210,12 @@ bool arm(Waiter& w, bool timed) {
   if (!p) return may_park(w, ctx);
   const bool runnable = !p->tracker->aborting() && p->tracker->block(*p, w);
   if (runnable || !w.abortable) return true;
-  // Nobody can wake us (or the run is unwinding): do not park.
+  // Nobody can wake us (or the run is unwinding): do not park, and so do
+  // not stay counted as blocked (block() counted us if it found the deadlock).
+  if (w.process) {
+    p->tracker->unblock(*p);
+    w.process = nullptr;
+  }
   w.state.store(WaitState::aborted, std::memory_order_relaxed);
   p->waiting.store(nullptr, std::memory_order_relaxed);
   return false;

@@ -7,7 +7,9 @@
 // communication and the ratio. Then it times ALT over 1, 4 and 16 channels,
 // with the input already waiting (ready) and with the ALT parking (idle),
 // for both ways an ALT can wait (relinking records on every channel, and the
-// doorbell).
+// doorbell). In between, one network on every thread at once (1, 2, 4, ...
+// up to the hardware's threads), none talking to another: what the threads
+// cost each other through state the runtime shares between them.
 //
 // One-thread figures are CPU time of that thread, two-thread ones wall time.
 // Each figure is the best of several runs, alternating csp and raw, so that
@@ -25,6 +27,7 @@
 #include <boost/fiber/all.hpp>
 #include <chrono>
 #include <limits>
+#include <memory>
 #include <optional>
 #include <cstdio>
 #include <cstdlib>
@@ -95,6 +98,65 @@ double csp_commstime(unsigned threads, long cycles) {
     // The others wait on ends nobody uses any more: by design here.
   }
   return ns_per(elapsed, 4 * cycles);
+}
+
+// One commstime network on each of `threads` threads, all at once: no
+// process talks to another thread, so with no state shared between the
+// threads each would run as fast as one thread alone. Wall time of the
+// slowest network, ns per communication.
+double csp_commstime_per_thread(unsigned threads, long cycles) {
+  struct Network {
+    csp::Channel<long> a{"a"}, b{"b"}, c{"c"}, d{"d"};
+    Clock::duration elapsed{};
+  };
+  std::vector<std::unique_ptr<Network>> nets;
+  csp::Runtime rt(threads);
+  for (unsigned t = 0; t < threads; ++t) {
+    Network& n = *nets.emplace_back(std::make_unique<Network>());
+    rt.spawn("prefix", t, [in = n.d.reader(), out = n.a.writer()]() mutable {
+      out.write(0);
+      for (;;) out.write(in.read());
+    });
+    rt.spawn("delta", t, [in = n.a.reader(), to_succ = n.b.writer(), to_consume = n.c.writer()]() mutable {
+      for (;;) {
+        const long x = in.read();
+        to_consume.write(x);
+        to_succ.write(x);
+      }
+    });
+    rt.spawn("succ", t, [in = n.b.reader(), out = n.d.writer()]() mutable {
+      for (;;) out.write(in.read() + 1);
+    });
+    rt.spawn("consume", t, [&n, cycles]() mutable {
+      csp::In<long> in = n.c.reader();
+      in.read();
+      const Stopwatch watch(false);
+      for (long i = 0; i < cycles; ++i) in.read();
+      n.elapsed = watch.elapsed();
+      n.c.poison();
+    });
+  }
+  try {
+    rt.run();
+  } catch (const csp::Deadlock&) {
+    // As above: the poisoned networks' other processes wait for good.
+  }
+  Clock::duration slowest{};
+  for (const auto& n : nets) slowest = std::max(slowest, n->elapsed);
+  return ns_per(slowest, 4 * cycles);
+}
+
+void print_commstime_per_thread(long cycles, int runs) {
+  const unsigned hardware = std::max(2u, std::thread::hardware_concurrency());
+  std::vector<unsigned> counts{1};
+  for (unsigned t = 2; t <= hardware; t *= 2) counts.push_back(t);
+  if (counts.back() != hardware) counts.push_back(hardware);
+  std::vector<double> best(counts.size(), std::numeric_limits<double>::max());
+  for (int r = 0; r < runs; ++r)
+    for (std::size_t i = 0; i < counts.size(); ++i)
+      best[i] = std::min(best[i], csp_commstime_per_thread(counts[i], cycles));
+  for (std::size_t i = 0; i < counts.size(); ++i)
+    std::printf("%-8u %10.1f %9.2fx\n", counts[i], best[i], best[i] / best[0]);
 }
 
 // --- the same network on raw Boost.Fiber ---------------------------------
@@ -242,6 +304,9 @@ int main(int argc, char** argv) {
   std::printf("(1 thread: CPU time of the thread; 2 threads: wall time)\n");
   std::printf("%-8s %10s %12s %8s\n", "threads", "csp", "raw boost", "raw/csp");
   for (unsigned threads : {1u, 2u}) print_commstime(threads, cycles, runs);
+  std::printf("\nA network on every thread at once, wall ns per communication, best of %d runs\n", runs);
+  std::printf("%-8s %10s %10s\n", "threads", "csp", "vs 1");
+  print_commstime_per_thread(cycles, runs);
   std::printf("\nALT on one thread, CPU ns per select + read, best of %d runs\n", runs);
   std::printf("%-8s %21s %21s\n", "", "relink", "doorbell");
   std::printf("%-8s %10s %10s %10s %10s\n", "inputs", "ready", "idle", "ready", "idle");

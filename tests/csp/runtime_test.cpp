@@ -374,6 +374,74 @@ TEST(Deadlock, DetectedInARingNamingEveryProcess) {
   EXPECT_EQ(unwound.load(), n);
 }
 
+// Four threads; on threads 1-3 a process waits on a channel of its own
+// (`waiters`), while on thread 0 "ping" sends `exchanges` values to "pong".
+// ping then writes every waiter's channel if `release`, or both end by
+// reading channels nobody writes. Should the run hang, a watchdog poisons
+// every channel after a while, so the test fails rather than hangs.
+struct ThreadsThatWaitWhileOneRuns {
+  static constexpr unsigned threads = 4;
+  static constexpr int exchanges = 20000;
+  std::vector<csp::Channel<int>> waiting;  // one per waiter, then ping's, then pong's
+  csp::Channel<int> exchange{"exchange"};
+  std::vector<int> got = std::vector<int>(threads, 0);
+
+  ThreadsThatWaitWhileOneRuns() {
+    for (unsigned t = 0; t <= threads; ++t) waiting.emplace_back("waiting" + std::to_string(t));
+  }
+
+  // Returns the Deadlock's message, "ended" or "hung".
+  std::string run(bool release) {
+    csp::Runtime rt(threads);
+    for (unsigned t = 1; t < threads; ++t)
+      rt.spawn("waiter" + std::to_string(t), t, [this, t] { got[t] = waiting[t].reader().read(); });
+    rt.spawn("ping", 0, [this, release] {
+      for (int i = 0; i < exchanges; ++i) exchange.writer().write(i);
+      if (!release) waiting[0].reader().read();
+      for (unsigned t = 1; t < threads; ++t) waiting[t].writer().write(static_cast<int>(t));
+    });
+    rt.spawn("pong", 0, [this, release] {
+      for (int i = 0; i < exchanges; ++i) EXPECT_EQ(exchange.reader().read(), i);
+      if (!release) waiting[threads].reader().read();
+    });
+    std::promise<void> done;
+    std::thread watchdog([this, ended = done.get_future()] {
+      if (ended.wait_for(20s) == std::future_status::ready) return;
+      for (auto& c : waiting) c.poison();
+    });
+    std::string outcome = "ended";
+    try {
+      rt.run();
+      if (waiting[0].reader().poisoned()) outcome = "hung";
+    } catch (const csp::Deadlock& e) {
+      outcome = e.what();
+    } catch (const csp::Poisoned&) {
+      outcome = "hung";
+    }
+    done.set_value();
+    watchdog.join();
+    return outcome;
+  }
+};
+
+// The runtime counts blocked processes per thread: a thread whose every
+// process waits is no deadlock while a process of another thread can run.
+TEST(Deadlock, ThreadsWhoseProcessesAllWaitAreNoDeadlockWhileAnotherRuns) {
+  ThreadsThatWaitWhileOneRuns run;
+  EXPECT_EQ(run.run(true), "ended");
+  for (unsigned t = 1; t < run.threads; ++t) EXPECT_EQ(run.got[t], static_cast<int>(t));
+}
+
+// ... and the last thread whose processes all come to wait sees the others'.
+TEST(Deadlock, DetectedWhenTheLastThreadToRunComesToWait) {
+  ThreadsThatWaitWhileOneRuns run;
+  const std::string what = run.run(false);
+  ASSERT_NE(what, "ended");
+  ASSERT_NE(what, "hung");
+  for (const char* name : {"'waiter1' (thread 1)", "'waiter3' (thread 3)", "'ping' (thread 0)", "'pong' (thread 0)"})
+    EXPECT_NE(what.find(name), std::string::npos) << what;
+}
+
 TEST(Deadlock, DetectedThroughAltAndPar) {
   csp::Channel<int> a("a");
   csp::Channel<int> b("b");
