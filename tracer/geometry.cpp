@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cmath>
 #include <numbers>
+#include <vector>
 
 namespace tracer {
 
@@ -119,21 +120,6 @@ bool inside_triangle(const P2& p, const P2& a, const P2& b, const P2& c, double 
   return sign * cross2(a, b, p) >= 0 && sign * cross2(b, c, p) >= 0 && sign * cross2(c, a, p) >= 0;
 }
 
-// Is vertex ring[k] an ear: convex, with no other remaining vertex inside?
-bool is_ear(const std::vector<P2>& pts, const std::vector<std::uint32_t>& ring, std::size_t k,
-            double sign) {
-  const std::size_t n = ring.size();
-  const P2& a = pts[ring[(k + n - 1) % n]];
-  const P2& b = pts[ring[k]];
-  const P2& c = pts[ring[(k + 1) % n]];
-  if (sign * cross2(a, b, c) <= 0) return false;
-  for (std::size_t j = 0; j < n; ++j) {
-    if (j == k || j == (k + 1) % n || j == (k + n - 1) % n) continue;
-    if (inside_triangle(pts[ring[j]], a, b, c, sign)) return false;
-  }
-  return true;
-}
-
 // Does the ring turn with `sign` at every corner, going round exactly once?
 // Then it is strictly convex: every corner is an ear.
 bool is_strictly_convex(const std::vector<P2>& pts, double sign) {
@@ -174,19 +160,101 @@ void clip_alternate_ears(std::vector<std::uint32_t> ring, Triangles& tris) {
   if (ring.size() == 3) tris.push_back({ring[0], ring[1], ring[2]});
 }
 
-// Any ring: clip the first ear from the start of the ring, again and again;
-// a ring with no ear left is finished as a fan. At least O(n^2).
-void clip_first_ears(std::vector<std::uint32_t> ring, const std::vector<P2>& pts, double sign,
-                     Triangles& tris) {
-  while (ring.size() > 3) {
-    std::size_t k = 0;
-    while (k < ring.size() && !is_ear(pts, ring, k, sign)) ++k;
-    if (k == ring.size()) break;  // no ear: finish as a fan below
-    const std::size_t n_ring = ring.size();
-    tris.push_back({ring[(k + n_ring - 1) % n_ring], ring[k], ring[(k + 1) % n_ring]});
-    ring.erase(ring.begin() + static_cast<std::ptrdiff_t>(k));
+// The remaining vertices of a ring in a uniform grid over its bounding box,
+// of cells about as wide as high and about one vertex to a cell, so that a
+// triangle finds the vertices it might hold by looking only at the cells its
+// bounding box covers. A clipped vertex stays in its cell, marked removed.
+class VertexGrid {
+ public:
+  explicit VertexGrid(const std::vector<P2>& pts) : pts_(pts), removed_(pts.size(), false) {
+    lo_ = hi_ = pts.front();
+    for (const P2& p : pts) {
+      lo_ = {std::min(lo_.x, p.x), std::min(lo_.y, p.y)};
+      hi_ = {std::max(hi_.x, p.x), std::max(hi_.y, p.y)};
+    }
+    const double n = static_cast<double>(pts.size());
+    const double w = hi_.x - lo_.x, h = hi_.y - lo_.y;
+    const double across = w > 0 && h > 0 ? std::sqrt(n * w / h) : w > 0 ? n : 1;
+    // Not NaN (from coordinates so large that their differences overflow).
+    columns_ = across >= 1 ? static_cast<std::size_t>(std::min(std::round(across), n)) : 1;
+    rows_ = static_cast<std::size_t>(std::clamp(std::round(n / static_cast<double>(columns_)), 1.0, n));
+    first_.assign(columns_ * rows_ + 1, 0);
+    for (const P2& p : pts) ++first_[cell(p) + 1];
+    for (std::size_t c = 1; c < first_.size(); ++c) first_[c] += first_[c - 1];
+    items_.resize(pts.size());
+    std::vector<std::uint32_t> fill(first_.begin(), first_.end() - 1);
+    for (std::uint32_t i = 0; i < pts.size(); ++i) items_[fill[cell(pts[i])]++] = i;
   }
-  for (std::size_t k = 1; k + 1 < ring.size(); ++k) tris.push_back({ring[0], ring[k], ring[k + 1]});
+
+  void remove(std::uint32_t i) { removed_[i] = true; }
+
+  // Does a remaining vertex other than a, b and c lie in triangle abc
+  // (boundary included)?
+  bool holds_another(std::uint32_t a, std::uint32_t b, std::uint32_t c, double sign) const {
+    const P2 &pa = pts_[a], &pb = pts_[b], &pc = pts_[c];
+    const std::size_t x0 = column({std::min({pa.x, pb.x, pc.x}), 0}), x1 = column({std::max({pa.x, pb.x, pc.x}), 0});
+    const std::size_t y0 = row({0, std::min({pa.y, pb.y, pc.y})}), y1 = row({0, std::max({pa.y, pb.y, pc.y})});
+    for (std::size_t y = y0; y <= y1; ++y)
+      for (std::uint32_t k = first_[y * columns_ + x0]; k < first_[y * columns_ + x1 + 1]; ++k) {
+        const std::uint32_t j = items_[k];
+        if (j == a || j == b || j == c || removed_[j]) continue;
+        if (inside_triangle(pts_[j], pa, pb, pc, sign)) return true;
+      }
+    return false;
+  }
+
+ private:
+  static std::size_t along(double v, double lo, double hi, std::size_t cells) {
+    if (!(hi > lo)) return 0;
+    const double t = (v - lo) / (hi - lo) * static_cast<double>(cells);
+    return std::min(cells - 1, static_cast<std::size_t>(std::max(0.0, t)));
+  }
+  std::size_t column(const P2& p) const { return along(p.x, lo_.x, hi_.x, columns_); }
+  std::size_t row(const P2& p) const { return along(p.y, lo_.y, hi_.y, rows_); }
+  std::size_t cell(const P2& p) const { return row(p) * columns_ + column(p); }
+
+  const std::vector<P2>& pts_;
+  std::vector<bool> removed_;
+  P2 lo_{}, hi_{};
+  std::size_t columns_ = 1, rows_ = 1;
+  std::vector<std::uint32_t> first_;  // cell c holds items_[first_[c] .. first_[c + 1]), cells row by row
+  std::vector<std::uint32_t> items_;
+};
+
+// Any ring: walk round it clipping ears. A vertex is an ear when its corner
+// turns with `sign` and no other remaining vertex lies in its triangle.
+// After a clip the walk passes over the next vertex, as clip_alternate_ears
+// does, so that where the ring is convex the ears are fat rather than a fan
+// of slivers round one vertex. A whole turn of the remaining ring with no
+// ear (a self-crossing or degenerate ring) finishes it as a fan. Near O(n)
+// on the polygons one meets: an ear's test looks only at the grid cells
+// round its triangle.
+void clip_ears(const std::vector<P2>& pts, double sign, Triangles& tris) {
+  const auto n = static_cast<std::uint32_t>(pts.size());
+  std::vector<std::uint32_t> prev(n), next(n);
+  for (std::uint32_t i = 0; i < n; ++i) {
+    prev[i] = (i + n - 1) % n;
+    next[i] = (i + 1) % n;
+  }
+  VertexGrid grid(pts);
+  std::uint32_t remaining = n, at = 0, since_clip = 0;
+  while (remaining > 3 && since_clip < remaining) {
+    const std::uint32_t a = prev[at], c = next[at];
+    const bool ear = sign * cross2(pts[a], pts[at], pts[c]) > 0 && !grid.holds_another(a, at, c, sign);
+    if (!ear) {
+      at = c;
+      ++since_clip;
+      continue;
+    }
+    tris.push_back({a, at, c});
+    next[a] = c;
+    prev[c] = a;
+    grid.remove(at);
+    --remaining;
+    at = next[c];
+    since_clip = 0;
+  }
+  for (std::uint32_t v = next[at]; next[v] != at; v = next[v]) tris.push_back({at, v, next[v]});
 }
 }  // namespace
 
@@ -201,13 +269,14 @@ std::vector<std::array<std::uint32_t, 3>> triangulate_polygon(const std::vector<
   std::vector<P2> pts;
   for (const Vec3d& p : v) pts.push_back({p[ax], p[ay]});
   const double sign = n[drop] >= 0 ? 1.0 : -1.0;  // winding as seen in the projection
-  std::vector<std::uint32_t> ring(v.size());
-  for (std::uint32_t i = 0; i < ring.size(); ++i) ring[i] = i;
   tris.reserve(v.size() - 2);
-  if (is_strictly_convex(pts, sign))
+  if (is_strictly_convex(pts, sign)) {
+    std::vector<std::uint32_t> ring(v.size());
+    for (std::uint32_t i = 0; i < ring.size(); ++i) ring[i] = i;
     clip_alternate_ears(std::move(ring), tris);
-  else
-    clip_first_ears(std::move(ring), pts, sign, tris);
+  } else {
+    clip_ears(pts, sign, tris);
+  }
   return tris;
 }
 

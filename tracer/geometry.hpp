@@ -122,10 +122,10 @@ Box3f cone_bounds(const ConeShape& c);
 // plane fixed by its first three vertices; returns vertex index triples with
 // the polygon's winding. A strictly convex polygon has its ears clipped at
 // every other vertex, pass after pass, in O(n): no long slivers, whose hit
-// distances single precision cannot resolve. Any other polygon has its first
-// ear from the start clipped each time; one that has no ear left
-// (self-intersecting or degenerate) is finished as a fan. Every input gives
-// n - 2 triangles.
+// distances single precision cannot resolve. Any other polygon has its ears
+// clipped on a walk round it, each ear tested against the vertices near it;
+// one that has no ear left (self-intersecting or degenerate) is finished as
+// a fan. Every input gives n - 2 triangles.
 std::vector<std::array<std::uint32_t, 3>> triangulate_polygon(const std::vector<Vec3d>& vertices);
 
 }  // namespace tracer

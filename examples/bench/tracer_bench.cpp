@@ -8,16 +8,22 @@
 //  - the paging overhead: the 1 KB paged render against direct access, the
 //    database as one contiguous array with 64 KB pages (page() is then one add,
 //    with no table, and is called least often), same rays, checked same image.
+// Then the time to triangulate concave polygons (toothed wheels) of growing
+// size.
 // Times are thread CPU seconds, so other processes on the machine skew them less.
 #include <time.h>
 
+#include <algorithm>
 #include <cstdio>
 #include <cstring>
+#include <numbers>
+#include <utility>
 #include <string>
 #include <vector>
 
 #include "tracer/database.hpp"
 #include "tracer/generators.hpp"
+#include "tracer/geometry.hpp"
 #include "tracer/render.hpp"
 
 #ifdef VMPRAY_HAVE_EMBREE
@@ -214,10 +220,42 @@ void bench_scene(const std::string& spec) {
               direct_image == paged_image ? "same image" : "IMAGES DIFFER");
 }
 
+// A wheel of `teeth` trapezoid teeth (radii 1 and 0.8), counter-clockwise
+// from a tooth's tip: 4 * teeth vertices, one in four a reflex corner.
+std::vector<tracer::Vec3d> toothed_wheel(int teeth) {
+  std::vector<tracer::Vec3d> v;
+  const double step = 2 * std::numbers::pi / teeth;
+  for (int t = 0; t < teeth; ++t)
+    for (const auto& [radius, at] : {std::pair{1.0, 0.0}, {1.0, 0.3}, {0.8, 0.5}, {0.8, 0.8}}) {
+      const double a = (t + at) * step;
+      v.push_back({radius * std::cos(a), radius * std::sin(a), 0});
+    }
+  return v;
+}
+
+// Concave polygons are cut by ear clipping; the time per vertex should not
+// grow with the polygon.
+void bench_triangulation() {
+  std::printf("concave polygon triangulation (toothed wheels):\n");
+  for (int teeth : {500, 2000, 8000}) {
+    const std::vector<tracer::Vec3d> v = toothed_wheel(teeth);
+    double best = 1e30;
+    std::size_t triangles = 0;
+    for (int rep = 0; rep < kRepeats; ++rep) {
+      const double t0 = cpu_seconds();
+      triangles = tracer::triangulate_polygon(v).size();
+      best = std::min(best, cpu_seconds() - t0);
+    }
+    std::printf("  %6zu vertices  %8.3f ms  %6.1f ns per vertex  %s\n", v.size(), best * 1e3,
+                best * 1e9 / double(v.size()), triangles == v.size() - 2 ? "n - 2 triangles" : "WRONG COUNT");
+  }
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
   std::vector<std::string> scenes = {"teapot", "mountain", "rings4", "tetra9"};
   if (argc > 1) scenes.assign(argv + 1, argv + argc);
   for (const auto& s : scenes) bench_scene(s);
+  bench_triangulation();
 }
