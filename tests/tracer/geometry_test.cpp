@@ -103,120 +103,6 @@ TEST(Box, SlabTestGivesEntryDistance) {
   EXPECT_FALSE(intersect_box(r, RayInverse(r), b, 0.0f, 2.0f));
 }
 
-TEST(Triangulate, NonConvexPolygonCoversItsArea) {
-  // An L shape (area 3), counter-clockwise, first corner convex.
-  const std::vector<Vec3d> l = {{0, 0, 0}, {2, 0, 0}, {2, 1, 0}, {1, 1, 0}, {1, 2, 0}, {0, 2, 0}};
-  const auto tris = triangulate_polygon(l);
-  ASSERT_EQ(tris.size(), 4u);
-  double area = 0;
-  for (const auto& t : tris) {
-    const Vec3d n = cross(l[t[1]] - l[t[0]], l[t[2]] - l[t[0]]);
-    EXPECT_GT(n.z, 0) << "every triangle keeps the polygon's winding";
-    area += 0.5 * n.z;
-  }
-  EXPECT_NEAR(area, 3.0, 1e-12);
-}
-
-std::vector<Vec3d> regular_polygon(int vertices, double radius) {
-  std::vector<Vec3d> v;
-  for (int i = 0; i < vertices; ++i) {
-    const double a = 2 * std::numbers::pi * i / vertices;
-    v.push_back({radius * std::cos(a), radius * std::sin(a), 0});
-  }
-  return v;
-}
-
-double smallest_angle(const Vec3d& a, const Vec3d& b, const Vec3d& c) {
-  auto angle = [](const Vec3d& p, const Vec3d& q, const Vec3d& r) {
-    return std::acos(dot(normalize(q - p), normalize(r - p)));
-  };
-  return std::min({angle(a, b, c), angle(b, c, a), angle(c, a, b)});
-}
-
-// No triangulation on a regular polygon's own vertices avoids thin triangles
-// (an ear's corners are pi / n), but a fan makes every triangle a sliver; here
-// the thin ones must be small. Counter-clockwise, odd and even counts.
-TEST(Triangulate, RegularPolygonHasFewThinTriangles) {
-  for (int n : {1999, 2000}) {
-    const auto v = regular_polygon(n, 1.5);
-    const auto tris = triangulate_polygon(v);
-    ASSERT_EQ(tris.size(), std::size_t(n - 2));
-    double area = 0, thin_area = 0;
-    for (const auto& t : tris) {
-      const double a = 0.5 * cross(v[t[1]] - v[t[0]], v[t[2]] - v[t[0]]).z;
-      ASSERT_GT(a, 0) << "every triangle keeps the polygon's winding";
-      area += a;
-      if (smallest_angle(v[t[0]], v[t[1]], v[t[2]]) < std::numbers::pi / 180) thin_area += a;
-    }
-    const double polygon_area = 0.5 * n * 1.5 * 1.5 * std::sin(2 * std::numbers::pi / n);
-    EXPECT_NEAR(area, polygon_area, 1e-12 * polygon_area) << n;
-    EXPECT_LT(thin_area, 0.01 * area) << n << ": area in triangles with a corner under 1 degree";
-  }
-}
-
-// Points spread over a convex polygon (within its inscribed circle, off the
-// diagonals) each lie in exactly one triangle.
-TEST(Triangulate, ConvexPolygonIsCoveredOnce) {
-  for (int n : {5, 6, 7, 64, 101}) {
-    const auto v = regular_polygon(n, 1.0);
-    const auto tris = triangulate_polygon(v);
-    auto inside = [&](const std::array<std::uint32_t, 3>& t, double x, double y) {
-      for (int k = 0; k < 3; ++k) {
-        const Vec3d& a = v[t[k]];
-        const Vec3d& b = v[t[(k + 1) % 3]];
-        if ((b.x - a.x) * (y - a.y) - (b.y - a.y) * (x - a.x) < 0) return false;
-      }
-      return true;
-    };
-    for (double y = -0.693; y < 0.7; y += 0.0517)
-      for (double x = -0.691; x < 0.7; x += 0.0513) {
-        if (std::hypot(x, y) > 0.8) continue;
-        int covering = 0;
-        for (const auto& t : tris) covering += inside(t, x, y);
-        EXPECT_EQ(covering, 1) << n << " vertices, point " << x << ' ' << y;
-      }
-  }
-}
-
-// A star of `points` spikes (radii 1 and 0.6), counter-clockwise, starting
-// at a convex corner as NFF requires: half its corners are reflex.
-std::vector<Vec3d> star(int points) {
-  std::vector<Vec3d> v;
-  for (int k = 0; k < 2 * points; ++k) {
-    const int i = (k + 2 * points - 1) % (2 * points);
-    const double r = i % 2 == 0 ? 1.0 : 0.6;
-    const double a = std::numbers::pi * i / points;
-    v.push_back({r * std::cos(a), r * std::sin(a), 0});
-  }
-  return v;
-}
-
-double shoelace_area(const std::vector<Vec3d>& v);
-
-// An arm of `turns` turns and width 0.6 winding out from the centre and back,
-// counter-clockwise, starting at a convex corner: n vertices, most of whose
-// ears hold other vertices.
-std::vector<Vec3d> spiral(int n, double turns) {
-  std::vector<Vec3d> v, back;
-  const int m = n / 2;
-  for (int i = 0; i < m; ++i) {
-    const double t = turns * 2 * std::numbers::pi * i / (m - 1);
-    const double r = 1 + 0.5 * t;
-    v.push_back({r * std::cos(t), r * std::sin(t), 0});
-    back.push_back({(r + 0.6) * std::cos(t), (r + 0.6) * std::sin(t), 0});
-  }
-  v.insert(v.end(), back.rbegin(), back.rend());
-  if (shoelace_area(v) < 0) std::reverse(v.begin(), v.end());
-  const auto convex = [&](std::size_t k) {
-    const Vec3d& a = v[(k + v.size() - 1) % v.size()];
-    return cross(v[k] - a, v[(k + 1) % v.size()] - v[k]).z > 0;
-  };
-  std::size_t k = 0;
-  while (!convex(k)) ++k;
-  std::rotate(v.begin(), v.begin() + static_cast<std::ptrdiff_t>((k + v.size() - 1) % v.size()), v.end());
-  return v;
-}
-
 double shoelace_area(const std::vector<Vec3d>& v) {
   double twice = 0;
   for (std::size_t i = 0; i < v.size(); ++i) {
@@ -232,6 +118,13 @@ bool inside_polygon(const std::vector<Vec3d>& v, double x, double y) {
   for (std::size_t i = 0, j = v.size() - 1; i < v.size(); j = i++)
     if ((v[i].y > y) != (v[j].y > y) && x < (v[j].x - v[i].x) * (y - v[i].y) / (v[j].y - v[i].y) + v[i].x) in = !in;
   return in;
+}
+
+double smallest_angle(const Vec3d& a, const Vec3d& b, const Vec3d& c) {
+  auto angle = [](const Vec3d& p, const Vec3d& q, const Vec3d& r) {
+    return std::acos(dot(normalize(q - p), normalize(r - p)));
+  };
+  return std::min({angle(a, b, c), angle(b, c, a), angle(c, a, b)});
 }
 
 // n - 2 triangles, each turning with the polygon, their areas summing to
@@ -266,6 +159,72 @@ double check_triangulation(const std::vector<Vec3d>& v, double extent, double st
       EXPECT_EQ(covering, inside_polygon(v, x, y) ? 1 : 0) << "point " << x << ' ' << y;
     }
   return thin_area / area;
+}
+
+// An L shape (area 3), counter-clockwise, first corner convex.
+TEST(Triangulate, NonConvexPolygonCoversItsArea) {
+  const std::vector<Vec3d> l = {{0, 0, 0}, {2, 0, 0}, {2, 1, 0}, {1, 1, 0}, {1, 2, 0}, {0, 2, 0}};
+  ASSERT_NEAR(shoelace_area(l), 3.0, 1e-12);
+  check_triangulation(l, 2.0, 0.0917);
+}
+
+std::vector<Vec3d> regular_polygon(int vertices, double radius) {
+  std::vector<Vec3d> v;
+  for (int i = 0; i < vertices; ++i) {
+    const double a = 2 * std::numbers::pi * i / vertices;
+    v.push_back({radius * std::cos(a), radius * std::sin(a), 0});
+  }
+  return v;
+}
+
+// No triangulation on a regular polygon's own vertices avoids thin triangles
+// (an ear's corners are pi / n), but a fan makes every triangle a sliver; here
+// the thin ones must be small. Counter-clockwise, odd and even counts.
+TEST(Triangulate, RegularPolygonHasFewThinTriangles) {
+  for (int n : {1999, 2000})
+    EXPECT_LT(check_triangulation(regular_polygon(n, 1.5), 1.5, 0.0731), 0.01)
+        << n << ": share of the area in triangles with a corner under 1 degree";
+}
+
+TEST(Triangulate, ConvexPolygonIsCoveredOnce) {
+  for (int n : {5, 6, 7, 64, 101}) check_triangulation(regular_polygon(n, 1.0), 1.0, 0.0517);
+}
+
+// A star of `points` spikes (radii 1 and 0.6), counter-clockwise, starting
+// at a convex corner as NFF requires: half its corners are reflex.
+std::vector<Vec3d> star(int points) {
+  std::vector<Vec3d> v;
+  for (int k = 0; k < 2 * points; ++k) {
+    const int i = (k + 2 * points - 1) % (2 * points);
+    const double r = i % 2 == 0 ? 1.0 : 0.6;
+    const double a = std::numbers::pi * i / points;
+    v.push_back({r * std::cos(a), r * std::sin(a), 0});
+  }
+  return v;
+}
+
+// An arm of `turns` turns and width 0.6 winding out from the centre and back,
+// counter-clockwise, starting at a convex corner: n vertices, most of whose
+// ears hold other vertices.
+std::vector<Vec3d> spiral(int n, double turns) {
+  std::vector<Vec3d> v, back;
+  const int m = n / 2;
+  for (int i = 0; i < m; ++i) {
+    const double t = turns * 2 * std::numbers::pi * i / (m - 1);
+    const double r = 1 + 0.5 * t;
+    v.push_back({r * std::cos(t), r * std::sin(t), 0});
+    back.push_back({(r + 0.6) * std::cos(t), (r + 0.6) * std::sin(t), 0});
+  }
+  v.insert(v.end(), back.rbegin(), back.rend());
+  if (shoelace_area(v) < 0) std::reverse(v.begin(), v.end());
+  const auto convex = [&](std::size_t k) {
+    const Vec3d& a = v[(k + v.size() - 1) % v.size()];
+    return cross(v[k] - a, v[(k + 1) % v.size()] - v[k]).z > 0;
+  };
+  std::size_t k = 0;
+  while (!convex(k)) ++k;
+  std::rotate(v.begin(), v.begin() + static_cast<std::ptrdiff_t>((k + v.size() - 1) % v.size()), v.end());
+  return v;
 }
 
 // Concave: the spikes go first, then the disc inside them is clipped as a
