@@ -29,11 +29,14 @@
 // Who wakes whom: writers wake readers (and fire ALTs), readers wake writers
 // (and fire room guards), poison wakes all; see detail/wait.hpp for the claiming rules.
 //
-// Unbound ends: a default-constructed In or Out refers to the unbound channel
-// of its type, poisoned from the start, so that each of its operations stops
-// at the poison check it makes anyway and only there, off the fast path,
-// finds the channel unbound and throws std::logic_error instead of Poisoned.
-// Its other members check first; an ALT refuses it as a guard.
+// Unbound ends: a default-constructed In or Out, and one moved from, refers
+// to the unbound channel of its type, poisoned from the start, so that each
+// of its operations stops at the poison check it makes anyway and only
+// there, off the fast path, finds the channel unbound and throws
+// std::logic_error instead of Poisoned. Its other members check first; an
+// ALT refuses it as a guard. The unbound channel is never freed, and an end
+// refers to it without a share in its ownership, so making an end unbound
+// touches no reference count.
 #pragma once
 
 #include <algorithm>
@@ -237,9 +240,9 @@ class ChannelState final : public ChannelBase {
 
 // The channel of every unbound end of type T (see the top of this file).
 template <class T>
-const std::shared_ptr<ChannelState<T>>& unbound_channel() {
-  static const std::shared_ptr<ChannelState<T>> channel = std::make_shared<ChannelState<T>>(ChannelBase::Unbound{});
-  return channel;
+std::shared_ptr<ChannelState<T>> unbound_channel() {
+  static ChannelState<T>* const channel = new ChannelState<T>(ChannelBase::Unbound{});
+  return std::shared_ptr<ChannelState<T>>(std::shared_ptr<void>(), channel);
 }
 
 }  // namespace detail
@@ -263,6 +266,13 @@ template <class T>
 class In {
  public:
   In() : state_(detail::unbound_channel<T>()) {}  // unbound: assign an end from a Channel before use
+  In(const In&) = default;
+  In& operator=(const In&) = default;
+  In(In&& o) noexcept : state_(std::exchange(o.state_, detail::unbound_channel<T>())) {}  // o is left unbound
+  In& operator=(In&& o) noexcept {
+    state_ = std::exchange(o.state_, detail::unbound_channel<T>());
+    return *this;
+  }
   T read() { return state_->read(); }
   std::optional<T> try_read() { return state_->try_read(); }
   std::optional<T> read_for(std::chrono::steady_clock::duration d) {
@@ -292,6 +302,13 @@ template <class T>
 class Out {
  public:
   Out() : state_(detail::unbound_channel<T>()) {}  // unbound: assign an end from a Channel before use
+  Out(const Out&) = default;
+  Out& operator=(const Out&) = default;
+  Out(Out&& o) noexcept : state_(std::exchange(o.state_, detail::unbound_channel<T>())) {}  // o is left unbound
+  Out& operator=(Out&& o) noexcept {
+    state_ = std::exchange(o.state_, detail::unbound_channel<T>());
+    return *this;
+  }
   void write(T value) { state_->write(std::move(value)); }
   bool try_write(T& value) { return state_->try_write(value); }
   bool poisoned() const {

@@ -74,7 +74,7 @@ void RecordQueue::erase(Record& r) {
 
 void ChannelBase::throw_unbound(const char* use) {
   throw std::logic_error(std::string(use) +
-                         ": the end is bound to no channel (default-constructed); assign it an end of a Channel first");
+                         ": the end is bound to no channel (default-constructed, or moved from); assign it an end of a Channel first");
 }
 
 void ChannelBase::throw_poisoned(const char* use) const {

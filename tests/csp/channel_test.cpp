@@ -231,6 +231,34 @@ TEST(Channel, UsingAnUnboundEndIsAnErrorThatNamesTheUse) {
   }
 }
 
+// An end moved from, by construction or by assignment, is unbound like a
+// default-constructed one; the end it moved to works.
+TEST(Channel, AnEndMovedFromIsUnbound) {
+  csp::Channel<int> c("c", 2);
+  csp::In<int> in = c.reader();
+  csp::Out<int> out = c.writer();
+  csp::In<int> in2(std::move(in));
+  csp::Out<int> out2(std::move(out));
+  const std::string unbound = ": the end is bound to no channel (default-constructed, or moved from)";
+  EXPECT_EQ(logic_error_of([&] { in.read(); }).rfind("In::read" + unbound, 0), 0u);
+  EXPECT_EQ(logic_error_of([&] { out.write(1); }).rfind("Out::write" + unbound, 0), 0u);
+  out2.write(7);
+  EXPECT_EQ(in2.read(), 7);
+  csp::In<int> in3;
+  csp::Out<int> out3;
+  in3 = std::move(in2);
+  out3 = std::move(out2);
+  EXPECT_EQ(logic_error_of([&] { (void)in2.name(); }).rfind("In::name" + unbound, 0), 0u);
+  EXPECT_EQ(logic_error_of([&] { out2.poison(); }).rfind("Out::poison" + unbound, 0), 0u);
+  out3.write(8);
+  EXPECT_EQ(in3.read(), 8);
+  EXPECT_FALSE(in3.poisoned()) << "the moved-from ends' failed uses left the channel alone";
+  // A moved-from end takes a new channel's end like any unbound one.
+  in = c.reader();
+  out3.write(9);
+  EXPECT_EQ(in.read(), 9);
+}
+
 // An end assigned from a channel after default construction is that
 // channel's end, whatever ends of its type were used unbound before.
 TEST(Channel, AnEndAssignedAfterDefaultConstructionIsBound) {
