@@ -2,7 +2,6 @@
 #include "csp/runtime.hpp"
 
 #include <boost/fiber/fiber.hpp>
-#include <boost/fiber/fixedsize_stack.hpp>
 #include <boost/fiber/operations.hpp>
 #include <barrier>
 #include <exception>
@@ -12,6 +11,7 @@
 #include <utility>
 
 #include "csp/detail/process.hpp"
+#include "csp/detail/stack.hpp"
 #include "csp/errors.hpp"
 
 namespace csp {
@@ -73,7 +73,7 @@ void bind_fiber(Process* p) {
 }
 
 boost::fibers::fiber start_fiber(std::size_t stack_size, std::function<void()> fn) {
-  return boost::fibers::fiber(std::allocator_arg, boost::fibers::fixedsize_stack(stack_size), std::move(fn));
+  return boost::fibers::fiber(std::allocator_arg, ProcessStack(stack_size), std::move(fn));
 }
 
 }  // namespace

@@ -36,7 +36,7 @@ struct ThreadUse {
 
 struct RuntimeOptions {
   unsigned threads = 0;                   // 0: std::thread::hardware_concurrency()
-  std::size_t stack_size = 256 * 1024;    // bytes per process fiber
+  std::size_t stack_size = 256 * 1024;    // bytes per process fiber, with a guard page below (detail/stack.hpp)
   SchedulerFactory scheduler;             // empty: FifoScheduler on every thread
 };
 

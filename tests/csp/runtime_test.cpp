@@ -6,13 +6,17 @@
 #include <atomic>
 #include <cstdint>
 #include <functional>
+#include <fstream>
 #include <future>
+#include <optional>
+#include <sstream>
 #include <stdexcept>
 #include <string>
 #include <thread>
 #include <vector>
 
 #include "csp/csp.hpp"
+#include "csp/detail/stack.hpp"
 
 namespace {
 
@@ -210,6 +214,71 @@ TEST(Runtime, AThreadOutsideAnyRuntimeThatWouldBlockGetsAnError) {
                                   c.reader().read();
                                 }),
             reading);
+}
+
+// The mapping of this process's memory that holds `address`, from
+// /proc/self/maps: its first address and permissions ("rw-p", "---p", ...).
+struct Mapping {
+  std::uintptr_t start = 0;
+  std::string permissions;
+};
+std::optional<Mapping> mapping_of(std::uintptr_t address) {
+  std::ifstream maps("/proc/self/maps");
+  for (std::string line; std::getline(maps, line);) {
+    std::istringstream fields(line);
+    std::string range, permissions;
+    fields >> range >> permissions;
+    const std::size_t dash = range.find('-');
+    const std::uintptr_t start = std::stoull(range.substr(0, dash), nullptr, 16);
+    const std::uintptr_t end = std::stoull(range.substr(dash + 1), nullptr, 16);
+    if (address >= start && address < end) return Mapping{start, permissions};
+  }
+  return std::nullopt;
+}
+
+// Below a process's stack lies a page nobody may touch, so a process that
+// runs off the end of its stack faults there rather than writing over
+// memory that is not its own.
+TEST(Runtime, AProcessStackHasAGuardPageBelowIt) {
+  std::optional<Mapping> stack, below;
+  csp::Runtime rt(1);
+  rt.spawn("p", 0, [&] {
+    volatile char local = 0;
+    stack = mapping_of(reinterpret_cast<std::uintptr_t>(&local));
+    if (stack) below = mapping_of(stack->start - 1);
+  });
+  rt.run();
+  ASSERT_TRUE(stack);
+  EXPECT_EQ(stack->permissions.substr(0, 3), "rw-");
+  ASSERT_TRUE(below) << "nothing is mapped below the stack";
+  EXPECT_EQ(below->permissions.substr(0, 3), "---") << "the page below a process's stack is accessible";
+}
+
+// Guarded stacks take two of the process's memory mappings each, so past a
+// quarter of the kernel's limit processes get unguarded stacks, and a run
+// with more processes than the guarded ones could number still runs.
+TEST(Runtime, MoreProcessesThanGuardedStacksCouldNumberAllRun) {
+#if defined(__SANITIZE_THREAD__)
+  GTEST_SKIP() << "ThreadSanitizer maps shadow memory beside every stack, so the kernel's limit on mappings "
+                  "comes before the runtime's";
+#endif
+  const std::size_t limit = csp::detail::ProcessStack::guarded_limit();
+  const std::size_t processes = 2 * limit + 1000;
+  csp::RuntimeOptions options;
+  options.threads = 1;
+  options.stack_size = 16 * 1024;
+  csp::Runtime rt(options);
+  std::size_t ran = 0, most_guarded = 0;
+  for (std::size_t i = 0; i < processes; ++i)
+    rt.spawn("p", 0, [&] {
+      ++ran;
+      most_guarded = std::max(most_guarded, csp::detail::ProcessStack::guarded_alive());
+      csp::sleep_for(1ms);  // so that every stack is alive at once
+    });
+  rt.run();
+  EXPECT_EQ(ran, processes);
+  EXPECT_EQ(most_guarded, limit);
+  EXPECT_EQ(csp::detail::ProcessStack::guarded_alive(), limit) << "ended processes' guarded stacks are kept";
 }
 
 // Each stage forwards values; on poison it poisons both its ends and ends.
