@@ -39,7 +39,12 @@
 
 #include <algorithm>
 #include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <optional>
+#include <sstream>
 #include <string>
+#include <string_view>
 
 #include "nodes/pixel_computer.hpp"
 #include "nodes/work_plan.hpp"
@@ -128,23 +133,80 @@ std::uint64_t image_memory_bytes(const Options& o, int width, int height) {
 // An image larger than the whole memory cannot be rendered (short of a swap
 // that turns minutes into hours); the check refuses what surely does not
 // fit, and promises nothing of what passes it.
+namespace {
+
+// The number in a control group's limit file, or nullopt for "max", a
+// missing file or anything else.
+std::optional<std::uint64_t> read_limit_file(const std::filesystem::path& file) {
+  std::ifstream in(file);
+  std::uint64_t bytes = 0;
+  if (in >> bytes) return bytes;
+  return std::nullopt;
+}
+
+}  // namespace
+
+std::optional<std::uint64_t> cgroup_memory_limit(const std::filesystem::path& root, const std::string& membership) {
+  std::optional<std::uint64_t> least;
+  std::istringstream lines(membership);
+  for (std::string line; std::getline(lines, line);) {
+    // hierarchy-ID:controller-list:path; v2's one hierarchy has ID 0 and no controllers listed.
+    const std::size_t first = line.find(':'), second = line.find(':', first + 1);
+    if (first == std::string::npos || second == std::string::npos) continue;
+    const std::string_view controllers = std::string_view(line).substr(first + 1, second - first - 1);
+    bool memory = false;
+    for (std::size_t at = 0; at <= controllers.size();) {
+      const std::size_t comma = std::min(controllers.find(',', at), controllers.size());
+      memory = memory || controllers.substr(at, comma - at) == "memory";
+      at = comma + 1;
+    }
+    const bool v2 = line.compare(0, first, "0") == 0 && controllers.empty();
+    if (!v2 && !memory) continue;
+    const std::filesystem::path hierarchy = v2 ? root : root / "memory";
+    const char* file = v2 ? "memory.max" : "memory.limit_in_bytes";
+    for (std::filesystem::path group = std::filesystem::path(line.substr(second + 1)).relative_path();;
+         group = group.parent_path()) {
+      if (const auto bytes = read_limit_file(hierarchy / group / file))
+        least = std::min(least.value_or(UINT64_MAX), *bytes);
+      if (group.empty()) break;
+    }
+  }
+  return least;
+}
+
 MemoryLimit memory_limit() {
   MemoryLimit limit;
   const long pages = sysconf(_SC_PHYS_PAGES), page_size = sysconf(_SC_PAGE_SIZE);
   if (pages > 0 && page_size > 0) limit.bytes = static_cast<std::uint64_t>(pages) * static_cast<std::uint64_t>(page_size);
+  // A container's limit: past it the kernel reclaims, then kills.
+  std::ifstream membership_file("/proc/self/cgroup");
+  std::ostringstream membership;
+  membership << membership_file.rdbuf();
+  if (const auto group = cgroup_memory_limit("/sys/fs/cgroup", membership.str()); group && *group < limit.bytes)
+    limit = {*group, MemoryLimit::Source::control_group};
   // Resident bytes are mapped bytes too: an address-space limit below the
   // memory fails the allocations first.
   rlimit space{};
   if (getrlimit(RLIMIT_AS, &space) == 0 && space.rlim_cur != RLIM_INFINITY && space.rlim_cur < limit.bytes)
-    limit = {static_cast<std::uint64_t>(space.rlim_cur), true};
+    limit = {static_cast<std::uint64_t>(space.rlim_cur), MemoryLimit::Source::address_space};
   return limit;
 }
 
 void check_image_memory(const Options& o, int width, int height, const MemoryLimit& limit) {
   const std::uint64_t needed = image_memory_bytes(o, width, height);
   if (needed <= limit.bytes) return;
-  const std::string available = limit.process_limit ? "the " + about(limit.bytes) + " this process may map (ulimit -v)"
-                                                    : "this machine's " + about(limit.bytes);
+  std::string available;
+  switch (limit.source) {
+    case MemoryLimit::Source::machine:
+      available = "this machine's " + about(limit.bytes);
+      break;
+    case MemoryLimit::Source::control_group:
+      available = "the " + about(limit.bytes) + " this process's control group may use";
+      break;
+    case MemoryLimit::Source::address_space:
+      available = "the " + about(limit.bytes) + " this process may map (ulimit -v)";
+      break;
+  }
   throw UsageError("--width/--height: a " + std::to_string(width) + "x" + std::to_string(height) +
                    " image needs about " + about(needed) + ", more than " + available);
 }

@@ -18,6 +18,9 @@
 #pragma once
 
 #include <cstdint>
+#include <filesystem>
+#include <optional>
+#include <string>
 
 #include "app/options.hpp"
 
@@ -25,16 +28,29 @@ namespace app {
 
 // What an estimate is held against.
 struct MemoryLimit {
+  enum class Source {
+    machine,        // the machine's physical memory
+    control_group,  // what this process's control group may use (a container's limit)
+    address_space,  // the address space this process may map (ulimit -v)
+  };
   std::uint64_t bytes = UINT64_MAX;
-  bool process_limit = false;  // the address space this process may map (ulimit -v), not the machine's memory
+  Source source = Source::machine;
 };
 
 // The peak bytes of the image-sized buffers of rendering a width x height
 // image with these options.
 std::uint64_t image_memory_bytes(const Options& options, int width, int height);
 
-// This machine's physical memory, or the address space this process may
-// map if that is less; no limit if neither can be read.
+// The memory limit of this process's control group: the least memory.max
+// (cgroup v2) or memory.limit_in_bytes (v1) on its path from its own group
+// up to the root of the hierarchy. `root` is where the cgroup file system is
+// mounted (/sys/fs/cgroup, holding the v1 hierarchies by controller, or v2's
+// if it is unified), `membership` the text of /proc/self/cgroup. nullopt when
+// no group on the path sets a limit, or none can be read.
+std::optional<std::uint64_t> cgroup_memory_limit(const std::filesystem::path& root, const std::string& membership);
+
+// The least of this machine's physical memory, its control group's limit and
+// the address space this process may map; no limit if none can be read.
 MemoryLimit memory_limit();
 
 // UsageError "--width/--height: a WxH image needs about X GB, more than this

@@ -6,10 +6,16 @@
 #include <unistd.h>
 
 #include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <optional>
+#include <sstream>
 #include <string>
+#include <utility>
 
 #include "app/memory_check.hpp"
 #include "tests/support/command_line.hpp"
+#include "tests/support/scratch.hpp"
 
 namespace {
 
@@ -86,28 +92,75 @@ TEST(MemoryCheck, RefusesAnImageAboveTheLimitNamingTheOptions) {
   const std::uint64_t needed = app::image_memory_bytes(o, 4096, 3000);
   EXPECT_NO_THROW(app::check_image_memory(o, 4096, 3000, {needed}));
   EXPECT_THROW(app::check_image_memory(o, 4096, 3000, {needed - 1}), app::UsageError);
-  try {
-    app::check_image_memory(parse_words("--single"), 4096, 4096, {200'000'000, true});
-    ADD_FAILURE() << "a 4096x4096 image passed a 200 MB limit";
-  } catch (const app::UsageError& e) {
-    EXPECT_STREQ(e.what(),
-                 "--width/--height: a 4096x4096 image needs about 252 MB, more than the 200 MB this process may map "
-                 "(ulimit -v)");
+  using Source = app::MemoryLimit::Source;
+  for (const auto& [source, whose] : {std::pair{Source::address_space, "this process may map (ulimit -v)"},
+                                      std::pair{Source::control_group, "this process's control group may use"}}) {
+    try {
+      app::check_image_memory(parse_words("--single"), 4096, 4096, {200'000'000, source});
+      ADD_FAILURE() << "a 4096x4096 image passed a 200 MB limit";
+    } catch (const app::UsageError& e) {
+      EXPECT_EQ(e.what(), std::string("--width/--height: a 4096x4096 image needs about 252 MB, more than the 200 MB ") +
+                              whose);
+    }
   }
 }
 
-TEST(MemoryCheck, TheLimitIsThePhysicalMemoryOrTheAddressSpaceIfLess) {
-  const std::uint64_t physical = static_cast<std::uint64_t>(sysconf(_SC_PHYS_PAGES)) * sysconf(_SC_PAGE_SIZE);
+// A control group tree in a scratch directory, as the kernel mounts it.
+class ControlGroups : public test::ScratchTest {
+ protected:
+  ControlGroups() : ScratchTest("vmpray_cgroup_") {}
+  void limit(const std::string& file, const std::string& value) {
+    std::filesystem::create_directories((root_ / file).parent_path());
+    std::ofstream(root_ / file) << value << "\n";
+  }
+  const std::filesystem::path& root_ = dir_;
+};
+
+// v2: the least memory.max from the process's group up to the root; "max"
+// sets none.
+TEST_F(ControlGroups, V2TakesTheLeastLimitOnThePathUpToTheRoot) {
+  const std::string membership = "0::/user.slice/app.scope\n";
+  EXPECT_EQ(app::cgroup_memory_limit(root_, membership), std::nullopt) << "no limit files at all";
+  limit("user.slice/app.scope/memory.max", "max");
+  EXPECT_EQ(app::cgroup_memory_limit(root_, membership), std::nullopt) << "max is no limit";
+  limit("user.slice/memory.max", "8589934592");
+  EXPECT_EQ(app::cgroup_memory_limit(root_, membership), 8589934592u) << "a parent's limit binds its children";
+  limit("user.slice/app.scope/memory.max", "2147483648");
+  EXPECT_EQ(app::cgroup_memory_limit(root_, membership), 2147483648u);
+  limit("memory.max", "1073741824");
+  EXPECT_EQ(app::cgroup_memory_limit(root_, membership), 1073741824u) << "up to the root";
+  EXPECT_EQ(app::cgroup_memory_limit(root_, "0::/other.slice\n"), 1073741824u) << "another group: the root only";
+}
+
+// v1: the memory controller's hierarchy, whatever other controllers share it;
+// the other hierarchies are not read.
+TEST_F(ControlGroups, V1ReadsTheMemoryHierarchy) {
+  limit("memory/docker/abc/memory.limit_in_bytes", "536870912");
+  limit("memory/memory.limit_in_bytes", "9223372036854771712");
+  limit("cpu/docker/abc/memory.limit_in_bytes", "1");
+  EXPECT_EQ(app::cgroup_memory_limit(root_, "5:cpu,cpuacct:/docker/abc\n4:memory:/docker/abc\n0::/\n"),
+            536870912u);
+  EXPECT_EQ(app::cgroup_memory_limit(root_, "4:blkio,memory:/docker/abc\n"), 536870912u);
+  EXPECT_EQ(app::cgroup_memory_limit(root_, "4:memoryx:/docker/abc\n"), std::nullopt) << "not the memory controller";
+  EXPECT_EQ(app::cgroup_memory_limit(root_, "garbage\n"), std::nullopt);
+}
+
+TEST(MemoryCheck, TheLimitIsTheLeastOfPhysicalMemoryControlGroupAndAddressSpace) {
+  using Source = app::MemoryLimit::Source;
+  app::MemoryLimit expected{static_cast<std::uint64_t>(sysconf(_SC_PHYS_PAGES)) * sysconf(_SC_PAGE_SIZE),
+                            Source::machine};
+  std::ifstream membership_file("/proc/self/cgroup");
+  std::ostringstream membership;
+  membership << membership_file.rdbuf();
+  const auto group = app::cgroup_memory_limit("/sys/fs/cgroup", membership.str());
+  if (group && *group < expected.bytes) expected = {*group, Source::control_group};
   rlimit space{};
   ASSERT_EQ(getrlimit(RLIMIT_AS, &space), 0);
+  if (space.rlim_cur != RLIM_INFINITY && space.rlim_cur < expected.bytes)
+    expected = {static_cast<std::uint64_t>(space.rlim_cur), Source::address_space};
   const app::MemoryLimit limit = app::memory_limit();
-  if (space.rlim_cur == RLIM_INFINITY || space.rlim_cur >= physical) {
-    EXPECT_EQ(limit.bytes, physical);
-    EXPECT_FALSE(limit.process_limit);
-  } else {
-    EXPECT_EQ(limit.bytes, space.rlim_cur);
-    EXPECT_TRUE(limit.process_limit);
-  }
+  EXPECT_EQ(limit.bytes, expected.bytes);
+  EXPECT_EQ(limit.source, expected.source);
 }
 
 }  // namespace
