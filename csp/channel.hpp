@@ -245,6 +245,25 @@ std::shared_ptr<ChannelState<T>> unbound_channel() {
   return std::shared_ptr<ChannelState<T>>(std::shared_ptr<void>(), channel);
 }
 
+// What an In or an Out holds: its channel, or the unbound one when
+// default-constructed or moved from.
+template <class T>
+class ChannelEnd {
+ protected:
+  ChannelEnd() : state_(unbound_channel<T>()) {}
+  explicit ChannelEnd(std::shared_ptr<ChannelState<T>> s) : state_(std::move(s)) {}
+  ChannelEnd(const ChannelEnd&) = default;
+  ChannelEnd& operator=(const ChannelEnd&) = default;
+  ChannelEnd(ChannelEnd&& o) noexcept : state_(std::exchange(o.state_, unbound_channel<T>())) {}
+  ChannelEnd& operator=(ChannelEnd&& o) noexcept {
+    state_ = std::exchange(o.state_, unbound_channel<T>());
+    return *this;
+  }
+  ~ChannelEnd() = default;
+
+  std::shared_ptr<ChannelState<T>> state_;
+};
+
 }  // namespace detail
 
 template <class T>
@@ -263,16 +282,9 @@ class Channel {
 };
 
 template <class T>
-class In {
+class In : private detail::ChannelEnd<T> {
  public:
-  In() : state_(detail::unbound_channel<T>()) {}  // unbound: assign an end from a Channel before use
-  In(const In&) = default;
-  In& operator=(const In&) = default;
-  In(In&& o) noexcept : state_(std::exchange(o.state_, detail::unbound_channel<T>())) {}  // o is left unbound
-  In& operator=(In&& o) noexcept {
-    state_ = std::exchange(o.state_, detail::unbound_channel<T>());
-    return *this;
-  }
+  In() = default;  // unbound: assign an end from a Channel before use; moving one leaves it unbound
   T read() { return state_->read(); }
   std::optional<T> try_read() { return state_->try_read(); }
   std::optional<T> read_for(std::chrono::steady_clock::duration d) {
@@ -294,21 +306,14 @@ class In {
  private:
   friend class Channel<T>;
   friend class Alt;
-  explicit In(std::shared_ptr<detail::ChannelState<T>> s) : state_(std::move(s)) {}
-  std::shared_ptr<detail::ChannelState<T>> state_;
+  explicit In(std::shared_ptr<detail::ChannelState<T>> s) : detail::ChannelEnd<T>(std::move(s)) {}
+  using detail::ChannelEnd<T>::state_;
 };
 
 template <class T>
-class Out {
+class Out : private detail::ChannelEnd<T> {
  public:
-  Out() : state_(detail::unbound_channel<T>()) {}  // unbound: assign an end from a Channel before use
-  Out(const Out&) = default;
-  Out& operator=(const Out&) = default;
-  Out(Out&& o) noexcept : state_(std::exchange(o.state_, detail::unbound_channel<T>())) {}  // o is left unbound
-  Out& operator=(Out&& o) noexcept {
-    state_ = std::exchange(o.state_, detail::unbound_channel<T>());
-    return *this;
-  }
+  Out() = default;  // unbound: assign an end from a Channel before use; moving one leaves it unbound
   void write(T value) { state_->write(std::move(value)); }
   bool try_write(T& value) { return state_->try_write(value); }
   bool poisoned() const {
@@ -327,8 +332,8 @@ class Out {
  private:
   friend class Channel<T>;
   friend class Alt;
-  explicit Out(std::shared_ptr<detail::ChannelState<T>> s) : state_(std::move(s)) {}
-  std::shared_ptr<detail::ChannelState<T>> state_;
+  explicit Out(std::shared_ptr<detail::ChannelState<T>> s) : detail::ChannelEnd<T>(std::move(s)) {}
+  using detail::ChannelEnd<T>::state_;
 };
 
 }  // namespace csp
