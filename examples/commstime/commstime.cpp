@@ -66,38 +66,55 @@ class Stopwatch {
 
 // --- commstime on csp ----------------------------------------------------
 
-double csp_commstime(unsigned threads, long cycles) {
-  csp::Channel<long> a("a"), b("b"), c("c"), d("d");
+// One commstime network: its channels, and the time its Consume measured.
+struct Network {
+  csp::Channel<long> a{"a"}, b{"b"}, c{"c"}, d{"d"};
   Clock::duration elapsed{};
-  csp::Runtime rt(threads);
-  const unsigned far = threads > 1 ? 1 : 0;  // Succ and Consume go across
-  rt.spawn("prefix", 0, [in = d.reader(), out = a.writer()]() mutable {
+};
+
+// Spawns n's Prefix and Delta on thread `near` and its Succ and Consume on
+// `far`. Consume times `cycles` cycles (the CPU time of its thread if
+// `thread_cpu`, else wall time), then poisons c to shut the network down:
+// poison spreads on first use.
+void spawn_commstime(csp::Runtime& rt, Network& n, unsigned near, unsigned far, long cycles, bool thread_cpu) {
+  rt.spawn("prefix", near, [in = n.d.reader(), out = n.a.writer()]() mutable {
     out.write(0);
     for (;;) out.write(in.read());
   });
-  rt.spawn("delta", 0, [in = a.reader(), to_succ = b.writer(), to_consume = c.writer()]() mutable {
+  rt.spawn("delta", near, [in = n.a.reader(), to_succ = n.b.writer(), to_consume = n.c.writer()]() mutable {
     for (;;) {
       const long x = in.read();
       to_consume.write(x);
       to_succ.write(x);
     }
   });
-  rt.spawn("succ", far, [in = b.reader(), out = d.writer()]() mutable {
+  rt.spawn("succ", far, [in = n.b.reader(), out = n.d.writer()]() mutable {
     for (;;) out.write(in.read() + 1);
   });
-  rt.spawn("consume", far, [in = c.reader(), &c, &elapsed, cycles, threads]() mutable {
+  rt.spawn("consume", far, [in = n.c.reader(), &n, cycles, thread_cpu]() mutable {
     in.read();
-    const Stopwatch watch(threads == 1);
+    const Stopwatch watch(thread_cpu);
     for (long i = 0; i < cycles; ++i) in.read();
-    elapsed = watch.elapsed();
-    c.poison();  // shut the network down: poison spreads on first use
+    n.elapsed = watch.elapsed();
+    n.c.poison();
   });
+}
+
+// Runs rt to its end. The poisoned networks' other processes wait on ends
+// nobody uses any more, which the runtime reports as a deadlock: by design.
+void run_until_poisoned(csp::Runtime& rt) {
   try {
     rt.run();
   } catch (const csp::Deadlock&) {
-    // The others wait on ends nobody uses any more: by design here.
   }
-  return ns_per(elapsed, 4 * cycles);
+}
+
+double csp_commstime(unsigned threads, long cycles) {
+  Network n;
+  csp::Runtime rt(threads);
+  spawn_commstime(rt, n, 0, threads > 1 ? 1 : 0, cycles, threads == 1);  // Succ and Consume go across
+  run_until_poisoned(rt);
+  return ns_per(n.elapsed, 4 * cycles);
 }
 
 // One commstime network on each of `threads` threads, all at once: no
@@ -105,42 +122,11 @@ double csp_commstime(unsigned threads, long cycles) {
 // threads each would run as fast as one thread alone. Wall time of the
 // slowest network, ns per communication.
 double csp_commstime_per_thread(unsigned threads, long cycles) {
-  struct Network {
-    csp::Channel<long> a{"a"}, b{"b"}, c{"c"}, d{"d"};
-    Clock::duration elapsed{};
-  };
   std::vector<std::unique_ptr<Network>> nets;
   csp::Runtime rt(threads);
-  for (unsigned t = 0; t < threads; ++t) {
-    Network& n = *nets.emplace_back(std::make_unique<Network>());
-    rt.spawn("prefix", t, [in = n.d.reader(), out = n.a.writer()]() mutable {
-      out.write(0);
-      for (;;) out.write(in.read());
-    });
-    rt.spawn("delta", t, [in = n.a.reader(), to_succ = n.b.writer(), to_consume = n.c.writer()]() mutable {
-      for (;;) {
-        const long x = in.read();
-        to_consume.write(x);
-        to_succ.write(x);
-      }
-    });
-    rt.spawn("succ", t, [in = n.b.reader(), out = n.d.writer()]() mutable {
-      for (;;) out.write(in.read() + 1);
-    });
-    rt.spawn("consume", t, [&n, cycles]() mutable {
-      csp::In<long> in = n.c.reader();
-      in.read();
-      const Stopwatch watch(false);
-      for (long i = 0; i < cycles; ++i) in.read();
-      n.elapsed = watch.elapsed();
-      n.c.poison();
-    });
-  }
-  try {
-    rt.run();
-  } catch (const csp::Deadlock&) {
-    // As above: the poisoned networks' other processes wait for good.
-  }
+  for (unsigned t = 0; t < threads; ++t)
+    spawn_commstime(rt, *nets.emplace_back(std::make_unique<Network>()), t, t, cycles, false);
+  run_until_poisoned(rt);
   Clock::duration slowest{};
   for (const auto& n : nets) slowest = std::max(slowest, n->elapsed);
   return ns_per(slowest, 4 * cycles);
