@@ -192,8 +192,8 @@ class VertexGrid {
   // (boundary included)?
   bool holds_another(std::uint32_t a, std::uint32_t b, std::uint32_t c, double sign) const {
     const P2 &pa = pts_[a], &pb = pts_[b], &pc = pts_[c];
-    const std::size_t x0 = column({std::min({pa.x, pb.x, pc.x}), 0}), x1 = column({std::max({pa.x, pb.x, pc.x}), 0});
-    const std::size_t y0 = row({0, std::min({pa.y, pb.y, pc.y})}), y1 = row({0, std::max({pa.y, pb.y, pc.y})});
+    const std::size_t x0 = column(std::min({pa.x, pb.x, pc.x})), x1 = column(std::max({pa.x, pb.x, pc.x}));
+    const std::size_t y0 = row(std::min({pa.y, pb.y, pc.y})), y1 = row(std::max({pa.y, pb.y, pc.y}));
     for (std::size_t y = y0; y <= y1; ++y)
       for (std::uint32_t k = first_[y * columns_ + x0]; k < first_[y * columns_ + x1 + 1]; ++k) {
         const std::uint32_t j = items_[k];
@@ -209,9 +209,9 @@ class VertexGrid {
     const double t = (v - lo) / (hi - lo) * static_cast<double>(cells);
     return std::min(cells - 1, static_cast<std::size_t>(std::max(0.0, t)));
   }
-  std::size_t column(const P2& p) const { return along(p.x, lo_.x, hi_.x, columns_); }
-  std::size_t row(const P2& p) const { return along(p.y, lo_.y, hi_.y, rows_); }
-  std::size_t cell(const P2& p) const { return row(p) * columns_ + column(p); }
+  std::size_t column(double x) const { return along(x, lo_.x, hi_.x, columns_); }
+  std::size_t row(double y) const { return along(y, lo_.y, hi_.y, rows_); }
+  std::size_t cell(const P2& p) const { return row(p.y) * columns_ + column(p.x); }
 
   const std::vector<P2>& pts_;
   std::vector<bool> removed_;
