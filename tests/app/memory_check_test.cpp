@@ -9,7 +9,6 @@
 #include <filesystem>
 #include <fstream>
 #include <optional>
-#include <sstream>
 #include <string>
 #include <utility>
 
@@ -149,10 +148,7 @@ TEST(MemoryCheck, TheLimitIsTheLeastOfPhysicalMemoryControlGroupAndAddressSpace)
   using Source = app::MemoryLimit::Source;
   app::MemoryLimit expected{static_cast<std::uint64_t>(sysconf(_SC_PHYS_PAGES)) * sysconf(_SC_PAGE_SIZE),
                             Source::machine};
-  std::ifstream membership_file("/proc/self/cgroup");
-  std::ostringstream membership;
-  membership << membership_file.rdbuf();
-  const auto group = app::cgroup_memory_limit("/sys/fs/cgroup", membership.str());
+  const auto group = app::cgroup_memory_limit("/sys/fs/cgroup", test::read_file("/proc/self/cgroup"));
   if (group && *group < expected.bytes) expected = {*group, Source::control_group};
   rlimit space{};
   ASSERT_EQ(getrlimit(RLIMIT_AS, &space), 0);

@@ -443,8 +443,8 @@ TEST(Deadlock, DetectedInARingNamingEveryProcess) {
   EXPECT_EQ(unwound.load(), n);
 }
 
-// Four threads; on threads 1-3 a process waits on a channel of its own
-// (`waiters`), while on thread 0 "ping" sends `exchanges` values to "pong".
+// Four threads; on threads 1-3 a process ("waiter") waits on a channel of
+// its own, while on thread 0 "ping" sends `exchanges` values to "pong".
 // ping then writes every waiter's channel if `release`, or both end by
 // reading channels nobody writes. Should the run hang, a watchdog poisons
 // every channel after a while, so the test fails rather than hangs.
