@@ -694,21 +694,30 @@ TEST(Priority, LowPriorityProcessesOnTwoThreadsDeliverEverything) {
   EXPECT_EQ(sum, long{count} * (count + 1) / 2);
 }
 
-// Thread 1 waits 30 ms for thread 0, which computes meanwhile: the waiting
-// shows as idle time on thread 1, the computing as busy time on thread 0.
+// Thread 1 waits for thread 0, which computes meanwhile: the waiting shows
+// as idle time on thread 1, the computing as busy time on thread 0. Thread 0
+// computes until 30 ms after thread 1 is about to wait, so however late a
+// loaded machine wakes thread 1 after the first message, it then waits for
+// 30 ms less the few instructions between its clock reading and its wait.
 TEST(Runtime, ThreadUseCountsTimeWithNothingToRun) {
+  using Clock = std::chrono::steady_clock;
   csp::Channel<int> started("started");
   csp::Channel<int> done("done");
+  std::atomic<Clock::rep> about_to_wait{0};
   csp::Runtime rt(2);
-  rt.spawn("busy", 0, [in = started.reader(), out = done.writer()]() mutable {
+  rt.spawn("busy", 0, [in = started.reader(), out = done.writer(), &about_to_wait]() mutable {
     in.read();
-    const auto until = std::chrono::steady_clock::now() + 30ms;
-    while (std::chrono::steady_clock::now() < until) {
+    Clock::rep since;
+    while ((since = about_to_wait.load()) == 0) {
+    }
+    const auto until = Clock::time_point(Clock::duration(since)) + 30ms;
+    while (Clock::now() < until) {
     }
     out.write(1);
   });
-  rt.spawn("waiting", 1, [out = started.writer(), in = done.reader()]() mutable {
+  rt.spawn("waiting", 1, [out = started.writer(), in = done.reader(), &about_to_wait]() mutable {
     out.write(1);
+    about_to_wait.store(Clock::now().time_since_epoch().count());
     in.read();
   });
   rt.run();
