@@ -29,7 +29,7 @@ ExperimentPoint run_point(const tracer::Database& db, const ExperimentSetup& set
   const tracer::RayStats rays = r.rays();
   const nodes::SvmStats svm = r.svm();
   p.rays = rays.rays();
-  p.page_accesses = svm.accesses;
+  p.page_accesses = svm.accesses();
   p.misses = svm.misses;
   p.miss_ratio = svm.miss_ratio();
   p.pages_per_pixel = rays.pages_per_sample();

@@ -94,7 +94,7 @@ viz::KeyValueTable machine_statistics(const nodes::MachineReport& r) {
             {"cache per node (pages)", std::to_string(r.cache_pages)},
             {"database pages", std::to_string(r.page_count) + " of " + std::to_string(r.page_size) + " bytes"},
             {"rays", std::to_string(rays.rays())},
-            {"page accesses", std::to_string(svm.accesses)},
+            {"page accesses", std::to_string(svm.accesses())},
             {"page requests (misses)", std::to_string(svm.misses)},
             {"miss ratio", fixed(100 * svm.miss_ratio(), 3) + "%"},
             {"pages served", std::to_string(r.served().pages_served)},

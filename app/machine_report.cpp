@@ -22,7 +22,7 @@ constexpr std::size_t kTableNodes = 16;
 
 void print_node_row(std::ostream& out, std::size_t n, const nodes::NodeReport& r) {
   out << "  " << std::setw(5) << n << std::setw(10) << r.work.items << std::setw(12)
-      << r.work.rays.rays() << std::setw(12) << r.svm.accesses << std::setw(10) << r.svm.misses
+      << r.work.rays.rays() << std::setw(12) << r.svm.accesses() << std::setw(10) << r.svm.misses
       << std::setw(11) << r.svm.miss_ratio() << std::setw(10) << r.served.pages_served << "\n";
 }
 
@@ -49,7 +49,7 @@ void print_per_node(std::ostream& out, const nodes::MachineReport& r, const char
 }
 
 void json_svm(std::ostream& out, const nodes::SvmStats& s) {
-  out << "{\"accesses\": " << s.accesses << ", \"local_hits\": " << s.own_hits
+  out << "{\"accesses\": " << s.accesses() << ", \"local_hits\": " << s.own_hits
       << ", \"cache_hits\": " << s.cache_hits << ", \"misses\": " << s.misses
       << ", \"coalesced\": " << s.coalesced << ", \"miss_ratio\": " << s.miss_ratio() << "}";
 }
@@ -132,7 +132,7 @@ void print_machine_report(std::ostream& out, const MachineSummary& m) {
   if (const std::uint32_t used = largest_cache(r); used < r.cache_pages)
     out << ", holding every remote page (at most " << used << ")";
   out << "\n"
-      << std::setprecision(4) << "svm            " << svm.accesses << " page accesses: "
+      << std::setprecision(4) << "svm            " << svm.accesses() << " page accesses: "
       << svm.own_hits << " local, " << svm.cache_hits << " cache hits, " << svm.misses << " misses (" << svm.coalesced
       << " coalesced), miss ratio " << svm.miss_ratio() << "\n"
       << "page traffic   " << served.pages_served << " page communications, "

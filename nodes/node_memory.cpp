@@ -48,47 +48,53 @@ std::uint32_t PagePlacement::own_count(int node) const {
 
 NodeMemory::NodeMemory(const PagePlacement& placement, int node, std::size_t page_size,
                        std::vector<std::vector<std::byte>> own_pages, std::uint32_t cache_pages)
-    : page_size_(page_size), own_(std::move(own_pages)), entry_(placement.page_count(), -1) {
-  const std::uint32_t own = placement.own_count(node);
-  if (own_.size() != own) throw std::logic_error("node " + std::to_string(node) + " given the wrong number of own pages");
-  for (const auto& page : own_)
-    if (page.size() != page_size) throw std::logic_error("own page of the wrong size");
-  for (std::uint32_t i = 0; i < own; ++i) entry_[placement.page_of(node, i)] = static_cast<std::int32_t>(i);
+    : page_size_(page_size),
+      own_count_(placement.own_count(node)),
+      own_(std::make_unique<std::byte[]>(own_count_ * page_size)),
+      entry_(placement.page_count(), -1) {
+  if (own_pages.size() != own_count_)
+    throw std::logic_error("node " + std::to_string(node) + " given the wrong number of own pages");
+  for (std::size_t i = 0; i < own_count_; ++i) {
+    if (own_pages[i].size() != page_size) throw std::logic_error("own page of the wrong size");
+    std::memcpy(own_.get() + i * page_size, own_pages[i].data(), page_size);
+    std::vector<std::byte>().swap(own_pages[i]);
+    entry_[placement.page_of(node, static_cast<std::uint32_t>(i))] = static_cast<std::int32_t>(i);
+  }
   // More slots than remote pages could never be filled.
-  capacity_ = std::min(cache_pages, placement.page_count() - own);
+  capacity_ = std::min(cache_pages, placement.page_count() - static_cast<std::uint32_t>(own_count_));
   slots_.reserve(capacity_);
-  last_use_.assign(capacity_, 0);
-  pins_.assign(capacity_, 0);
-  slot_page_.assign(capacity_, 0);
+  slot_storage_.reserve(capacity_);
 }
 
-int NodeMemory::take_slot() {
+int NodeMemory::take_slot(std::span<const int> in_use) {
   if (slots_.size() < capacity_) {
-    slots_.push_back(std::make_unique<std::byte[]>(page_size_));
+    slot_storage_.push_back(std::make_unique<std::byte[]>(page_size_));
+    slots_.push_back(Slot{slot_storage_.back().get(), 0, 0});
     return static_cast<int>(slots_.size() - 1);
   }
   int victim = -1;
   std::uint64_t oldest = std::numeric_limits<std::uint64_t>::max();
   for (std::size_t s = 0; s < slots_.size(); ++s)
-    if (last_use_[s] < oldest && pins_[s] == 0) {
-      oldest = last_use_[s];
+    if (slots_[s].last_use < oldest && std::find(in_use.begin(), in_use.end(), static_cast<int>(s)) == in_use.end()) {
+      oldest = slots_[s].last_use;
       victim = static_cast<int>(s);
     }
-  if (victim < 0) throw std::logic_error("page cache: every slot is pinned");
-  entry_[slot_page_[static_cast<std::size_t>(victim)]] = -1;
+  if (victim < 0) throw std::logic_error("page cache: every slot is in use");
+  entry_[slots_[static_cast<std::size_t>(victim)].page] = -1;
   ++evictions_;
   return victim;
 }
 
-int NodeMemory::install(std::uint32_t page, std::span<const std::byte> bytes) {
+int NodeMemory::install(std::uint32_t page, std::span<const std::byte> bytes, std::span<const int> in_use) {
   if (bytes.size() != page_size_) throw std::runtime_error("page " + std::to_string(page) + " arrived with a wrong size");
   if (entry_[page] != -1) throw std::logic_error("page " + std::to_string(page) + " installed twice");
   if (capacity_ == 0) throw std::logic_error("page cache has no slot for remote page " + std::to_string(page));
-  const int slot = take_slot();
-  std::memcpy(slots_[static_cast<std::size_t>(slot)].get(), bytes.data(), page_size_);
-  slot_page_[static_cast<std::size_t>(slot)] = page;
+  const int slot = take_slot(in_use);
+  Slot& s = slots_[static_cast<std::size_t>(slot)];
+  std::memcpy(s.bytes, bytes.data(), page_size_);
+  s.page = page;
   entry_[page] = -2 - slot;
-  touch(slot);
+  use(slot);
   return slot;
 }
 

@@ -8,15 +8,18 @@
 //
 // Invariants:
 //  - entry_[p] says where page p lives on this node, so one array load
-//    answers every access: >= 0 own page (its index in own_), -1 not here,
-//    <= -2 cache slot (-2 - entry).
-//  - each occupied slot carries the time of its last use, a counter that
-//    every touch and install advances, so stamps are distinct and order the
-//    slots exactly as an LRU list would. A touch is one store, which keeps
-//    the hit path short; only an install into a full cache pays, scanning
-//    the slots for the oldest unpinned one (O(capacity), once per miss).
-//  - a pinned slot is never evicted: a worker pins the slot whose bytes it
-//    is using, so another worker of the node cannot pull them away.
+//    answers every access: >= 0 own page (its index among the own pages,
+//    which lie end to end in one block), -1 not here, <= -2 cache slot
+//    (-2 - entry).
+//  - each occupied slot carries its bytes' address and the time of its last
+//    use side by side, so a hit reads and stamps one record. The time is a
+//    counter that every use and install advances, so stamps are distinct and
+//    order the slots exactly as an LRU list would. Only an install into a
+//    full cache pays, scanning the slots for the oldest one not in use
+//    (O(capacity), once per miss).
+//  - a slot named in install()'s `in_use` is never evicted: the node's
+//    workers each name the slot whose bytes they are using, so one worker's
+//    install cannot pull them away from another.
 //  - resident bytes = own pages + occupied slots; slots are allocated on
 //    first use and never exceed the cache capacity.
 // A node's workers are fibers on one OS thread and run one at a time, and no
@@ -56,8 +59,9 @@ class PagePlacement {
 
 class NodeMemory {
  public:
-  // own_pages: own_count(node) pages of page_size bytes, in own_index order,
-  // moved in (the host keeps no copy).
+  // own_pages: own_count(node) pages of page_size bytes, in own_index order;
+  // each is freed as soon as it is copied into the node's own block, so the
+  // host keeps no copy.
   NodeMemory(const PagePlacement& placement, int node, std::size_t page_size,
              std::vector<std::vector<std::byte>> own_pages, std::uint32_t cache_pages);
 
@@ -65,17 +69,22 @@ class NodeMemory {
   static bool is_slot(std::int32_t entry) { return entry <= -2; }
   static int slot_of_entry(std::int32_t entry) { return -2 - entry; }
 
-  const std::byte* own_page(std::int32_t index) const { return own_[static_cast<std::size_t>(index)].data(); }
-  const std::byte* slot_bytes(int slot) const { return slots_[static_cast<std::size_t>(slot)].get(); }
+  const std::byte* own_page(std::int32_t index) const {
+    return own_.get() + static_cast<std::size_t>(index) * page_size_;
+  }
+  const std::byte* slot_bytes(int slot) const { return slots_[static_cast<std::size_t>(slot)].bytes; }
 
-  void touch(int slot) { last_use_[static_cast<std::size_t>(slot)] = ++clock_; }  // make most recently used
-  void pin(int slot) { ++pins_[static_cast<std::size_t>(slot)]; }
-  void unpin(int slot) { --pins_[static_cast<std::size_t>(slot)]; }
+  // The slot's bytes, making it the most recently used.
+  const std::byte* use(int slot) {
+    Slot& s = slots_[static_cast<std::size_t>(slot)];
+    s.last_use = ++clock_;
+    return s.bytes;
+  }
 
   // Copies a fetched remote page into a free slot or the least recently
-  // used unpinned one, and returns that slot. Throws std::logic_error if
-  // every slot is pinned (cannot happen: see svm.hpp).
-  int install(std::uint32_t page, std::span<const std::byte> bytes);
+  // used one not named in `in_use`, and returns that slot. Throws
+  // std::logic_error if every slot is in use (cannot happen: see svm.hpp).
+  int install(std::uint32_t page, std::span<const std::byte> bytes, std::span<const int> in_use = {});
 
   // Miss coalescing: begin_fetch is true for the first worker to miss on a
   // page (it fetches); later ones add_waiter and are woken by the fetcher
@@ -86,21 +95,26 @@ class NodeMemory {
 
   std::uint32_t cache_capacity() const { return capacity_; }
   std::size_t page_size() const { return page_size_; }
-  std::size_t own_bytes() const { return own_.size() * page_size_; }
-  std::size_t resident_bytes() const { return (own_.size() + slots_.size()) * page_size_; }
+  std::size_t own_bytes() const { return own_count_ * page_size_; }
+  std::size_t resident_bytes() const { return (own_count_ + slots_.size()) * page_size_; }
   std::uint64_t evictions() const { return evictions_; }
 
  private:
-  int take_slot();
+  struct Slot {
+    std::byte* bytes;
+    std::uint64_t last_use;  // clock_ at its last use or install
+    std::uint32_t page;
+  };
+
+  int take_slot(std::span<const int> in_use);
 
   std::size_t page_size_;
   std::uint32_t capacity_;
-  std::vector<std::vector<std::byte>> own_;
+  std::size_t own_count_;
+  std::unique_ptr<std::byte[]> own_;  // own_count_ pages end to end
   std::vector<std::int32_t> entry_;
-  std::vector<std::unique_ptr<std::byte[]>> slots_;  // stable addresses
-  std::vector<std::uint32_t> slot_page_;
-  std::vector<std::uint64_t> last_use_;  // per slot: clock_ at its last touch or install
-  std::vector<int> pins_;
+  std::vector<Slot> slots_;
+  std::vector<std::unique_ptr<std::byte[]>> slot_storage_;  // slots_[s].bytes points into [s]
   std::uint64_t clock_ = 0;
   std::uint64_t evictions_ = 0;
   std::unordered_map<std::uint32_t, std::vector<int>> pending_;  // page -> waiting workers

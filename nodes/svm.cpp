@@ -8,7 +8,6 @@
 namespace nodes {
 
 SvmStats& SvmStats::operator+=(const SvmStats& o) {
-  accesses += o.accesses;
   own_hits += o.own_hits;
   cache_hits += o.cache_hits;
   misses += o.misses;
@@ -17,7 +16,8 @@ SvmStats& SvmStats::operator+=(const SvmStats& o) {
 }
 
 double SvmStats::miss_ratio() const {
-  return accesses == 0 ? 0.0 : static_cast<double>(misses + coalesced) / static_cast<double>(accesses);
+  const std::uint64_t all = accesses();
+  return all == 0 ? 0.0 : static_cast<double>(misses + coalesced) / static_cast<double>(all);
 }
 
 SvmSource::SvmSource(NodeSvm& node, int worker, PageFetch fetch)
@@ -28,7 +28,6 @@ SvmSource::SvmSource(NodeSvm& node, int worker, PageFetch fetch)
       wake_("svm wake " + std::to_string(worker), 1) {}
 
 const std::byte* SvmSource::page(tracer::PageId id) {
-  ++stats_.accesses;
   const std::int32_t entry = memory_.entry(id);
   if (entry >= 0) {
     ++stats_.own_hits;
@@ -40,21 +39,6 @@ const std::byte* SvmSource::page(tracer::PageId id) {
     return from_slot(NodeMemory::slot_of_entry(entry));
   }
   return miss(id);
-}
-
-void SvmSource::release() {
-  if (pinned_ >= 0) memory_.unpin(pinned_);
-  pinned_ = -1;
-}
-
-const std::byte* SvmSource::from_slot(int slot) {
-  if (slot != pinned_) {
-    release();
-    memory_.pin(slot);
-    pinned_ = slot;
-  }
-  memory_.touch(slot);
-  return memory_.slot_bytes(slot);
 }
 
 const std::byte* SvmSource::miss(tracer::PageId id) {
@@ -81,7 +65,7 @@ const std::byte* SvmSource::fetch_and_install(tracer::PageId id) {
     throw std::logic_error("asked for page " + std::to_string(id) + ", got page " +
                            std::to_string(page_reply_id(reply)));
   // Pin before waking anyone, so the page stays until this worker moves on.
-  const std::byte* bytes = from_slot(memory_.install(id, page_reply_bytes(reply)));
+  const std::byte* bytes = from_slot(node_.install(id, page_reply_bytes(reply)));
   for (int waiter : memory_.end_fetch(id)) node_.worker(waiter).wake_.writer().write(1);
   return bytes;
 }
@@ -89,6 +73,13 @@ const std::byte* SvmSource::fetch_and_install(tracer::PageId id) {
 SvmSource& NodeSvm::add_worker(PageFetch fetch) {
   workers_.push_back(std::make_unique<SvmSource>(*this, worker_count(), std::move(fetch)));
   return *workers_.back();
+}
+
+int NodeSvm::install(std::uint32_t page, std::span<const std::byte> bytes) {
+  pinned_.clear();
+  for (const auto& w : workers_)
+    if (w->pinned_ >= 0) pinned_.push_back(w->pinned_);
+  return memory_.install(page, bytes, pinned_);
 }
 
 SvmStats NodeSvm::stats() const {

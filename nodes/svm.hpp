@@ -13,13 +13,17 @@
 // fetcher writes once p is installed; the woken worker looks p up again
 // (and fetches it itself if it was evicted in between).
 //
-// Page lifetime: a worker pins the cache slot it last returned, so another
-// worker's install never evicts bytes still in use (the page() contract is
-// "valid until the next page() call on this source"). A worker drops its pin
-// before it blocks — at a miss, and by release() before it talks to the
-// farmer or collector. Since a node's fibers share one OS thread and only
-// the running fiber can hold a pin it is using, an installing worker always
-// finds an unpinned slot.
+// Page lifetime: a worker's pin is the cache slot it last returned, so
+// another worker's install never evicts bytes still in use (the page()
+// contract is "valid until the next page() call on this source"): an install
+// passes the node's pinned slots to NodeMemory, which evicts none of them. A
+// worker drops its pin before it blocks — at a miss, and by release() before
+// it talks to the farmer or collector. Since a node's fibers share one OS
+// thread and only the running fiber can hold a pin it is using, an
+// installing worker always finds a slot no one has pinned.
+//
+// A pin is one store into the worker's own source, so a cache hit costs a
+// table load, a stamp of the slot's last use and that store.
 #pragma once
 
 #include <cstdint>
@@ -38,13 +42,14 @@ namespace nodes {
 // arrives, and returns it.
 using PageFetch = std::function<std::vector<std::byte>(std::uint32_t page)>;
 
+// Every access ends in exactly one of the four counts.
 struct SvmStats {
-  std::uint64_t accesses = 0;
   std::uint64_t own_hits = 0;
   std::uint64_t cache_hits = 0;
   std::uint64_t misses = 0;     // page requests sent (page communications)
   std::uint64_t coalesced = 0;  // misses served by another worker's pending request
 
+  std::uint64_t accesses() const { return own_hits + cache_hits + misses + coalesced; }
   SvmStats& operator+=(const SvmStats& o);
   // Accesses not answered by own pages or the cache, over all accesses.
   double miss_ratio() const;
@@ -57,13 +62,16 @@ class SvmSource final : public tracer::PageSource {
   SvmSource(NodeSvm& node, int worker, PageFetch fetch);
 
   const std::byte* page(tracer::PageId id) override;
-  void release();  // drop the pin: call before blocking outside page()
+  void release() { pinned_ = -1; }  // drop the pin: call before blocking outside page()
   const SvmStats& stats() const { return stats_; }
 
  private:
   friend class NodeSvm;
   const std::byte* miss(tracer::PageId id);
-  const std::byte* from_slot(int slot);
+  const std::byte* from_slot(int slot) {
+    pinned_ = slot;
+    return memory_.use(slot);
+  }
   const std::byte* fetch_and_install(tracer::PageId id);
 
   NodeSvm& node_;
@@ -92,8 +100,12 @@ class NodeSvm {
 
  private:
   friend class SvmSource;
+  // Installs a fetched page where no worker's pin is.
+  int install(std::uint32_t page, std::span<const std::byte> bytes);
+
   NodeMemory memory_;
   std::vector<std::unique_ptr<SvmSource>> workers_;
+  std::vector<int> pinned_;  // scratch for install()
 };
 
 }  // namespace nodes

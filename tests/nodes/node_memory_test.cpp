@@ -1,6 +1,6 @@
 // Own pages, page placement and the LRU page cache of one processor, driven
-// directly (no fibers): placement covers every page once, LRU order, pinning
-// and miss coalescing bookkeeping.
+// directly (no fibers): placement covers every page once, LRU order, slots
+// in use kept from eviction, and miss coalescing bookkeeping.
 #include "nodes/node_memory.hpp"
 
 #include <gtest/gtest.h>
@@ -80,7 +80,7 @@ TEST(NodeMemory, EvictsLeastRecentlyUsed) {
   NodeMemory memory(placement, 0, page_size, own_pages(placement, 0), 2);
   const int a = memory.install(1, page_bytes(1));
   memory.install(3, page_bytes(3));
-  memory.touch(a);  // page 1 is now more recent than page 3
+  EXPECT_EQ(memory.use(a)[0], std::byte{1});  // page 1 is now more recent than page 3
   memory.install(5, page_bytes(5));
   EXPECT_TRUE(NodeMemory::is_slot(memory.entry(1)));
   EXPECT_EQ(memory.entry(3), -1);
@@ -89,42 +89,42 @@ TEST(NodeMemory, EvictsLeastRecentlyUsed) {
   EXPECT_EQ(memory.evictions(), 1u);
 }
 
-TEST(NodeMemory, PinnedSlotIsNeverEvicted) {
+TEST(NodeMemory, SlotInUseIsNeverEvicted) {
   const PagePlacement placement(Distribution::modulo, 2, 10);
   NodeMemory memory(placement, 0, page_size, own_pages(placement, 0), 2);
   const int old_slot = memory.install(1, page_bytes(1));
   memory.install(3, page_bytes(3));
-  memory.pin(old_slot);  // page 1 is least recently used but in use
-  memory.install(5, page_bytes(5));
-  memory.install(7, page_bytes(7));
+  const std::vector<int> in_use{old_slot};  // page 1 is least recently used but in use
+  memory.install(5, page_bytes(5), in_use);
+  memory.install(7, page_bytes(7), in_use);
   EXPECT_TRUE(NodeMemory::is_slot(memory.entry(1)));
   EXPECT_EQ(memory.slot_bytes(old_slot)[0], std::byte{1});
-  memory.unpin(old_slot);
   memory.install(9, page_bytes(9));
   EXPECT_EQ(memory.entry(1), -1);
 }
 
-// A long random run of installs, touches and pins against a plain list kept
-// in recency order: the cache must hold exactly the pages the list says.
+// A long random run of installs and uses, with slots taken in and out of use,
+// against a plain list kept in recency order: the cache must hold exactly
+// the pages the list says.
 TEST(NodeMemory, MatchesAListKeptInRecencyOrder) {
   constexpr std::uint32_t pages = 200, capacity = 7;
   const PagePlacement placement(Distribution::modulo, 2, pages);
   NodeMemory memory(placement, 0, page_size, own_pages(placement, 0), capacity);
   std::list<std::uint32_t> recency;  // cached pages, most recent first
-  std::vector<int> pins(capacity, 0);
+  std::vector<int> in_use;
   std::mt19937 random(5);
   for (int step = 0; step < 20000; ++step) {
     const std::uint32_t page = 2 * (random() % (pages / 2)) + 1;  // node 1's pages
     const std::int32_t entry = memory.entry(page);
     if (NodeMemory::is_slot(entry)) {
       const int slot = NodeMemory::slot_of_entry(entry);
-      memory.touch(slot);
+      ASSERT_EQ(memory.use(slot)[0], static_cast<std::byte>(page));
       recency.remove(page);
       recency.push_front(page);
-      if (random() % 4 == 0) {  // pin or unpin, keeping one slot free to evict
-        const bool may_pin = std::count_if(pins.begin(), pins.end(), [](int n) { return n > 0; }) + 1 < int{capacity};
-        if (pins[slot] > 0) memory.unpin(slot), --pins[slot];
-        else if (may_pin) memory.pin(slot), ++pins[slot];
+      if (random() % 4 == 0) {  // into or out of use, keeping one slot free to evict
+        const auto it = std::find(in_use.begin(), in_use.end(), slot);
+        if (it != in_use.end()) in_use.erase(it);
+        else if (in_use.size() + 1 < capacity) in_use.push_back(slot);
       }
       continue;
     }
@@ -132,10 +132,10 @@ TEST(NodeMemory, MatchesAListKeptInRecencyOrder) {
     if (recency.size() == capacity) {
       auto victim = recency.end();
       do --victim;
-      while (pins[NodeMemory::slot_of_entry(memory.entry(*victim))] > 0);
+      while (std::count(in_use.begin(), in_use.end(), NodeMemory::slot_of_entry(memory.entry(*victim))) > 0);
       recency.erase(victim);
     }
-    memory.install(page, page_bytes(page));
+    memory.install(page, page_bytes(page), in_use);
     recency.push_front(page);
     for (std::uint32_t p = 1; p < pages; p += 2)
       ASSERT_EQ(NodeMemory::is_slot(memory.entry(p)), std::find(recency.begin(), recency.end(), p) != recency.end())
@@ -144,11 +144,11 @@ TEST(NodeMemory, MatchesAListKeptInRecencyOrder) {
   EXPECT_GT(memory.evictions(), 1000u);
 }
 
-TEST(NodeMemory, AllSlotsPinnedIsAnError) {
+TEST(NodeMemory, AllSlotsInUseIsAnError) {
   const PagePlacement placement(Distribution::modulo, 2, 10);
   NodeMemory memory(placement, 0, page_size, own_pages(placement, 0), 1);
-  memory.pin(memory.install(1, page_bytes(1)));
-  EXPECT_THROW(memory.install(3, page_bytes(3)), std::logic_error);
+  const std::vector<int> in_use{memory.install(1, page_bytes(1))};
+  EXPECT_THROW(memory.install(3, page_bytes(3), in_use), std::logic_error);
 }
 
 TEST(NodeMemory, ResidentBytesNeverExceedOwnShareAndCache) {
