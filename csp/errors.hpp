@@ -1,6 +1,7 @@
 // Exceptions of the CSP runtime.
-// Poisoned ends a process normally (it is how a network shuts down); Deadlock
-// and ProcessesFailed are what Runtime::run() reports when a run goes wrong.
+// Poisoned ends a process normally (it is how a network shuts down); Deadlock,
+// ProcessesFailed and ProcessNotStarted are what Runtime::run() reports when
+// a run goes wrong.
 #pragma once
 
 #include <stdexcept>
@@ -24,6 +25,14 @@ struct Deadlock : std::runtime_error {
 // what() holds the first failure followed by a summary of the others.
 struct ProcessesFailed : std::runtime_error {
   explicit ProcessesFailed(const std::string& summary) : std::runtime_error(summary) {}
+};
+
+// Thrown by Runtime::run() when a spawned process could not start (no
+// memory for its stack): what() names the first and counts the others. The
+// processes that waited for it were unwound, as in a deadlock, which this
+// error reports in its place, being the cause.
+struct ProcessNotStarted : std::runtime_error {
+  explicit ProcessNotStarted(const std::string& what) : std::runtime_error(what) {}
 };
 
 }  // namespace csp

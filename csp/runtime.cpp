@@ -4,6 +4,7 @@
 #include <boost/fiber/fiber.hpp>
 #include <boost/fiber/operations.hpp>
 #include <barrier>
+#include <condition_variable>
 #include <exception>
 #include <mutex>
 #include <stdexcept>
@@ -47,6 +48,18 @@ std::string message_of(const std::exception_ptr& e) {
   throw ProcessesFailed(text);
 }
 
+// Appends a failure; with no memory left to hold it, counts it instead: the
+// callers run where an exception would end the program (a fiber's end, a
+// runtime thread's loop).
+void note_failure(std::vector<Failure>& list, std::size_t& lost, const std::string& process,
+                  std::exception_ptr error) noexcept {
+  try {
+    list.push_back({process, std::move(error)});
+  } catch (...) {
+    ++lost;
+  }
+}
+
 enum class Ending { normal, poisoned, deadlock, failed };
 
 Ending run_body(const std::function<void()>& body, std::exception_ptr& error) {
@@ -77,6 +90,31 @@ boost::fibers::fiber start_fiber(std::size_t stack_size, std::function<void()> f
 }
 
 }  // namespace
+
+// Holds the runtime threads until every one of them exists, so that a thread
+// the system cannot create abandons the run before any process starts.
+class StartGate {
+ public:
+  void open(bool go) {
+    {
+      std::lock_guard<std::mutex> lk(mutex_);
+      state_ = go ? State::go : State::abandoned;
+    }
+    opened_.notify_all();
+  }
+  // True: run; false: the run is abandoned.
+  bool wait() {
+    std::unique_lock<std::mutex> lk(mutex_);
+    opened_.wait(lk, [this] { return state_ != State::closed; });
+    return state_ == State::go;
+  }
+
+ private:
+  enum class State { closed, go, abandoned };
+  std::mutex mutex_;
+  std::condition_variable opened_;
+  State state_ = State::closed;
+};
 
 // A process placed on a thread but not started yet.
 struct Spawn {
@@ -135,8 +173,10 @@ struct Runtime::Impl {
     }
   }
 
-  void worker_main(unsigned index, std::barrier<>& finished);
+  void worker_main(unsigned index, detail::StartGate& gate, std::barrier<>& finished);
+  void launch_all(std::vector<Spawn>& batch, std::vector<boost::fibers::fiber>& fibers);
   boost::fibers::fiber launch(Spawn s);
+  void not_started(Process& p, std::exception_ptr error);
   void run_process(Process& p, const std::function<void()>& body);
 
   RuntimeOptions options;
@@ -146,12 +186,16 @@ struct Runtime::Impl {
   std::vector<std::chrono::steady_clock::duration> idle;
   detail::Tracker tracker;
   std::mutex failures_mutex;
-  std::vector<Failure> failures;  // guarded by failures_mutex
+  std::vector<Failure> failures;     // guarded by failures_mutex
+  std::vector<Failure> unstarted;    // guarded by failures_mutex
+  std::size_t lost_failures = 0;     // guarded by failures_mutex: failed, no memory to say why
+  std::size_t lost_unstarted = 0;    // guarded by failures_mutex
   bool started = false;
   bool finished = false;  // every thread has exited: nothing can start any more
 };
 
-void Runtime::Impl::worker_main(unsigned index, std::barrier<>& finished) {
+void Runtime::Impl::worker_main(unsigned index, detail::StartGate& gate, std::barrier<>& finished) {
+  if (!gate.wait()) return;
   const auto started = std::chrono::steady_clock::now();
   Scheduler* algo =
       options.scheduler
@@ -174,7 +218,7 @@ void Runtime::Impl::worker_main(unsigned index, std::barrier<>& finished) {
     w.inbox.clear();
     stop = w.stop;
     lk.unlock();
-    for (Spawn& s : batch) fibers.push_back(launch(std::move(s)));
+    launch_all(batch, fibers);
   }
   for (boost::fibers::fiber& f : fibers) f.join();
   use[index].seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
@@ -184,6 +228,30 @@ void Runtime::Impl::worker_main(unsigned index, std::barrier<>& finished) {
   // to finish its fibers first.
   finished.arrive_and_wait();
   detail::set_thread_scheduler(nullptr);
+}
+
+// A process that cannot start (no memory for its stack) is recorded and no
+// longer counted alive, so the run still ends: whoever waits for it is
+// unwound as in a deadlock, and run() reports the failed start instead.
+void Runtime::Impl::launch_all(std::vector<Spawn>& batch, std::vector<boost::fibers::fiber>& fibers) {
+  for (Spawn& s : batch) {
+    const std::shared_ptr<Process> p = s.process;
+    try {
+      // Room first: a joinable fiber must not be lost to a failed push_back.
+      if (fibers.size() == fibers.capacity()) fibers.reserve(2 * fibers.size() + batch.size());
+      fibers.push_back(launch(std::move(s)));
+    } catch (...) {
+      not_started(*p, std::current_exception());
+    }
+  }
+}
+
+void Runtime::Impl::not_started(Process& p, std::exception_ptr error) {
+  {
+    std::lock_guard<std::mutex> lk(failures_mutex);
+    detail::note_failure(unstarted, lost_unstarted, p.name, std::move(error));
+  }
+  tracker.remove(p);
 }
 
 boost::fibers::fiber Runtime::Impl::launch(Spawn s) {
@@ -196,7 +264,7 @@ void Runtime::Impl::run_process(Process& p, const std::function<void()>& body) {
   std::exception_ptr error;
   if (detail::run_body(body, error) == detail::Ending::failed) {
     std::lock_guard<std::mutex> lk(failures_mutex);
-    failures.push_back({p.name, error});
+    detail::note_failure(failures, lost_failures, p.name, error);
   }
   detail::bind_fiber(nullptr);
   tracker.remove(p);
@@ -228,13 +296,38 @@ void Runtime::run() {
     impl_->finished = true;
     return;
   }
+  const unsigned count = impl_->options.threads;
   std::vector<std::thread> threads;
-  std::barrier<> finished(impl_->options.threads);
-  for (unsigned i = 0; i < impl_->options.threads; ++i) {
-    threads.emplace_back([this, i, &finished] { impl_->worker_main(i, finished); });
+  detail::StartGate gate;
+  std::barrier<> finished(count);
+  try {
+    threads.reserve(count);
+    for (unsigned i = 0; i < count; ++i)
+      threads.emplace_back([this, i, &gate, &finished] { impl_->worker_main(i, gate, finished); });
+  } catch (const std::exception& e) {
+    gate.open(false);
+    for (std::thread& t : threads) t.join();
+    impl_->finished = true;
+    throw std::runtime_error("csp: could not start runtime thread " + std::to_string(threads.size() + 1) + " of " +
+                             std::to_string(count) + ", so no process ran: " + e.what());
   }
+  gate.open(true);
   for (std::thread& t : threads) t.join();
   impl_->finished = true;
+
+  if (impl_->lost_unstarted > 0 && impl_->unstarted.empty())
+    throw ProcessNotStarted(std::to_string(impl_->lost_unstarted) +
+                            " processes could not start, and no memory was left to record which");
+  if (!impl_->unstarted.empty()) {
+    const auto& first = impl_->unstarted.front();
+    const std::size_t more = impl_->unstarted.size() - 1 + impl_->lost_unstarted;
+    std::string text = "process '" + first.process + "' could not start: " + detail::message_of(first.error);
+    if (more > 0) text += " (and " + std::to_string(more) + " more processes)";
+    throw ProcessNotStarted(text);
+  }
+  if (impl_->lost_failures > 0 && impl_->failures.empty())
+    throw ProcessesFailed(std::to_string(impl_->lost_failures) +
+                          " processes failed, and no memory was left to record why");
 
   std::string dump = impl_->tracker.deadlock_dump();
   if (!dump.empty()) {
@@ -253,6 +346,7 @@ struct ParGroup {
   detail::Waiter* parent = nullptr;  // a parent process, parked until remaining == 0
   std::vector<Failure> failures;     // in the order the children ended
   std::vector<Failure> poisons;
+  std::size_t lost = 0;              // failed, and no memory was left to record why
   bool deadlock = false;
 };
 
@@ -265,8 +359,8 @@ void run_child(ParGroup& g, Process* child, const std::string& name, const std::
   detail::bind_fiber(nullptr);
   {
     detail::ChannelLock lk(g.lock);
-    if (e == detail::Ending::failed) g.failures.push_back({name, error});
-    if (e == detail::Ending::poisoned) g.poisons.push_back({name, error});
+    if (e == detail::Ending::failed) detail::note_failure(g.failures, g.lost, name, error);
+    if (e == detail::Ending::poisoned) detail::note_failure(g.poisons, g.lost, name, error);
     g.deadlock |= e == detail::Ending::deadlock;
     // Wake the parent before ending, so it is never counted blocked alone.
     if (--g.remaining == 0 && g.parent && detail::try_claim(*g.parent)) {
@@ -283,6 +377,8 @@ void par(std::vector<std::function<void()>> processes) {
   ParGroup g;
   g.remaining = processes.size();
   std::vector<boost::fibers::fiber> fibers;
+  fibers.reserve(processes.size());
+  std::string not_started;  // why a child could not start (none after it did)
   for (std::size_t i = 0; i < processes.size(); ++i) {
     std::shared_ptr<Process> child;
     std::string name = (parent ? parent->name : std::string("par")) + "." + std::to_string(i);
@@ -294,9 +390,18 @@ void par(std::vector<std::function<void()>> processes) {
       child->stack_size = parent->stack_size;
       parent->tracker->add(*child);
     }
-    fibers.push_back(detail::start_fiber(
-        parent ? parent->stack_size : RuntimeOptions{}.stack_size,
-        [&g, child, name, body = std::move(processes[i])] { run_child(g, child.get(), name, body); }));
+    try {
+      fibers.push_back(detail::start_fiber(
+          parent ? parent->stack_size : RuntimeOptions{}.stack_size,
+          [&g, child, name, body = std::move(processes[i])] { run_child(g, child.get(), name, body); }));
+    } catch (...) {
+      // The children started go on, and are waited for below: they use g.
+      not_started = "process '" + name + "' could not start: " + detail::message_of(std::current_exception());
+      if (child) parent->tracker->remove(*child);
+      detail::ChannelLock lk(g.lock);
+      g.remaining -= processes.size() - i;
+      break;
+    }
   }
   // A process parks, counted as blocked, until its children have ended.
   // Outside a Runtime nothing counts, and the joins below are the wait (the
@@ -314,8 +419,10 @@ void par(std::vector<std::function<void()>> processes) {
     }
   }
   for (boost::fibers::fiber& f : fibers) f.join();
+  if (!not_started.empty()) throw ProcessNotStarted(not_started);  // the cause of any deadlock below
   if (g.deadlock) detail::unwind_deadlock();
   if (!g.failures.empty()) detail::rethrow_failures(g.failures);
+  if (g.lost > 0) throw ProcessesFailed(std::to_string(g.lost) + " processes of a PAR failed, and no memory was left to record why");
   if (!g.poisons.empty()) std::rethrow_exception(g.poisons.front().error);
 }
 

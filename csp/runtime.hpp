@@ -53,7 +53,10 @@ class Runtime {
   void spawn(std::string name, unsigned thread, std::function<void()> body, Priority priority = Priority::high);
   // Runs every process to its end; once per Runtime. Rethrows a process's
   // exception (ProcessesFailed if several failed); Poisoned ends a process
-  // normally. Throws Deadlock listing the blocked processes.
+  // normally. Throws Deadlock listing the blocked processes;
+  // ProcessNotStarted if a process had no memory for its stack (those
+  // waiting for it unwound as in a deadlock); std::runtime_error, before any
+  // process starts, if a runtime thread cannot be created.
   void run();
   // After run(): one entry per thread.
   std::vector<ThreadUse> thread_use() const;

@@ -273,7 +273,12 @@ MachineResult run_machine(tracer::Database db, const MachineOptions& options) {
   host.owners.assign(items, 0);
   for (std::size_t n = 0; n < nodes.size(); ++n) spawn_node(wiring, static_cast<NodeId>(n), *nodes[n]);
   spawn_host(wiring, host);
-  runtime.run();
+  try {
+    runtime.run();
+  } catch (const csp::ProcessNotStarted& e) {
+    throw csp::ProcessNotStarted(std::string(e.what()) + "; a machine of " + std::to_string(topology.size()) +
+                                 " nodes needs more memory than this process may map (see ulimit -v)");
+  }
 
   MachineResult result;
   MachineReport& report = result.report;

@@ -5,9 +5,11 @@
 #include <unistd.h>
 
 #include <atomic>
+#include <cerrno>
 #include <fstream>
 #include <mutex>
-#include <new>
+#include <string>
+#include <system_error>
 #include <unordered_map>
 #include <vector>
 
@@ -80,7 +82,9 @@ boost::context::stack_context ProcessStack::allocate() {
   }
   guarded.fetch_sub(1, std::memory_order_relaxed);
   void* p = map(size_);
-  if (!p) throw std::bad_alloc();
+  if (!p)
+    throw std::system_error(errno, std::generic_category(),
+                            "no memory for a " + std::to_string(size_ / 1024) + " KB process stack");
   sctx.size = size_;
   sctx.sp = static_cast<char*>(p) + sctx.size;
   return sctx;

@@ -153,6 +153,26 @@ TEST_F(Cli, AnImageTooLargeForTheMemoryIsRefusedBeforeTheRender) {
   EXPECT_TRUE(fs::exists(dir_ / "out.png"));
 }
 
+// A machine whose process stacks do not fit in the address space this
+// process may map ends with one line naming a process that could not start:
+// the processes started before it, waiting for it, are unwound, not left to
+// hang, and nothing is written.
+TEST_F(Cli, AMachineTooLargeForTheAddressSpaceEndsWithAnError) {
+#if defined(__SANITIZE_ADDRESS__) || defined(__SANITIZE_THREAD__)
+  GTEST_SKIP() << "a sanitizer's shadow memory does not fit in 600 MB of address space";
+#endif
+  // 1024 nodes run about 4100 processes with 256 KB stacks: over 1 GB.
+  const Outcome r = run_vmpray("teapot --nodes 1024 --threads 2 --width 16 --height 16 -q -o out.png", "stdout.txt",
+                               "ulimit -v 600000");
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_EQ(lines(r.err), 1u) << r.err;
+  EXPECT_NE(r.err.find("could not start: no memory for a 256 KB process stack"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("a machine of 1024 nodes needs more memory than this process may map (see ulimit -v)"),
+            std::string::npos)
+      << r.err;
+  EXPECT_FALSE(fs::exists(dir_ / "out.png"));
+}
+
 // A signal that would end the command while it writes its outputs waits
 // until they are all in place (or all removed), then goes through.
 TEST(OutputPhase, HoldsAnInterruptUntilItEnds) {

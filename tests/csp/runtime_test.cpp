@@ -1,6 +1,8 @@
 // Runtime and PAR: placement, failures, poison shutdown, deadlock diagnosis,
 // blocking outside a Runtime.
 #include <gtest/gtest.h>
+#include <sys/resource.h>
+#include <unistd.h>
 
 #include <algorithm>
 #include <atomic>
@@ -279,6 +281,75 @@ TEST(Runtime, MoreProcessesThanGuardedStacksCouldNumberAllRun) {
   EXPECT_EQ(ran, processes);
   EXPECT_EQ(most_guarded, limit);
   EXPECT_EQ(csp::detail::ProcessStack::guarded_alive(), limit) << "ended processes' guarded stacks are kept";
+}
+
+// A process whose stack cannot be mapped (here none can: 128 TB is more than
+// the whole user address space) is reported by run(), which names it and
+// counts the others, instead of ending the program.
+TEST(Runtime, AProcessThatCannotStartIsReportedByRun) {
+  csp::RuntimeOptions options;
+  options.threads = 2;
+  options.stack_size = std::size_t{1} << 47;
+  csp::Runtime rt(options);
+  std::atomic<int> ran{0};
+  for (const char* name : {"first", "second", "third"}) rt.spawn(name, 0, [&] { ++ran; });
+  try {
+    rt.run();
+    FAIL() << "run() returned";
+  } catch (const csp::ProcessNotStarted& e) {
+    EXPECT_EQ(std::string(e.what()),
+              "process 'first' could not start: no memory for a 137438953472 KB process stack: Cannot allocate memory "
+              "(and 2 more processes)");
+  }
+  EXPECT_EQ(ran, 0);
+}
+
+// The address space this process may map, lowered for one test and then
+// restored.
+class AddressSpaceLimit {
+ public:
+  explicit AddressSpaceLimit(rlim_t bytes) {
+    getrlimit(RLIMIT_AS, &saved_);
+    rlimit lowered = saved_;
+    lowered.rlim_cur = bytes;
+    setrlimit(RLIMIT_AS, &lowered);
+  }
+  ~AddressSpaceLimit() { setrlimit(RLIMIT_AS, &saved_); }
+
+ private:
+  rlimit saved_{};
+};
+
+std::size_t mapped_bytes() {
+  std::ifstream statm("/proc/self/statm");
+  std::size_t pages = 0;
+  statm >> pages;
+  return pages * static_cast<std::size_t>(sysconf(_SC_PAGESIZE));
+}
+
+// A runtime thread the system cannot create (no room for its stack) makes
+// run() throw before any process starts, rather than end the program with
+// the threads it did create still running. Of 64 threads, at most the few
+// whose stacks the C library keeps for reuse can start within 4 MB more.
+TEST(Runtime, AThreadThatCannotBeCreatedAbandonsTheRunBeforeAnyProcess) {
+#if defined(__SANITIZE_ADDRESS__) || defined(__SANITIZE_THREAD__)
+  GTEST_SKIP() << "a sanitizer's shadow memory cannot run under a lowered address-space limit";
+#endif
+  csp::Runtime rt(64);
+  std::atomic<int> ran{0};
+  for (unsigned t = 0; t < 64; ++t) rt.spawn("p", t, [&] { ++ran; });
+  std::string error;
+  {
+    const AddressSpaceLimit limit(mapped_bytes() + 4 * 1024 * 1024);
+    try {
+      rt.run();
+    } catch (const std::runtime_error& e) {
+      error = e.what();
+    }
+  }
+  EXPECT_EQ(error.rfind("csp: could not start runtime thread ", 0), 0u) << error;
+  EXPECT_NE(error.find(" of 64, so no process ran: "), std::string::npos) << error;
+  EXPECT_EQ(ran, 0);
 }
 
 // Each stage forwards values; on poison it poisons both its ends and ends.
