@@ -1,5 +1,7 @@
-// libFuzzer target for the NFF parser: any input either parses into a scene
-// meeting scene.hpp's invariants or throws SceneError; anything else (a
+// libFuzzer target for the NFF parser and the database build behind it: any
+// input either parses into a scene meeting scene.hpp's invariants, whose
+// database then builds (polygons triangulated, BVH built, records packed) or
+// is refused with DatabaseError, or it throws SceneError; anything else (a
 // crash, a sanitizer report, another exception) is a finding. Inputs are
 // capped so memory stays bounded: 64 KiB of text, or 4 KiB of gzip (which
 // inflates at most ~1000-fold).
@@ -10,6 +12,7 @@
 #include <string_view>
 #include <variant>
 
+#include "tracer/database.hpp"
 #include "tracer/nff.hpp"
 
 namespace {
@@ -35,10 +38,18 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   bool gzip = size >= 2 && data[0] == 0x1f && data[1] == 0x8b;
   if (size > (gzip ? 4096u : 65536u)) return -1;  // -1: keep out of the corpus
   std::string_view text(reinterpret_cast<const char*>(data), size);
+  tracer::Scene scene;
   try {
-    check_invariants(tracer::parse_nff(text, "fuzz.nff"));
+    scene = tracer::parse_nff(text, "fuzz.nff");
   } catch (const tracer::SceneError&) {
-    // The expected outcome for malformed input.
+    return 0;  // the expected outcome for malformed input
+  }
+  check_invariants(scene);
+  try {
+    const tracer::Database db = tracer::build_database(scene);
+    if (db.pages.size() != db.header.page_count) std::abort();
+  } catch (const tracer::DatabaseError&) {
+    // A scene too large for the database's references.
   }
   return 0;
 }
