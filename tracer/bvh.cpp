@@ -128,8 +128,7 @@ class Builder {
   int bin_of(std::uint32_t prim, int axis, const Box3f& centroids) const {
     const float lo = centroids.lo[axis], ext = centroids.hi[axis] - lo;
     const float c = bounds_[prim].centre()[axis];
-    const int b = static_cast<int>((c - lo) / ext * kBins);
-    return std::clamp(b, 0, kBins - 1);
+    return clamped_int((c - lo) / ext * kBins, 0, kBins - 1);
   }
 
   Split find_split(std::uint32_t begin, std::uint32_t end, const Box3f& centroids,

@@ -17,6 +17,16 @@
 
 namespace tracer {
 
+// v truncated toward zero and clamped to [lo, hi]; NaN gives lo. Casting a
+// floating value that int cannot hold, or NaN, is undefined, so the clamp
+// comes first (a scene near the limits of float can produce either).
+template <typename F>
+int clamped_int(F v, int lo, int hi) {
+  if (!(v >= static_cast<F>(lo))) return lo;
+  if (v >= static_cast<F>(hi)) return hi;
+  return static_cast<int>(v);
+}
+
 struct Ray {
   Vec3f origin;
   Vec3f dir;  // not necessarily unit length
@@ -29,7 +39,7 @@ struct Box3f {
   void extend(const Vec3f& p) { lo = min(lo, p); hi = max(hi, p); }
   void extend(const Box3f& b) { lo = min(lo, b.lo); hi = max(hi, b.hi); }
   bool empty() const { return lo.x > hi.x; }
-  Vec3f centre() const { return (lo + hi) * 0.5f; }
+  Vec3f centre() const { return lo * 0.5f + hi * 0.5f; }  // the same as (lo + hi) / 2, but finite
   Vec3f extent() const { return hi - lo; }
   float half_area() const {
     const Vec3f d = extent();

@@ -20,7 +20,7 @@ void choose_dims(const Box3f& bounds, std::size_t prims, float density, int dims
   const double longest = std::max({double(e.x), double(e.y), double(e.z), 1e-30});
   if (!(side > longest * 1e-4)) side = longest / std::cbrt(cells);
   for (int a = 0; a < 3; ++a)
-    dims[a] = std::clamp(static_cast<int>(std::ceil(e[a] / side)), 1, kMaxDim);
+    dims[a] = clamped_int(std::ceil(e[a] / side), 1, kMaxDim);
 }
 
 }  // namespace
@@ -30,8 +30,8 @@ void grid_cell_range(const Box3f& bounds, const int dims[3], const Box3f& b, int
   for (int a = 0; a < 3; ++a) {
     const float ext = bounds.hi[a] - bounds.lo[a];
     const float scale = ext > 0 ? dims[a] / ext : 0.0f;
-    lo[a] = std::clamp(static_cast<int>((b.lo[a] - bounds.lo[a]) * scale), 0, dims[a] - 1);
-    hi[a] = std::clamp(static_cast<int>((b.hi[a] - bounds.lo[a]) * scale), 0, dims[a] - 1);
+    lo[a] = clamped_int((b.lo[a] - bounds.lo[a]) * scale, 0, dims[a] - 1);
+    hi[a] = clamped_int((b.hi[a] - bounds.lo[a]) * scale, 0, dims[a] - 1);
   }
 }
 

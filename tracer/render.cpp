@@ -374,7 +374,7 @@ GridWalk start_walk(const DatabaseHeader& h, const Ray& ray, const RayInverse& i
   for (int a = 0; a < 3; ++a) {
     const float size = (h.bounds.hi[a] - h.bounds.lo[a]) / h.grid_dims[a];
     const float rel = size > 0 ? (p[a] - h.bounds.lo[a]) / size : 0.0f;
-    w.cell[a] = std::clamp(static_cast<int>(rel), 0, h.grid_dims[a] - 1);
+    w.cell[a] = clamped_int(rel, 0, h.grid_dims[a] - 1);
     const float inf = std::numeric_limits<float>::infinity();
     if (ray.dir[a] > 0) {
       w.step[a] = 1;

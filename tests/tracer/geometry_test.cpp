@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <array>
 #include <cstdint>
+#include <limits>
 #include <vector>
 #include <cmath>
 #include <numbers>
@@ -14,6 +15,18 @@ namespace tracer {
 namespace {
 
 constexpr float kInf = 1e30f;
+
+TEST(ClampedInt, TruncatesInRangeAndClampsWhatIntCannotHold) {
+  EXPECT_EQ(clamped_int(2.9f, 0, 7), 2);
+  EXPECT_EQ(clamped_int(7.5f, 0, 7), 7);
+  EXPECT_EQ(clamped_int(-0.5f, 0, 7), 0);
+  EXPECT_EQ(clamped_int(0.5, 1, 7), 1);
+  EXPECT_EQ(clamped_int(3e38f, 0, 7), 7);
+  EXPECT_EQ(clamped_int(-3e38f, 0, 7), 0);
+  EXPECT_EQ(clamped_int(std::numeric_limits<float>::infinity(), 0, 7), 7);
+  EXPECT_EQ(clamped_int(std::numeric_limits<float>::quiet_NaN(), 0, 7), 0);
+  EXPECT_EQ(clamped_int(std::numeric_limits<double>::quiet_NaN(), 1, 7), 1);
+}
 
 TEST(Sphere, HitsNearSideFromOutside) {
   const auto t = intersect_sphere({{0, 0, -5}, {0, 0, 1}}, {0, 0, 0}, 1.0f, 0.0f, kInf);
