@@ -1,10 +1,10 @@
 // libFuzzer target for the NFF parser and the database build behind it: any
-// input either parses into a scene meeting scene.hpp's invariants, whose
-// database then builds (polygons triangulated, BVH built, records packed) or
-// is refused with DatabaseError, or it throws SceneError; anything else (a
-// crash, a sanitizer report, another exception) is a finding. Inputs are
-// capped so memory stays bounded: 64 KiB of text, or 4 KiB of gzip (which
-// inflates at most ~1000-fold).
+// input either throws SceneError or parses into a scene meeting scene.hpp's
+// invariants, whose database then builds with either accelerator (polygons
+// triangulated, BVH or grid built, records packed) or is refused with
+// DatabaseError; anything else (a crash, a sanitizer report, another
+// exception) is a finding. Inputs are capped so memory stays bounded: 64 KiB
+// of text, or 4 KiB of gzip (which inflates at most ~1000-fold).
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
@@ -45,11 +45,13 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     return 0;  // the expected outcome for malformed input
   }
   check_invariants(scene);
-  try {
-    const tracer::Database db = tracer::build_database(scene);
-    if (db.pages.size() != db.header.page_count) std::abort();
-  } catch (const tracer::DatabaseError&) {
-    // A scene too large for the database's references.
+  for (const tracer::Accel accel : {tracer::Accel::bvh, tracer::Accel::grid}) {
+    try {
+      const tracer::Database db = tracer::build_database(scene, tracer::BuildOptions{.accel = accel});
+      if (db.pages.size() != db.header.page_count) std::abort();
+    } catch (const tracer::DatabaseError&) {
+      // A scene too large for the database's references.
+    }
   }
   return 0;
 }
