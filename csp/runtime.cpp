@@ -48,6 +48,11 @@ std::string message_of(const std::exception_ptr& e) {
   throw ProcessesFailed(text);
 }
 
+// What ProcessNotStarted says of one process.
+std::string could_not_start(const std::string& process, const std::exception_ptr& error) {
+  return "process '" + process + "' could not start: " + message_of(error);
+}
+
 // Appends a failure; with no memory left to hold it, counts it instead: the
 // callers run where an exception would end the program (a fiber's end, a
 // runtime thread's loop).
@@ -321,7 +326,7 @@ void Runtime::run() {
   if (!impl_->unstarted.empty()) {
     const auto& first = impl_->unstarted.front();
     const std::size_t more = impl_->unstarted.size() - 1 + impl_->lost_unstarted;
-    std::string text = "process '" + first.process + "' could not start: " + detail::message_of(first.error);
+    std::string text = detail::could_not_start(first.process, first.error);
     if (more > 0) text += " (and " + std::to_string(more) + " more processes)";
     throw ProcessNotStarted(text);
   }
@@ -396,7 +401,7 @@ void par(std::vector<std::function<void()>> processes) {
           [&g, child, name, body = std::move(processes[i])] { run_child(g, child.get(), name, body); }));
     } catch (...) {
       // The children started go on, and are waited for below: they use g.
-      not_started = "process '" + name + "' could not start: " + detail::message_of(std::current_exception());
+      not_started = detail::could_not_start(name, std::current_exception());
       if (child) parent->tracker->remove(*child);
       detail::ChannelLock lk(g.lock);
       g.remaining -= processes.size() - i;
