@@ -76,10 +76,10 @@ SvmSource& NodeSvm::add_worker(PageFetch fetch) {
 }
 
 int NodeSvm::install(std::uint32_t page, std::span<const std::byte> bytes) {
-  pinned_.clear();
+  std::vector<int> pinned;  // empty, and so never allocated, unless a worker holds a pin
   for (const auto& w : workers_)
-    if (w->pinned_ >= 0) pinned_.push_back(w->pinned_);
-  return memory_.install(page, bytes, pinned_);
+    if (w->pinned_ >= 0) pinned.push_back(w->pinned_);
+  return memory_.install(page, bytes, pinned);
 }
 
 SvmStats NodeSvm::stats() const {

@@ -105,7 +105,6 @@ class NodeSvm {
 
   NodeMemory memory_;
   std::vector<std::unique_ptr<SvmSource>> workers_;
-  std::vector<int> pinned_;  // scratch for install()
 };
 
 }  // namespace nodes
