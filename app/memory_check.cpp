@@ -126,13 +126,6 @@ std::uint64_t image_memory_bytes(const Options& o, int width, int height) {
   return bytes;
 }
 
-// The machine's physical memory rather than MemAvailable: what is available
-// moves from moment to moment with other processes and the page cache, so a
-// check against it would refuse a run that could have fitted once they made
-// room, and one command line would pass or fail by the moment it was typed.
-// An image larger than the whole memory cannot be rendered (short of a swap
-// that turns minutes into hours); the check refuses what surely does not
-// fit, and promises nothing of what passes it.
 namespace {
 
 // The number in a control group's limit file, or nullopt for "max", a
@@ -174,6 +167,13 @@ std::optional<std::uint64_t> cgroup_memory_limit(const std::filesystem::path& ro
   return least;
 }
 
+// The machine's physical memory rather than MemAvailable: what is available
+// moves from moment to moment with other processes and the page cache, so a
+// check against it would refuse a run that could have fitted once they made
+// room, and one command line would pass or fail by the moment it was typed.
+// An image larger than the whole memory cannot be rendered (short of a swap
+// that turns minutes into hours); the check refuses what surely does not
+// fit, and promises nothing of what passes it.
 MemoryLimit memory_limit() {
   MemoryLimit limit;
   const long pages = sysconf(_SC_PHYS_PAGES), page_size = sysconf(_SC_PAGE_SIZE);
