@@ -96,29 +96,72 @@ boost::fibers::fiber start_fiber(std::size_t stack_size, std::function<void()> f
 
 }  // namespace
 
-// Holds the runtime threads until every one of them exists, so that a thread
-// the system cannot create abandons the run before any process starts.
+// Holds the runtime threads until every one of them exists and has set up
+// its scheduler, so that a thread the system cannot create, or one left
+// without memory for its scheduler, abandons the run before any process
+// starts. The threads set up one at a time, once all exist, so that what
+// one finds of the memory left is not taken by another meanwhile.
 class StartGate {
  public:
-  void open(bool go) {
-    {
-      std::lock_guard<std::mutex> lk(mutex_);
-      state_ = go ? State::go : State::abandoned;
-    }
-    opened_.notify_all();
-  }
-  // True: run; false: the run is abandoned.
-  bool wait() {
+  explicit StartGate(unsigned threads) : setting_up_(threads) {}
+
+  // The creator: every thread exists.
+  void all_created() { settle(State::setting_up); }
+  // The creator: a thread could not be created.
+  void abandon() { settle(State::abandoned); }
+
+  // A runtime thread: runs set_up() (which may throw) in its turn, then
+  // waits for the verdict. True: run.
+  template <class SetUp>
+  bool set_up_and_wait(unsigned thread, SetUp set_up) {
     std::unique_lock<std::mutex> lk(mutex_);
-    opened_.wait(lk, [this] { return state_ != State::closed; });
+    changed_.wait(lk, [this] { return state_ != State::creating; });
+    if (state_ == State::abandoned) return false;
+    try {
+      set_up();
+    } catch (...) {
+      if (!failure_) {
+        failure_ = std::current_exception();
+        failed_thread_ = thread;
+      }
+    }
+    if (--setting_up_ == 0) changed_.notify_all();
+    changed_.wait(lk, [this] { return state_ == State::go || state_ == State::abandoned; });
     return state_ == State::go;
   }
 
+  // The creator, after all_created(): waits for the set-ups, then lets the
+  // threads run if all succeeded. Returns the first failure, if any.
+  std::exception_ptr open_when_set_up(unsigned& failed_thread) {
+    std::exception_ptr failure;
+    {
+      std::unique_lock<std::mutex> lk(mutex_);
+      changed_.wait(lk, [this] { return setting_up_ == 0; });
+      state_ = failure_ ? State::abandoned : State::go;
+      failure = failure_;
+      failed_thread = failed_thread_;
+    }
+    changed_.notify_all();
+    return failure;
+  }
+
  private:
-  enum class State { closed, go, abandoned };
+  enum class State { creating, setting_up, go, abandoned };
+
+  void settle(State s) {
+    {
+      std::lock_guard<std::mutex> lk(mutex_);
+      state_ = s;
+    }
+    changed_.notify_all();
+  }
+
   std::mutex mutex_;
-  std::condition_variable opened_;
-  State state_ = State::closed;
+  std::condition_variable changed_;
+  unsigned setting_up_;
+  std::exception_ptr failure_;
+  unsigned failed_thread_ = 0;
+  State state_ = State::creating;
 };
 
 // A process placed on a thread but not started yet.
@@ -151,6 +194,10 @@ using detail::SpinlockLock;
 using detail::Worker;
 
 struct Runtime::Impl {
+  // More than Boost allocates to start fibers on a thread (its dispatcher's
+  // stack is 128 KB).
+  static constexpr std::size_t boost_thread_set_up_bytes = 1 << 20;
+
   explicit Impl(RuntimeOptions o)
       : options(with_thread_count(std::move(o))), tracker(options.threads, [this] { stop_all(); }) {
     for (unsigned i = 0; i < options.threads; ++i) workers.push_back(std::make_unique<Worker>());
@@ -179,6 +226,8 @@ struct Runtime::Impl {
   }
 
   void worker_main(unsigned index, detail::StartGate& gate, std::barrier<>& finished);
+  void set_up_thread(unsigned index);
+  void serve(unsigned index);
   void launch_all(std::vector<Spawn>& batch, std::vector<boost::fibers::fiber>& fibers);
   boost::fibers::fiber launch(Spawn s);
   void not_started(Process& p, std::exception_ptr error);
@@ -199,16 +248,40 @@ struct Runtime::Impl {
   bool finished = false;  // every thread has exited: nothing can start any more
 };
 
-void Runtime::Impl::worker_main(unsigned index, detail::StartGate& gate, std::barrier<>& finished) {
-  if (!gate.wait()) return;
-  const auto started = std::chrono::steady_clock::now();
-  Scheduler* algo =
+// Installs this thread's scheduler and gives its main fiber and Boost's
+// dispatcher their properties now, while a failure can still be reported.
+// Boost makes the thread's fiber context, scheduler and dispatcher stack
+// where std::bad_alloc ends the program, so room for them is first tried.
+void Runtime::Impl::set_up_thread(unsigned index) {
+  ::operator delete(::operator new(boost_thread_set_up_bytes));
+  std::unique_ptr<Scheduler> owned(
       options.scheduler
           ? options.scheduler(index)
-          : new FifoScheduler(&idle[index], idle_spin(options.threads, std::thread::hardware_concurrency()));
-  boost::fibers::scheduler* scheduler = boost::fibers::context::active()->get_scheduler();
-  scheduler->set_algo(boost::fibers::algo::algorithm::ptr_t(algo));
-  detail::set_thread_scheduler(scheduler);
+          : new FifoScheduler(&idle[index], idle_spin(options.threads, std::thread::hardware_concurrency())));
+  Scheduler* algo = owned.get();
+  boost::fibers::context* main = boost::fibers::context::active();
+  detail::reserve_properties();  // for the dispatcher, which set_algo makes ready
+  main->get_scheduler()->set_algo(boost::fibers::algo::algorithm::ptr_t(owned.release()));
+  detail::set_thread_scheduler(main->get_scheduler());
+  main->set_properties(algo->new_properties(main));
+}
+
+void Runtime::Impl::worker_main(unsigned index, detail::StartGate& gate, std::barrier<>& finished) {
+  if (gate.set_up_and_wait(index, [this, index] { set_up_thread(index); })) {
+    serve(index);
+    // A fiber of another thread may still be inside this thread's scheduler,
+    // waking it; the scheduler dies with the thread, so wait for every
+    // thread to finish its fibers first.
+    finished.arrive_and_wait();
+  }
+  detail::set_thread_scheduler(nullptr);
+  detail::release_properties_reserve();
+}
+
+// Starts the processes posted to this thread until told to stop, then
+// waits for them to end.
+void Runtime::Impl::serve(unsigned index) {
+  const auto started = std::chrono::steady_clock::now();
   std::vector<boost::fibers::fiber> fibers;
   Worker& w = *workers[index];
   for (bool stop = false; !stop;) {
@@ -228,11 +301,6 @@ void Runtime::Impl::worker_main(unsigned index, detail::StartGate& gate, std::ba
   for (boost::fibers::fiber& f : fibers) f.join();
   use[index].seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
   use[index].idle_seconds = std::chrono::duration<double>(idle[index]).count();
-  // A fiber of another thread may still be inside this thread's scheduler,
-  // waking it; the scheduler dies with the thread, so wait for every thread
-  // to finish its fibers first.
-  finished.arrive_and_wait();
-  detail::set_thread_scheduler(nullptr);
 }
 
 // A process that cannot start (no memory for its stack) is recorded and no
@@ -261,6 +329,7 @@ void Runtime::Impl::not_started(Process& p, std::exception_ptr error) {
 
 boost::fibers::fiber Runtime::Impl::launch(Spawn s) {
   const std::size_t stack_size = s.process->stack_size;
+  detail::reserve_properties();
   return detail::start_fiber(stack_size, [this, s = std::move(s)] { run_process(*s.process, s.body); });
 }
 
@@ -303,20 +372,26 @@ void Runtime::run() {
   }
   const unsigned count = impl_->options.threads;
   std::vector<std::thread> threads;
-  detail::StartGate gate;
+  detail::StartGate gate(count);
   std::barrier<> finished(count);
+  const auto give_up = [&](const std::string& what, std::size_t thread, const std::exception_ptr& why) {
+    for (std::thread& t : threads) t.join();
+    impl_->finished = true;
+    throw std::runtime_error("csp: could not " + what + " runtime thread " + std::to_string(thread + 1) + " of " +
+                             std::to_string(count) + ", so no process ran: " + detail::message_of(why));
+  };
   try {
     threads.reserve(count);
     for (unsigned i = 0; i < count; ++i)
       threads.emplace_back([this, i, &gate, &finished] { impl_->worker_main(i, gate, finished); });
-  } catch (const std::exception& e) {
-    gate.open(false);
-    for (std::thread& t : threads) t.join();
-    impl_->finished = true;
-    throw std::runtime_error("csp: could not start runtime thread " + std::to_string(threads.size() + 1) + " of " +
-                             std::to_string(count) + ", so no process ran: " + e.what());
+  } catch (...) {
+    gate.abandon();
+    give_up("start", threads.size(), std::current_exception());
   }
-  gate.open(true);
+  gate.all_created();
+  unsigned failed_thread = 0;
+  if (const std::exception_ptr failure = gate.open_when_set_up(failed_thread))
+    give_up("set up", failed_thread, failure);
   for (std::thread& t : threads) t.join();
   impl_->finished = true;
 
@@ -334,8 +409,8 @@ void Runtime::run() {
     throw ProcessesFailed(std::to_string(impl_->lost_failures) +
                           " processes failed, and no memory was left to record why");
 
-  std::string dump = impl_->tracker.deadlock_dump();
-  if (!dump.empty()) {
+  if (impl_->tracker.aborting()) {
+    std::string dump = impl_->tracker.deadlock_dump();
     for (const Failure& f : impl_->failures) {
       dump += "\n  (before that, process '" + f.process + "' failed: " + detail::message_of(f.error) + ")";
     }
@@ -396,6 +471,7 @@ void par(std::vector<std::function<void()>> processes) {
       parent->tracker->add(*child);
     }
     try {
+      if (detail::thread_scheduler()) detail::reserve_properties();
       fibers.push_back(detail::start_fiber(
           parent ? parent->stack_size : RuntimeOptions{}.stack_size,
           [&g, child, name, body = std::move(processes[i])] { run_child(g, child.get(), name, body); }));

@@ -54,9 +54,10 @@ class Runtime {
   // Runs every process to its end; once per Runtime. Rethrows a process's
   // exception (ProcessesFailed if several failed); Poisoned ends a process
   // normally. Throws Deadlock listing the blocked processes;
-  // ProcessNotStarted if a process had no memory for its stack (those
-  // waiting for it unwound as in a deadlock); std::runtime_error, before any
-  // process starts, if a runtime thread cannot be created.
+  // ProcessNotStarted if a process had no memory for its stack or
+  // scheduling record (those waiting for it unwound as in a deadlock);
+  // std::runtime_error, before any process starts, if a runtime thread
+  // cannot be created or set up.
   void run();
   // After run(): one entry per thread.
   std::vector<ThreadUse> thread_use() const;

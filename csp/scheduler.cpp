@@ -10,6 +10,26 @@
 
 namespace csp {
 
+namespace {
+// A plain pointer: a thread_local with a destructor would need memory of its own.
+thread_local void* properties_reserve = nullptr;
+}  // namespace
+
+static_assert(sizeof(ProcessProps) <= ProcessProps::reserve_bytes);
+
+void* ProcessProps::operator new(std::size_t size) {
+  if (properties_reserve && size <= reserve_bytes) return std::exchange(properties_reserve, nullptr);
+  return ::operator new(size);
+}
+
+void ProcessProps::operator delete(void* p) noexcept { ::operator delete(p); }
+
+void detail::reserve_properties() {
+  if (!properties_reserve) properties_reserve = ::operator new(ProcessProps::reserve_bytes);
+}
+
+void detail::release_properties_reserve() noexcept { ::operator delete(std::exchange(properties_reserve, nullptr)); }
+
 std::chrono::microseconds idle_spin(unsigned threads, unsigned hardware_threads) {
   if (hardware_threads != 0 && threads > hardware_threads) return std::chrono::microseconds{0};
   return std::chrono::microseconds{50};

@@ -28,6 +28,7 @@
 #include <atomic>
 #include <chrono>
 #include <condition_variable>
+#include <cstddef>
 #include <functional>
 #include <memory>
 #include <mutex>
@@ -41,7 +42,14 @@ namespace csp {
 
 namespace detail {
 struct Process;
-}
+
+// Sets aside, on the calling thread, the memory of the next properties
+// made there (none if it already holds some). Throws std::bad_alloc.
+void reserve_properties();
+// Frees the calling thread's reserve, if any; a thread that reserved
+// calls it before it exits.
+void release_properties_reserve() noexcept;
+}  // namespace detail
 
 // A transputer's two levels. A ready high-priority process always runs
 // before a ready low-priority one of the same thread; neither preempts the
@@ -51,10 +59,19 @@ struct Process;
 // scheduler (virtual_time.hpp) orders by clock alone.
 enum class Priority { high, low };
 
+// Boost.Fiber makes a fiber's properties when the fiber is first made
+// ready, inside a noexcept call where std::bad_alloc would end the program.
+// So the runtime sets their memory aside beforehand, where a failure can be
+// reported (reserve_properties()), and these allocation functions take it.
 class ProcessProps : public boost::fibers::fiber_properties {
  public:
   explicit ProcessProps(boost::fibers::context* ctx, bool virtual_time = false)
       : fiber_properties(ctx), virtual_time(virtual_time) {}
+  // The calling thread's reserve if it holds one, else the heap.
+  static void* operator new(std::size_t size);
+  static void operator delete(void* p) noexcept;
+  // Room for any properties class (checked where each is defined).
+  static constexpr std::size_t reserve_bytes = 128;
   detail::Process* process = nullptr;  // null for fibers that are not csp processes
   const bool virtual_time;             // these are VirtualProps (virtual_time.hpp)
   bool yielded = false;                // set by csp::yield(), cleared when the fiber is ready again

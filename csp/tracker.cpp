@@ -1,5 +1,6 @@
 // Tracker: alive/blocked accounting and the deadlock abort (see process.hpp).
 #include <algorithm>
+#include <new>
 #include <stdexcept>
 #include <string>
 #include <sstream>
@@ -61,28 +62,37 @@ std::uint64_t Tracker::alive() const {
   return alive;
 }
 
-// Two reads of every thread's word that agree, versions and all, were all
-// true at one instant; a thread with a process able to run means the run
-// goes on (that process will survey when it blocks or ends).
+// Two reads of every thread's words whose versions add up to the same sum
+// saw the same words, all true at one instant: a word changes only by
+// adding one to its version (until, some four million changes on, the
+// version wraps). A thread with a process able to run means the run goes
+// on (that process will survey when it blocks or ends). Allocates nothing:
+// it runs where memory may have run out.
 Tracker::Run Tracker::survey() const {
-  thread_local std::vector<std::uint64_t> first;
-  first.resize(threads_);
   for (;;) {
     std::uint64_t alive = 0;
+    std::uint64_t versions = 0;
     for (unsigned t = 0; t < threads_; ++t) {
-      first[t] = counts_[t].word.load();
-      if (!all_blocked(first[t])) return Run::going;
-      alive += alive_of(first[t]);
+      const std::uint64_t word = counts_[t].word.load();
+      if (!all_blocked(word)) return Run::going;
+      alive += alive_of(word);
+      versions += version_of(word);
     }
-    bool agree = true;
-    for (unsigned t = 0; t < threads_ && agree; ++t) agree = counts_[t].word.load() == first[t];
-    if (agree) return alive == 0 ? Run::ended : Run::deadlocked;
+    std::uint64_t versions_again = 0;
+    for (unsigned t = 0; t < threads_; ++t) {
+      const std::uint64_t word = counts_[t].word.load();
+      if (!all_blocked(word)) return Run::going;
+      versions_again += version_of(word);
+    }
+    if (versions_again == versions) return alive == 0 ? Run::ended : Run::deadlocked;
   }
 }
 
 std::string Tracker::deadlock_dump() const {
   std::lock_guard<std::mutex> lk(mutex_);
-  return dump_;
+  if (!dump_.empty()) return dump_;
+  return "deadlock: all " + std::to_string(dump_processes_) +
+         " live processes wait on channels, no timer pending (no memory was left to say on what)";
 }
 
 bool Tracker::abort_run(const Process* self) {
@@ -90,7 +100,12 @@ bool Tracker::abort_run(const Process* self) {
   if (!aborting_.compare_exchange_strong(expected, true, std::memory_order_acq_rel)) return false;
   {
     std::lock_guard<std::mutex> lk(mutex_);
-    dump_ = describe_locked();
+    dump_processes_ = processes_.size();
+    try {
+      dump_ = describe_locked();
+    } catch (const std::bad_alloc&) {
+      // Unwinding the processes matters more than naming their waits.
+    }
     // Everyone waits (parked, or about to park having found the deadlock
     // too) and nobody else can claim them: wake all to unwind.
     for (Process* q : processes_) {

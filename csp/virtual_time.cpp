@@ -11,6 +11,8 @@
 
 namespace csp {
 
+static_assert(sizeof(VirtualProps) <= ProcessProps::reserve_bytes);
+
 namespace {
 
 // Every fiber of a runtime thread has ProcessProps (scheduler.hpp).

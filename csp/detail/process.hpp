@@ -64,7 +64,7 @@ class Tracker {
   void unblock(Process& p);
   bool aborting() const { return aborting_.load(std::memory_order_acquire); }
   std::uint64_t alive() const;
-  std::string deadlock_dump() const;  // empty unless the run deadlocked
+  std::string deadlock_dump() const;  // what each process waited on; only once aborting()
 
   static constexpr unsigned count_bits = 21;
   static constexpr std::uint64_t max_processes_per_thread = (std::uint64_t{1} << count_bits) - 1;
@@ -77,6 +77,7 @@ class Tracker {
   static constexpr std::uint64_t one_version = std::uint64_t{1} << (2 * count_bits);
   static std::uint64_t blocked_of(std::uint64_t word) { return word & max_processes_per_thread; }
   static std::uint64_t alive_of(std::uint64_t word) { return (word >> count_bits) & max_processes_per_thread; }
+  static std::uint64_t version_of(std::uint64_t word) { return word >> (2 * count_bits); }
   static bool all_blocked(std::uint64_t word) { return blocked_of(word) == alive_of(word); }
 
   struct alignas(64) Counts {
@@ -95,7 +96,8 @@ class Tracker {
   std::atomic<bool> aborting_{false};
   mutable std::mutex mutex_;           // guards processes_ and dump_
   std::vector<Process*> processes_;
-  std::string dump_;
+  std::string dump_;                   // empty if there was no memory to write it
+  std::size_t dump_processes_ = 0;
   std::function<void()> on_all_ended_;
 };
 

@@ -352,6 +352,28 @@ TEST(Runtime, AThreadThatCannotBeCreatedAbandonsTheRunBeforeAnyProcess) {
   EXPECT_EQ(ran, 0);
 }
 
+// A runtime thread that cannot set up its scheduler (here its factory
+// fails, as allocating it would with no memory left) abandons the run
+// before any process starts, rather than ending the program.
+TEST(Runtime, AThreadThatCannotSetUpAbandonsTheRunBeforeAnyProcess) {
+  csp::RuntimeOptions options;
+  options.threads = 4;
+  options.scheduler = [](unsigned thread) -> csp::Scheduler* {
+    if (thread == 2) throw std::bad_alloc();
+    return new csp::FifoScheduler();
+  };
+  csp::Runtime rt(options);
+  std::atomic<int> ran{0};
+  for (unsigned t = 0; t < 4; ++t) rt.spawn("p", t, [&] { ++ran; });
+  try {
+    rt.run();
+    FAIL() << "run() did not throw";
+  } catch (const std::runtime_error& e) {
+    EXPECT_STREQ(e.what(), "csp: could not set up runtime thread 3 of 4, so no process ran: std::bad_alloc");
+  }
+  EXPECT_EQ(ran, 0);
+}
+
 // Each stage forwards values; on poison it poisons both its ends and ends.
 void stage(csp::In<int> in, csp::Out<int> out) {
   try {
