@@ -17,12 +17,14 @@ struct Poisoned : std::runtime_error {
 
 // Thrown by Runtime::run() when every live process waits on a channel and no
 // timer is pending; what() lists each blocked process and what it waits on.
+// If a process had failed, its failure is reported instead (the others were
+// most likely waiting for it).
 struct Deadlock : std::runtime_error {
   explicit Deadlock(const std::string& dump) : std::runtime_error(dump) {}
 };
 
 // Thrown by Runtime::run() and par() when more than one process failed;
-// what() holds the first failure followed by a summary of the others.
+// what() holds the first failure, then the next few and how many more.
 struct ProcessesFailed : std::runtime_error {
   explicit ProcessesFailed(const std::string& summary) : std::runtime_error(summary) {}
 };

@@ -3,6 +3,7 @@
 
 #include <boost/fiber/fiber.hpp>
 #include <boost/fiber/operations.hpp>
+#include <algorithm>
 #include <barrier>
 #include <condition_variable>
 #include <exception>
@@ -36,15 +37,18 @@ std::string message_of(const std::exception_ptr& e) {
   }
 }
 
-// One failure: rethrown as is; several: ProcessesFailed naming them all.
+// One failure: rethrown as is; several: ProcessesFailed naming the first
+// few and counting the rest.
 [[noreturn]] void rethrow_failures(const std::vector<Failure>& failures) {
+  constexpr std::size_t named = 4;
   if (failures.size() == 1) std::rethrow_exception(failures.front().error);
   std::string text = "process '" + failures.front().process + "' failed: " + message_of(failures.front().error) +
                      "; and " + std::to_string(failures.size() - 1) + " more:";
-  for (std::size_t i = 1; i < failures.size(); ++i) {
+  for (std::size_t i = 1; i < std::min(failures.size(), named); ++i) {
     text += " process '" + failures[i].process + "': " + message_of(failures[i].error) + ";";
   }
   text.pop_back();
+  if (failures.size() > named) text += "; ...";
   throw ProcessesFailed(text);
 }
 
@@ -409,14 +413,9 @@ void Runtime::run() {
     throw ProcessesFailed(std::to_string(impl_->lost_failures) +
                           " processes failed, and no memory was left to record why");
 
-  if (impl_->tracker.aborting()) {
-    std::string dump = impl_->tracker.deadlock_dump();
-    for (const Failure& f : impl_->failures) {
-      dump += "\n  (before that, process '" + f.process + "' failed: " + detail::message_of(f.error) + ")";
-    }
-    throw Deadlock(dump);
-  }
+  // Processes left waiting on one that failed deadlock: the failure is the cause.
   if (!impl_->failures.empty()) detail::rethrow_failures(impl_->failures);
+  if (impl_->tracker.aborting()) throw Deadlock(impl_->tracker.deadlock_dump());
 }
 
 // The state a PAR shares with its children, guarded by lock.

@@ -52,12 +52,12 @@ class Runtime {
   // Before run(), or from inside a running process. thread is taken modulo threads().
   void spawn(std::string name, unsigned thread, std::function<void()> body, Priority priority = Priority::high);
   // Runs every process to its end; once per Runtime. Rethrows a process's
-  // exception (ProcessesFailed if several failed); Poisoned ends a process
-  // normally. Throws Deadlock listing the blocked processes;
-  // ProcessNotStarted if a process had no memory for its stack or
-  // scheduling record (those waiting for it unwound as in a deadlock);
-  // std::runtime_error, before any process starts, if a runtime thread
-  // cannot be created or set up.
+  // exception (ProcessesFailed if several failed), also when the others
+  // then deadlocked waiting for it; Poisoned ends a process normally.
+  // Throws Deadlock listing the blocked processes; ProcessNotStarted if a
+  // process had no memory for its stack or scheduling record (those
+  // waiting for it unwound as in a deadlock); std::runtime_error, before any
+  // process starts, if a runtime thread cannot be created or set up.
   void run();
   // After run(): one entry per thread.
   std::vector<ThreadUse> thread_use() const;

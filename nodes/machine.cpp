@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <chrono>
 #include <memory>
+#include <new>
 #include <stdexcept>
 #include <string>
 #include <thread>
@@ -15,6 +16,11 @@
 namespace nodes {
 
 namespace {
+
+// The hint that ends an error of a machine the memory could not hold.
+std::string needs_more_memory(std::size_t nodes) {
+  return "a machine of " + std::to_string(nodes) + " nodes needs more memory than this process may map (see ulimit -v)";
+}
 
 // Everything one processor holds during a run; addresses stay stable while
 // its processes refer to them.
@@ -276,8 +282,9 @@ MachineResult run_machine(tracer::Database db, const MachineOptions& options) {
   try {
     runtime.run();
   } catch (const csp::ProcessNotStarted& e) {
-    throw csp::ProcessNotStarted(std::string(e.what()) + "; a machine of " + std::to_string(topology.size()) +
-                                 " nodes needs more memory than this process may map (see ulimit -v)");
+    throw csp::ProcessNotStarted(std::string(e.what()) + "; " + needs_more_memory(topology.size()));
+  } catch (const std::bad_alloc&) {
+    throw std::runtime_error("a process of the machine ran out of memory; " + needs_more_memory(topology.size()));
   }
 
   MachineResult result;

@@ -374,6 +374,38 @@ TEST(Runtime, AThreadThatCannotSetUpAbandonsTheRunBeforeAnyProcess) {
   EXPECT_EQ(ran, 0);
 }
 
+// Processes left waiting on one that failed deadlock; run() reports the
+// failure, which caused it, rather than the deadlock.
+TEST(Runtime, ReportsAFailureRatherThanTheDeadlockItLeftBehind) {
+  csp::Channel<int> c("c");
+  csp::Runtime rt(2);
+  rt.spawn("writer", 0, [] { throw std::runtime_error("no value to send"); });
+  rt.spawn("reader", 1, [in = c.reader()]() mutable { in.read(); });
+  try {
+    rt.run();
+    FAIL() << "run() did not throw";
+  } catch (const csp::Deadlock& e) {
+    FAIL() << "reported the deadlock: " << e.what();
+  } catch (const std::runtime_error& e) {
+    EXPECT_STREQ(e.what(), "no value to send");
+  }
+}
+
+TEST(Runtime, NamesTheFirstFewOfManyFailures) {
+  csp::Runtime rt(1);
+  for (char digit = '0'; digit <= '9'; ++digit) {
+    const std::string error{'e', digit};
+    rt.spawn(std::string{'p', digit}, 0, [error] { throw std::runtime_error(error); });
+  }
+  try {
+    rt.run();
+    FAIL() << "run() did not throw";
+  } catch (const csp::ProcessesFailed& e) {
+    EXPECT_STREQ(e.what(), "process 'p0' failed: e0; and 9 more: process 'p1': e1; process 'p2': e2; "
+                           "process 'p3': e3; ...");
+  }
+}
+
 // Each stage forwards values; on poison it poisons both its ends and ends.
 void stage(csp::In<int> in, csp::Out<int> out) {
   try {
