@@ -264,9 +264,10 @@ void Runtime::Impl::set_up_thread(unsigned index) {
           : new FifoScheduler(&idle[index], idle_spin(options.threads, std::thread::hardware_concurrency())));
   Scheduler* algo = owned.get();
   boost::fibers::context* main = boost::fibers::context::active();
-  detail::reserve_properties();  // for the dispatcher, which set_algo makes ready
+  algo->make_room_for_fiber();  // for the dispatcher, which set_algo makes ready
   main->get_scheduler()->set_algo(boost::fibers::algo::algorithm::ptr_t(owned.release()));
-  detail::set_thread_scheduler(main->get_scheduler());
+  detail::set_thread_scheduler(main->get_scheduler(), algo);
+  algo->make_room_for_fiber();
   main->set_properties(algo->new_properties(main));
 }
 
@@ -278,7 +279,7 @@ void Runtime::Impl::worker_main(unsigned index, detail::StartGate& gate, std::ba
     // thread to finish its fibers first.
     finished.arrive_and_wait();
   }
-  detail::set_thread_scheduler(nullptr);
+  detail::set_thread_scheduler(nullptr, nullptr);
   detail::release_properties_reserve();
 }
 
@@ -333,7 +334,7 @@ void Runtime::Impl::not_started(Process& p, std::exception_ptr error) {
 
 boost::fibers::fiber Runtime::Impl::launch(Spawn s) {
   const std::size_t stack_size = s.process->stack_size;
-  detail::reserve_properties();
+  detail::thread_algorithm()->make_room_for_fiber();
   return detail::start_fiber(stack_size, [this, s = std::move(s)] { run_process(*s.process, s.body); });
 }
 
@@ -470,7 +471,7 @@ void par(std::vector<std::function<void()>> processes) {
       parent->tracker->add(*child);
     }
     try {
-      if (detail::thread_scheduler()) detail::reserve_properties();
+      if (Scheduler* algo = detail::thread_algorithm()) algo->make_room_for_fiber();
       fibers.push_back(detail::start_fiber(
           parent ? parent->stack_size : RuntimeOptions{}.stack_size,
           [&g, child, name, body = std::move(processes[i])] { run_child(g, child.get(), name, body); }));

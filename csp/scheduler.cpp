@@ -28,6 +28,8 @@ void detail::reserve_properties() {
   if (!properties_reserve) properties_reserve = ::operator new(ProcessProps::reserve_bytes);
 }
 
+void Scheduler::make_room_for_fiber() { detail::reserve_properties(); }
+
 void detail::release_properties_reserve() noexcept { ::operator delete(std::exchange(properties_reserve, nullptr)); }
 
 std::chrono::microseconds idle_spin(unsigned threads, unsigned hardware_threads) {

@@ -77,7 +77,15 @@ class ProcessProps : public boost::fibers::fiber_properties {
   bool yielded = false;                // set by csp::yield(), cleared when the fiber is ready again
 };
 
-using Scheduler = boost::fibers::algo::algorithm_with_properties<ProcessProps>;
+// The base of the runtime's schedulers.
+class Scheduler : public boost::fibers::algo::algorithm_with_properties<ProcessProps> {
+ public:
+  // Called on the scheduler's thread before a fiber starts there, where an
+  // exception is reported as a process that could not start: sets aside
+  // the fiber's properties (and, in a derived scheduler, room in its ready
+  // set), so that Boost's noexcept awakened() need allocate nothing.
+  virtual void make_room_for_fiber();
+};
 // Called once on each runtime thread, with that thread's index.
 using SchedulerFactory = std::function<Scheduler*(unsigned thread)>;
 

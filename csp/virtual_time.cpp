@@ -46,13 +46,22 @@ VirtualTimeScheduler::~VirtualTimeScheduler() {
   if (thread_clock == this) thread_clock = nullptr;
 }
 
+// A fiber is in later_ at most once, so room for one entry per fiber is
+// room for every push.
+void VirtualTimeScheduler::make_room_for_fiber() {
+  Scheduler::make_room_for_fiber();
+  const std::size_t needed = fibers_ + 1;
+  if (later_.capacity() < needed) later_.reserve(std::max(needed, 2 * later_.capacity()));
+}
+
 boost::fibers::fiber_properties* VirtualTimeScheduler::new_properties(boost::fibers::context* ctx) {
+  ++fibers_;
   return new VirtualProps(ctx, *this);
 }
 
 void VirtualTimeScheduler::push(std::int64_t key, boost::fibers::context* ctx) {
   if (key == now_) {
-    current_.push_back(ctx);
+    ctx->ready_link(current_);
     return;
   }
   later_.emplace_back(key, arrivals_++, ctx);
@@ -108,7 +117,7 @@ boost::fibers::context* VirtualTimeScheduler::pick_next() noexcept {
     ctx = std::get<2>(later_.back());
     later_.pop_back();
   } else {
-    ctx = current_.front();
+    ctx = &current_.front();
     current_.pop_front();
   }
   now_ = std::max(now_, key);

@@ -37,7 +37,6 @@
 #include <atomic>
 #include <chrono>
 #include <cstdint>
-#include <deque>
 #include <memory>
 #include <tuple>
 #include <vector>
@@ -74,6 +73,7 @@ class VirtualTimeScheduler final : public Scheduler {
   explicit VirtualTimeScheduler(std::shared_ptr<VirtualTimeRecord> record = {});
   ~VirtualTimeScheduler() override;
 
+  void make_room_for_fiber() override;
   boost::fibers::fiber_properties* new_properties(boost::fibers::context* ctx) override;
   void awakened(boost::fibers::context* ctx, ProcessProps& props) noexcept override;
   boost::fibers::context* pick_next() noexcept override;
@@ -102,8 +102,9 @@ class VirtualTimeScheduler final : public Scheduler {
   using Entry = std::tuple<std::int64_t, std::uint64_t, boost::fibers::context*>;
   struct RunsLater;  // the heap's order
   void push(std::int64_t key, boost::fibers::context* ctx);
-  std::deque<boost::fibers::context*> current_;
-  std::vector<Entry> later_;  // a heap in a vector: no allocation per push once it has grown
+  boost::fibers::scheduler::ready_queue_type current_;
+  std::vector<Entry> later_;  // a heap in a vector, with room for every fiber (make_room_for_fiber)
+  std::size_t fibers_ = 0;    // fibers given properties: a bound on those in later_
   std::int64_t now_ = 0;      // the largest key picked yet: the current virtual time
   // The properties of the fiber picked last, which is the running fiber
   // (Boost resumes what pick_next returns), or null before the first pick.

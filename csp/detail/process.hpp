@@ -13,8 +13,8 @@
 // nobody will wake one: the state is stable. Only a process that makes its
 // own thread's word all blocked (by blocking, or by ending) can complete
 // that state, so only it surveys the other words: it reads them all twice,
-// and if both reads agree, versions included, they were all true at one
-// instant (between the reads). The last thread to reach the state sees the
+// and if the versions of both reads add up the same, no word changed between
+// them, so all were true at one instant. The last thread to reach the state sees the
 // others', since its update precedes its reads in the single order of
 // sequentially consistent operations. A survey that finds every word all
 // blocked aborts the run; one that finds nothing alive ends it (once,
@@ -109,7 +109,9 @@ Process* process_of(boost::fibers::context* ctx);
 // The scheduler of the calling runtime thread (null on other threads); a
 // runtime thread sets it on start and clears it on exit.
 boost::fibers::scheduler* thread_scheduler();
-void set_thread_scheduler(boost::fibers::scheduler* s);
+// The csp Scheduler installed in it (null likewise).
+Scheduler* thread_algorithm();
+void set_thread_scheduler(boost::fibers::scheduler* s, Scheduler* algorithm);
 
 }  // namespace csp::detail
 

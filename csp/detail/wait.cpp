@@ -45,6 +45,7 @@ constinit thread_local std::array<boost::fibers::context*, deferred_wake_capacit
 // Cached here because context::active() is a costly TLS lookup in Boost's
 // shared library, and a thread's scheduler never changes.
 thread_local boost::fibers::scheduler* runtime_scheduler = nullptr;
+thread_local Scheduler* runtime_algorithm = nullptr;
 
 }  // namespace
 
@@ -173,7 +174,11 @@ void issue_deferred_wakes() {
 }
 
 boost::fibers::scheduler* thread_scheduler() { return runtime_scheduler; }
-void set_thread_scheduler(boost::fibers::scheduler* s) { runtime_scheduler = s; }
+Scheduler* thread_algorithm() { return runtime_algorithm; }
+void set_thread_scheduler(boost::fibers::scheduler* s, Scheduler* algorithm) {
+  runtime_scheduler = s;
+  runtime_algorithm = algorithm;
+}
 
 Process* process_of(boost::fibers::context* ctx) {
   if (!runtime_scheduler) return nullptr;

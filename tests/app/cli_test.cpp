@@ -173,36 +173,38 @@ TEST_F(Cli, AMachineTooLargeForTheAddressSpaceEndsWithAnError) {
   EXPECT_FALSE(fs::exists(dir_ / "out.png"));
 }
 
-// Wherever the memory runs out (ulimit -v from where eight runtime threads
-// barely start to where the render fits), a run either succeeds or ends
-// with one line and status 1: never an abort from an allocation that fails
-// inside Boost.Fiber's noexcept scheduling calls, nor a hang from a deadlock
-// that finds no memory to describe itself.
+// Wherever the memory runs out (ulimit -v from where the runtime threads
+// barely start to where the render fits), a run, in real or virtual time,
+// either succeeds or ends with one line and status 1: never an abort from
+// an allocation that fails inside Boost.Fiber's noexcept scheduling calls,
+// nor a hang from a deadlock that finds no memory to describe itself.
 TEST_F(Cli, RunningOutOfAddressSpaceAnywhereEndsInSuccessOrOneLine) {
 #if defined(__SANITIZE_ADDRESS__) || defined(__SANITIZE_THREAD__)
   GTEST_SKIP() << "a sanitizer's shadow memory does not fit in 200 MB of address space";
 #endif
   int failures = 0;
-  for (int limit_mb = 70; limit_mb <= 200; limit_mb += 5) {
-    const std::string limit = "ulimit -v " + std::to_string(limit_mb * 1000);
-    const std::string cmd = "cd '" + dir_.string() + "' && " + limit + " && exec timeout -s KILL 60 " +
-                            VMPRAY_BINARY + " teapot --threads 8 --width 64 --height 64 -q -o out.png" +
-                            " >stdout.txt 2>stderr.txt </dev/null";
-    const int status = std::system(cmd.c_str());
-    const std::string err = test::read_file(dir_ / "stderr.txt");
-    const int code = WEXITSTATUS(status);
-    SCOPED_TRACE(limit + ": status " + std::to_string(code) + ", stderr: " + err);
-    ASSERT_TRUE(code == 0 || code == 1);
-    if (code == 0) {
-      EXPECT_EQ(err, "");
-      EXPECT_TRUE(fs::exists(dir_ / "out.png"));
-    } else {
-      ++failures;
-      EXPECT_EQ(lines(err), 1u);
-      EXPECT_EQ(err.rfind("vmpray: ", 0), 0u);
-      EXPECT_FALSE(fs::exists(dir_ / "out.png"));
+  for (const char* timing : {"", " --timing virtual"}) {
+    for (int limit_mb = 50; limit_mb <= 200; limit_mb += 10) {
+      const std::string limit = "ulimit -v " + std::to_string(limit_mb * 1000);
+      const std::string cmd = "cd '" + dir_.string() + "' && " + limit + " && exec timeout -s KILL 60 " +
+                              VMPRAY_BINARY + " teapot --threads 8 --width 64 --height 64 -q -o out.png" + timing +
+                              " >stdout.txt 2>stderr.txt </dev/null";
+      const int status = std::system(cmd.c_str());
+      const std::string err = test::read_file(dir_ / "stderr.txt");
+      const int code = WEXITSTATUS(status);
+      SCOPED_TRACE(limit + timing + ": status " + std::to_string(code) + ", stderr: " + err);
+      ASSERT_TRUE(code == 0 || code == 1);
+      if (code == 0) {
+        EXPECT_EQ(err, "");
+        EXPECT_TRUE(fs::exists(dir_ / "out.png"));
+      } else {
+        ++failures;
+        EXPECT_EQ(lines(err), 1u);
+        EXPECT_EQ(err.rfind("vmpray: ", 0), 0u);
+        EXPECT_FALSE(fs::exists(dir_ / "out.png"));
+      }
+      fs::remove(dir_ / "out.png");
     }
-    fs::remove(dir_ / "out.png");
   }
   EXPECT_GT(failures, 0) << "no limit was low enough to fail";
 }
