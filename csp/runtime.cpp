@@ -214,10 +214,14 @@ struct Runtime::Impl {
     return o;
   }
 
-  void post(unsigned thread, Spawn s) {
-    Worker& w = *workers[thread];
+  // Counts the process alive and hands it to its thread; if either fails,
+  // neither is done.
+  void post(Spawn s) {
+    Worker& w = *workers[s.process->thread];
     detail::ChannelLock lk(w.lock);
-    w.inbox.push_back(std::move(s));
+    if (w.inbox.size() == w.inbox.capacity()) w.inbox.reserve(2 * w.inbox.size() + 1);
+    tracker.add(*s.process);
+    w.inbox.push_back(std::move(s));  // into the room made above: cannot throw
     w.wake_locked();
   }
 
@@ -364,8 +368,7 @@ void Runtime::spawn(std::string name, unsigned thread, std::function<void()> bod
   p->thread = thread % threads();
   p->priority = priority;
   p->stack_size = impl_->options.stack_size;
-  impl_->tracker.add(*p);
-  impl_->post(p->thread, Spawn{p, std::move(body)});
+  impl_->post(Spawn{p, std::move(body)});
 }
 
 void Runtime::run() {
@@ -450,6 +453,11 @@ void run_child(ParGroup& g, Process* child, const std::string& name, const std::
   if (child) child->tracker->remove(*child);
 }
 
+// "parent.i", or "par.i" outside a process.
+std::string child_name(const Process* parent, std::size_t i) {
+  return (parent ? parent->name : std::string("par")) + "." + std::to_string(i);
+}
+
 }  // namespace
 
 void par(std::vector<std::function<void()>> processes) {
@@ -458,27 +466,33 @@ void par(std::vector<std::function<void()>> processes) {
   g.remaining = processes.size();
   std::vector<boost::fibers::fiber> fibers;
   fibers.reserve(processes.size());
-  std::string not_started;  // why a child could not start (none after it did)
+  std::exception_ptr not_started;  // why a child could not start (none after it did)
+  std::size_t not_started_child = 0;
   for (std::size_t i = 0; i < processes.size(); ++i) {
     std::shared_ptr<Process> child;
-    std::string name = (parent ? parent->name : std::string("par")) + "." + std::to_string(i);
-    if (parent) {
-      child = std::make_shared<Process>();
-      child->name = name;
-      child->thread = parent->thread;
-      child->priority = parent->priority;
-      child->stack_size = parent->stack_size;
-      parent->tracker->add(*child);
-    }
+    bool counted = false;
     try {
+      std::string name = child_name(parent, i);
+      if (parent) {
+        child = std::make_shared<Process>();
+        child->name = name;
+        child->thread = parent->thread;
+        child->priority = parent->priority;
+        child->stack_size = parent->stack_size;
+        parent->tracker->add(*child);
+        counted = true;
+      }
       if (Scheduler* algo = detail::thread_algorithm()) algo->make_room_for_fiber();
       fibers.push_back(detail::start_fiber(
           parent ? parent->stack_size : RuntimeOptions{}.stack_size,
-          [&g, child, name, body = std::move(processes[i])] { run_child(g, child.get(), name, body); }));
+          [&g, child, name = std::move(name), body = std::move(processes[i])] {
+            run_child(g, child.get(), name, body);
+          }));
     } catch (...) {
       // The children started go on, and are waited for below: they use g.
-      not_started = detail::could_not_start(name, std::current_exception());
-      if (child) parent->tracker->remove(*child);
+      not_started = std::current_exception();
+      not_started_child = i;
+      if (counted) parent->tracker->remove(*child);
       detail::ChannelLock lk(g.lock);
       g.remaining -= processes.size() - i;
       break;
@@ -500,7 +514,8 @@ void par(std::vector<std::function<void()>> processes) {
     }
   }
   for (boost::fibers::fiber& f : fibers) f.join();
-  if (!not_started.empty()) throw ProcessNotStarted(not_started);  // the cause of any deadlock below
+  if (not_started)  // the cause of any deadlock below
+    throw ProcessNotStarted(detail::could_not_start(child_name(parent, not_started_child), not_started));
   if (g.deadlock) detail::unwind_deadlock();
   if (!g.failures.empty()) detail::rethrow_failures(g.failures);
   if (g.lost > 0) throw ProcessesFailed(std::to_string(g.lost) + " processes of a PAR failed, and no memory was left to record why");

@@ -1,5 +1,4 @@
 // Tracker: alive/blocked accounting and the deadlock abort (see process.hpp).
-#include <algorithm>
 #include <new>
 #include <stdexcept>
 #include <string>
@@ -22,13 +21,13 @@ void Tracker::add(Process& p) {
                               " processes alive on runtime thread " + std::to_string(p.thread));
   } while (!counts.compare_exchange_weak(word, word + one_alive + one_version));
   std::lock_guard<std::mutex> lk(mutex_);
-  processes_.push_back(&p);
+  processes_.push_back(p);
 }
 
 void Tracker::remove(Process& p) {
   {
     std::lock_guard<std::mutex> lk(mutex_);
-    processes_.erase(std::find(processes_.begin(), processes_.end(), &p));
+    processes_.erase(processes_.iterator_to(p));
   }
   const std::uint64_t word = counts_of(p).fetch_add(one_version - one_alive) + one_version - one_alive;
   if (!all_blocked(word)) return;
@@ -108,9 +107,9 @@ bool Tracker::abort_run(const Process* self) {
     }
     // Everyone waits (parked, or about to park having found the deadlock
     // too) and nobody else can claim them: wake all to unwind.
-    for (Process* q : processes_) {
-      Waiter* w = q->waiting.load(std::memory_order_acquire);
-      if (q == self || !w || !w->abortable) continue;
+    for (Process& q : processes_) {
+      Waiter* w = q.waiting.load(std::memory_order_acquire);
+      if (&q == self || !w || !w->abortable) continue;
       if (try_claim(*w)) complete(*w, WaitState::aborted, 0);
     }
   }
@@ -121,9 +120,9 @@ bool Tracker::abort_run(const Process* self) {
 std::string Tracker::describe_locked() const {
   std::ostringstream out;
   out << "deadlock: all " << processes_.size() << " live processes wait on channels, no timer pending";
-  for (const Process* q : processes_) {
-    out << "\n  process '" << q->name << "' (thread " << q->thread << "): ";
-    if (const Waiter* w = q->waiting.load(std::memory_order_acquire)) {
+  for (const Process& q : processes_) {
+    out << "\n  process '" << q.name << "' (thread " << q.thread << "): ";
+    if (const Waiter* w = q.waiting.load(std::memory_order_acquire)) {
       out << describe_wait(*w);
     } else {
       out << "ending";

@@ -30,9 +30,9 @@
 #include <memory>
 #include <mutex>
 #include <string>
-#include <vector>
 
 #include <boost/fiber/scheduler.hpp>
+#include <boost/intrusive/list.hpp>
 
 #include "csp/detail/wait.hpp"
 #include "csp/scheduler.hpp"
@@ -42,6 +42,7 @@ namespace csp::detail {
 class Tracker;
 
 struct Process {
+  boost::intrusive::list_member_hook<> alive;  // in its Tracker's list while alive
   std::string name;
   unsigned thread = 0;
   Priority priority = Priority::high;     // its PAR children's too
@@ -94,8 +95,12 @@ class Tracker {
   std::unique_ptr<Counts[]> counts_;
   std::atomic<bool> ended_{false};
   std::atomic<bool> aborting_{false};
-  mutable std::mutex mutex_;           // guards processes_ and dump_
-  std::vector<Process*> processes_;
+  mutable std::mutex mutex_;  // guards processes_ and dump_
+  // Linked through the processes themselves: adding or removing one
+  // allocates nothing and takes constant time.
+  boost::intrusive::list<Process, boost::intrusive::member_hook<Process, boost::intrusive::list_member_hook<>,
+                                                                &Process::alive>>
+      processes_;
   std::string dump_;                   // empty if there was no memory to write it
   std::size_t dump_processes_ = 0;
   std::function<void()> on_all_ended_;
