@@ -426,7 +426,7 @@ void Runtime::run() {
 struct ParGroup {
   detail::Spinlock lock;
   std::size_t remaining = 0;
-  detail::Waiter* parent = nullptr;  // a parent process, parked until remaining == 0
+  detail::Waiter* parent = nullptr;  // the parent, while parked until remaining == 0
   std::vector<Failure> failures;     // in the order the children ended
   std::vector<Failure> poisons;
   std::size_t lost = 0;              // failed, and no memory was left to record why
@@ -435,33 +435,39 @@ struct ParGroup {
 
 namespace {
 
-void run_child(ParGroup& g, Process* child, const std::string& name, const std::function<void()>& body) {
-  detail::bind_fiber(child);
+void run_child(ParGroup& g, Process& child, const std::function<void()>& body) {
+  detail::bind_fiber(&child);
   std::exception_ptr error;
   const detail::Ending e = detail::run_body(body, error);
   detail::bind_fiber(nullptr);
   {
     detail::ChannelLock lk(g.lock);
-    if (e == detail::Ending::failed) detail::note_failure(g.failures, g.lost, name, error);
-    if (e == detail::Ending::poisoned) detail::note_failure(g.poisons, g.lost, name, error);
+    if (e == detail::Ending::failed) detail::note_failure(g.failures, g.lost, child.name, error);
+    if (e == detail::Ending::poisoned) detail::note_failure(g.poisons, g.lost, child.name, error);
     g.deadlock |= e == detail::Ending::deadlock;
     // Wake the parent before ending, so it is never counted blocked alone.
     if (--g.remaining == 0 && g.parent && detail::try_claim(*g.parent)) {
       detail::complete(*g.parent, detail::WaitState::data, 0);
     }
   }
-  if (child) child->tracker->remove(*child);
+  child.tracker->remove(child);
 }
 
-// "parent.i", or "par.i" outside a process.
-std::string child_name(const Process* parent, std::size_t i) {
-  return (parent ? parent->name : std::string("par")) + "." + std::to_string(i);
-}
+std::string child_name(const Process& parent, std::size_t i) { return parent.name + "." + std::to_string(i); }
 
 }  // namespace
 
 void par(std::vector<std::function<void()>> processes) {
+  if (!detail::thread_scheduler()) {
+    // A plain thread: run the PAR as a process, so that a deadlock among the
+    // children is found and thrown rather than waited on forever.
+    Runtime runtime(1);
+    runtime.spawn("par", 0, [&processes] { par(std::move(processes)); });
+    runtime.run();
+    return;
+  }
   Process* parent = detail::current_process();
+  if (!parent) throw std::logic_error("csp::par: called from a fiber of a runtime thread that is no process");
   ParGroup g;
   g.remaining = processes.size();
   std::vector<boost::fibers::fiber> fibers;
@@ -472,22 +478,17 @@ void par(std::vector<std::function<void()>> processes) {
     std::shared_ptr<Process> child;
     bool counted = false;
     try {
-      std::string name = child_name(parent, i);
-      if (parent) {
-        child = std::make_shared<Process>();
-        child->name = name;
-        child->thread = parent->thread;
-        child->priority = parent->priority;
-        child->stack_size = parent->stack_size;
-        parent->tracker->add(*child);
-        counted = true;
-      }
-      if (Scheduler* algo = detail::thread_algorithm()) algo->make_room_for_fiber();
-      fibers.push_back(detail::start_fiber(
-          parent ? parent->stack_size : RuntimeOptions{}.stack_size,
-          [&g, child, name = std::move(name), body = std::move(processes[i])] {
-            run_child(g, child.get(), name, body);
-          }));
+      child = std::make_shared<Process>();
+      child->name = child_name(*parent, i);
+      child->thread = parent->thread;
+      child->priority = parent->priority;
+      child->stack_size = parent->stack_size;
+      parent->tracker->add(*child);
+      counted = true;
+      detail::thread_algorithm()->make_room_for_fiber();
+      fibers.push_back(detail::start_fiber(parent->stack_size, [&g, child, body = std::move(processes[i])] {
+        run_child(g, *child, body);
+      }));
     } catch (...) {
       // The children started go on, and are waited for below: they use g.
       not_started = std::current_exception();
@@ -498,10 +499,8 @@ void par(std::vector<std::function<void()>> processes) {
       break;
     }
   }
-  // A process parks, counted as blocked, until its children have ended.
-  // Outside a Runtime nothing counts, and the joins below are the wait (the
-  // caller may be a thread, which may not park: see detail/wait.hpp).
-  if (parent) {
+  // The parent parks, counted as blocked, until its children have ended.
+  {
     SpinlockLock lk(g.lock);
     while (g.remaining > 0) {
       detail::Waiter w;
@@ -515,7 +514,7 @@ void par(std::vector<std::function<void()>> processes) {
   }
   for (boost::fibers::fiber& f : fibers) f.join();
   if (not_started)  // the cause of any deadlock below
-    throw ProcessNotStarted(detail::could_not_start(child_name(parent, not_started_child), not_started));
+    throw ProcessNotStarted(detail::could_not_start(child_name(*parent, not_started_child), not_started));
   if (g.deadlock) detail::unwind_deadlock();
   if (!g.failures.empty()) detail::rethrow_failures(g.failures);
   if (g.lost > 0) throw ProcessesFailed(std::to_string(g.lost) + " processes of a PAR failed, and no memory was left to record why");

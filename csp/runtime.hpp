@@ -69,8 +69,9 @@ class Runtime {
 
 // PAR: runs every process as a fiber on the calling thread and waits for all.
 // Rethrows the first failure after all have ended (ProcessesFailed if several).
-// Outside a Runtime the children are no processes, so no deadlock among them
-// is detected.
+// Called from a thread outside any Runtime, it runs as process "par" of a
+// Runtime of one thread of its own, and waits for it: a deadlock among its
+// children is then thrown as Deadlock.
 void par(std::vector<std::function<void()>> processes);
 
 // Fiber-aware sleep; never counted as blocked by the deadlock detector.

@@ -146,6 +146,35 @@ TEST(Par, WorksOutsideARuntime) {
   EXPECT_EQ(got, 3);
 }
 
+// Outside a Runtime a PAR whose children deadlock throws Deadlock naming
+// them, as inside one. Should it wait instead, its channels are poisoned
+// after a while, so the test fails rather than hangs.
+TEST(Par, ADeadlockOutsideARuntimeIsThrown) {
+  csp::Channel<int> a("a");
+  csp::Channel<int> b("b");
+  std::promise<std::string> outcome;
+  std::future<std::string> result = outcome.get_future();
+  std::thread thread([&] {
+    try {
+      csp::par({[in = a.reader()]() mutable { in.read(); }, [in = b.reader()]() mutable { in.read(); }});
+      outcome.set_value("returned");
+    } catch (const csp::Deadlock& e) {
+      outcome.set_value(e.what());
+    } catch (const csp::Poisoned&) {
+      outcome.set_value("waited");
+    }
+  });
+  if (result.wait_for(10s) != std::future_status::ready) {
+    a.poison();
+    b.poison();
+  }
+  thread.join();
+  const std::string what = result.get();
+  EXPECT_EQ(what.rfind("deadlock: ", 0), 0u) << what;
+  EXPECT_NE(what.find("process 'par.0' (thread 0): reading channel 'a'"), std::string::npos) << what;
+  EXPECT_NE(what.find("process 'par.1' (thread 0): reading channel 'b'"), std::string::npos) << what;
+}
+
 // Runs use(c) for a fresh channel "c" of the given capacity on a thread of
 // its own, outside any Runtime. Returns the message of the std::logic_error
 // it threw, or "returned"; should it wait instead, c is poisoned after a
