@@ -86,6 +86,7 @@ class Scheduler : public boost::fibers::algo::algorithm_with_properties<ProcessP
   // set), so that Boost's noexcept awakened() need allocate nothing.
   virtual void make_room_for_fiber();
 };
+
 // Called once on each runtime thread, with that thread's index.
 using SchedulerFactory = std::function<Scheduler*(unsigned thread)>;
 

@@ -95,7 +95,7 @@ class Tracker {
   std::unique_ptr<Counts[]> counts_;
   std::atomic<bool> ended_{false};
   std::atomic<bool> aborting_{false};
-  mutable std::mutex mutex_;  // guards processes_ and dump_
+  mutable std::mutex mutex_;  // guards processes_, dump_ and dump_processes_
   // Linked through the processes themselves: adding or removing one
   // allocates nothing and takes constant time.
   boost::intrusive::list<Process, boost::intrusive::member_hook<Process, boost::intrusive::list_member_hook<>,
