@@ -8,6 +8,7 @@
 #include <condition_variable>
 #include <exception>
 #include <mutex>
+#include <new>
 #include <stdexcept>
 #include <thread>
 #include <utility>
@@ -261,7 +262,7 @@ struct Runtime::Impl {
 // Boost makes the thread's fiber context, scheduler and dispatcher stack
 // where std::bad_alloc ends the program, so room for them is first tried.
 void Runtime::Impl::set_up_thread(unsigned index) {
-  ::operator delete(::operator new(boost_thread_set_up_bytes));
+  if (!detail::address_space_free(boost_thread_set_up_bytes)) throw std::bad_alloc();
   std::unique_ptr<Scheduler> owned(
       options.scheduler
           ? options.scheduler(index)
@@ -271,7 +272,7 @@ void Runtime::Impl::set_up_thread(unsigned index) {
   algo->make_room_for_fiber();  // for the dispatcher, which set_algo makes ready
   main->get_scheduler()->set_algo(boost::fibers::algo::algorithm::ptr_t(owned.release()));
   detail::set_thread_scheduler(main->get_scheduler(), algo);
-  algo->make_room_for_fiber();
+  algo->make_room_for_fiber();  // for the main fiber's, made next
   main->set_properties(algo->new_properties(main));
 }
 

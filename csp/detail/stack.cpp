@@ -47,6 +47,13 @@ void* map(std::size_t bytes) {
 
 }  // namespace
 
+bool address_space_free(std::size_t bytes) {
+  void* p = ::mmap(nullptr, bytes, PROT_NONE, MAP_PRIVATE | MAP_ANONYMOUS | MAP_NORESERVE, -1, 0);
+  if (p == MAP_FAILED) return false;
+  ::munmap(p, bytes);
+  return true;
+}
+
 ProcessStack::ProcessStack(std::size_t size) : page_(static_cast<std::size_t>(::sysconf(_SC_PAGESIZE))) {
   size_ = (size + page_ - 1) / page_ * page_;
 }

@@ -35,4 +35,9 @@ class ProcessStack {
   std::size_t page_;
 };
 
+// Whether `bytes` of address space could be mapped now (ulimit -v leaves
+// room for them): maps and unmaps them, leaving the C library's allocator
+// as it was (a freed malloc block that large would raise its mmap threshold).
+bool address_space_free(std::size_t bytes);
+
 }  // namespace csp::detail
