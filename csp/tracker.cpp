@@ -8,6 +8,15 @@
 
 namespace csp::detail {
 
+namespace {
+
+// The first line of a deadlock's report.
+std::string deadlock_headline(std::size_t processes) {
+  return "deadlock: all " + std::to_string(processes) + " live processes wait on channels, no timer pending";
+}
+
+}  // namespace
+
 Tracker::Tracker(unsigned threads, std::function<void()> on_all_ended)
     : threads_(threads), counts_(std::make_unique<Counts[]>(threads)), on_all_ended_(std::move(on_all_ended)) {}
 
@@ -90,8 +99,7 @@ Tracker::Run Tracker::survey() const {
 std::string Tracker::deadlock_dump() const {
   std::lock_guard<std::mutex> lk(mutex_);
   if (!dump_.empty()) return dump_;
-  return "deadlock: all " + std::to_string(dump_processes_) +
-         " live processes wait on channels, no timer pending (no memory was left to say on what)";
+  return deadlock_headline(dump_processes_) + " (no memory was left to say on what)";
 }
 
 bool Tracker::abort_run(const Process* self) {
@@ -119,7 +127,7 @@ bool Tracker::abort_run(const Process* self) {
 
 std::string Tracker::describe_locked() const {
   std::ostringstream out;
-  out << "deadlock: all " << processes_.size() << " live processes wait on channels, no timer pending";
+  out << deadlock_headline(processes_.size());
   for (const Process& q : processes_) {
     out << "\n  process '" << q.name << "' (thread " << q.thread << "): ";
     if (const Waiter* w = q.waiting.load(std::memory_order_acquire)) {
