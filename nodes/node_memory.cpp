@@ -63,13 +63,11 @@ NodeMemory::NodeMemory(const PagePlacement& placement, int node, std::size_t pag
   // More slots than remote pages could never be filled.
   capacity_ = std::min(cache_pages, placement.page_count() - static_cast<std::uint32_t>(own_count_));
   slots_.reserve(capacity_);
-  slot_storage_.reserve(capacity_);
 }
 
 int NodeMemory::take_slot(std::span<const int> in_use) {
   if (slots_.size() < capacity_) {
-    slot_storage_.push_back(std::make_unique<std::byte[]>(page_size_));
-    slots_.push_back(Slot{slot_storage_.back().get(), 0, 0});
+    slots_.push_back(Slot{std::make_unique<std::byte[]>(page_size_), 0, 0});
     return static_cast<int>(slots_.size() - 1);
   }
   int victim = -1;
@@ -91,7 +89,7 @@ int NodeMemory::install(std::uint32_t page, std::span<const std::byte> bytes, st
   if (capacity_ == 0) throw std::logic_error("page cache has no slot for remote page " + std::to_string(page));
   const int slot = take_slot(in_use);
   Slot& s = slots_[static_cast<std::size_t>(slot)];
-  std::memcpy(s.bytes, bytes.data(), page_size_);
+  std::memcpy(s.bytes.get(), bytes.data(), page_size_);
   s.page = page;
   entry_[page] = -2 - slot;
   use(slot);

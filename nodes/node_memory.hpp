@@ -72,13 +72,13 @@ class NodeMemory {
   const std::byte* own_page(std::int32_t index) const {
     return own_.get() + static_cast<std::size_t>(index) * page_size_;
   }
-  const std::byte* slot_bytes(int slot) const { return slots_[static_cast<std::size_t>(slot)].bytes; }
+  const std::byte* slot_bytes(int slot) const { return slots_[static_cast<std::size_t>(slot)].bytes.get(); }
 
   // The slot's bytes, making it the most recently used.
   const std::byte* use(int slot) {
     Slot& s = slots_[static_cast<std::size_t>(slot)];
     s.last_use = ++clock_;
-    return s.bytes;
+    return s.bytes.get();
   }
 
   // Copies a fetched remote page into a free slot or the least recently
@@ -101,7 +101,7 @@ class NodeMemory {
 
  private:
   struct Slot {
-    std::byte* bytes;
+    std::unique_ptr<std::byte[]> bytes;  // page_size_ bytes, allocated on first use
     std::uint64_t last_use;  // clock_ at its last use or install
     std::uint32_t page;
   };
@@ -114,7 +114,6 @@ class NodeMemory {
   std::unique_ptr<std::byte[]> own_;  // own_count_ pages end to end
   std::vector<std::int32_t> entry_;
   std::vector<Slot> slots_;
-  std::vector<std::unique_ptr<std::byte[]>> slot_storage_;  // slots_[s].bytes points into [s]
   std::uint64_t clock_ = 0;
   std::uint64_t evictions_ = 0;
   std::unordered_map<std::uint32_t, std::vector<int>> pending_;  // page -> waiting workers
