@@ -207,7 +207,7 @@ class VertexGrid {
   static std::size_t along(double v, double lo, double hi, std::size_t cells) {
     if (!(hi > lo)) return 0;
     const double t = (v - lo) / (hi - lo) * static_cast<double>(cells);
-    return std::min(cells - 1, static_cast<std::size_t>(std::max(0.0, t)));
+    return static_cast<std::size_t>(clamped_int(t, 0, static_cast<int>(cells - 1)));
   }
   std::size_t column(double x) const { return along(x, lo_.x, hi_.x, columns_); }
   std::size_t row(double y) const { return along(y, lo_.y, hi_.y, rows_); }
