@@ -30,7 +30,8 @@ struct ProcessesFailed : std::runtime_error {
 };
 
 // Thrown by Runtime::run() when a spawned process could not start (no
-// memory for its stack): what() names the first and counts the others. The
+// memory for its stack or its scheduling record), and by par() for a child
+// that could not: what() names the first and counts the others. The
 // processes that waited for it were unwound, as in a deadlock, which this
 // error reports in its place, being the cause.
 struct ProcessNotStarted : std::runtime_error {
