@@ -1,9 +1,13 @@
 // Single experiment points and the compute-constant fit (see experiments.hpp).
 #include "app/experiments.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <exception>
+#include <mutex>
 #include <stdexcept>
+#include <thread>
 
 namespace app {
 
@@ -38,7 +42,60 @@ ExperimentPoint run_point(const tracer::Database& db, const ExperimentSetup& set
   return p;
 }
 
-double fit_unit(const tracer::Database& db, const ExperimentSetup& setup, double seconds) {
+std::vector<ExperimentPoint> run_points(const tracer::Database& db, const std::vector<ExperimentSetup>& setups,
+                                        unsigned jobs, const PointDone& done) {
+  const std::size_t count = setups.size();
+  std::vector<ExperimentPoint> points(count);
+  std::vector<std::exception_ptr> failures(count);
+  std::vector<bool> finished(count, false);
+  std::mutex lock;  // guards everything below, and the calls of `done`
+  std::size_t next = 0, reported = 0;
+  bool failed = false;
+  const auto work = [&] {
+    for (;;) {
+      std::size_t i = 0;
+      {
+        const std::lock_guard held(lock);
+        if (failed || next == count) return;
+        i = next++;
+      }
+      try {
+        points[i] = run_point(db, setups[i]);
+      } catch (...) {
+        failures[i] = std::current_exception();
+      }
+      const std::lock_guard held(lock);
+      finished[i] = true;
+      if (failures[i]) failed = true;
+      for (; reported < count && finished[reported] && !failures[reported]; ++reported) {
+        if (!done) continue;
+        try {
+          done(reported, points[reported]);
+        } catch (...) {
+          failures[reported] = std::current_exception();
+          failed = true;
+          break;
+        }
+      }
+    }
+  };
+  std::vector<std::thread> helpers;
+  const std::size_t wanted = std::min<std::size_t>(std::max(jobs, 1u), count);
+  for (std::size_t k = 1; k < wanted; ++k) {
+    try {
+      helpers.emplace_back(work);
+    } catch (...) {  // no thread or no memory for one: fewer jobs
+      break;         // the threads that did start, and this one, run every point
+    }
+  }
+  work();
+  for (std::thread& t : helpers) t.join();
+  for (const std::exception_ptr& failure : failures)
+    if (failure) std::rethrow_exception(failure);
+  return points;
+}
+
+double fit_unit(const tracer::Database& db, const ExperimentSetup& setup, double seconds, unsigned jobs) {
   if (!(seconds > 0)) throw std::invalid_argument("--fit-seconds must be positive");
   // A small probe unit keeps the probe run well inside the virtual clock's range.
   constexpr double probe_unit = 1e-6;
@@ -46,9 +103,10 @@ double fit_unit(const tracer::Database& db, const ExperimentSetup& setup, double
   probe.topology = "hypercube";
   probe.nodes = 1;
   probe.model.unit = probe_unit;
-  const double compute = run_point(db, probe).predicted_seconds;
-  probe.model.unit = 0.0;  // what remains is message time (work requests, results)
-  const double messages = run_point(db, probe).predicted_seconds;
+  ExperimentSetup messages_only = probe;
+  messages_only.model.unit = 0.0;  // what remains is message time (work requests, results)
+  const std::vector<ExperimentPoint> runs = run_points(db, {probe, messages_only}, jobs);
+  const double compute = runs[0].predicted_seconds, messages = runs[1].predicted_seconds;
   if (compute - messages <= 0) throw std::runtime_error("fit: the one-node run did no counted work");
   return probe_unit * (seconds - messages) / (compute - messages);
 }

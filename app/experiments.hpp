@@ -4,13 +4,16 @@
 // constant to a published time.
 //
 // Every point is a deterministic virtual-time run (nodes/timing.hpp), so a
-// point's figures depend only on its inputs. Speedup and efficiency are
+// point's figures depend only on its inputs, and points may run side by
+// side on several threads with the same results. Speedup and efficiency are
 // against the same scene on one node under the same model: E = T1 / (N * TN).
 #pragma once
 
 #include <cstdint>
+#include <functional>
 #include <optional>
 #include <string>
+#include <vector>
 
 #include "nodes/machine.hpp"
 #include "nodes/timing.hpp"
@@ -53,11 +56,25 @@ struct ExperimentPoint {
 // One run of db's frame under setup; db is copied (the machine consumes its copy).
 ExperimentPoint run_point(const tracer::Database& db, const ExperimentSetup& setup);
 
+// Called with each point's index in order, once it and every point before
+// it have finished; one call at a time.
+using PointDone = std::function<void(std::size_t index, const ExperimentPoint& point)>;
+
+// The points of all setups, in their order, run on up to `jobs` threads at
+// once (the caller's among them; jobs 0 is taken as 1). Setups are handed
+// out in order, so when runs fail the one rethrown, after the runs under
+// way have finished, is the first in setup order, as a one-by-one run would
+// report; no setup after a failure is started, and `done` is not called for
+// it or for any point after it.
+std::vector<ExperimentPoint> run_points(const tracer::Database& db, const std::vector<ExperimentSetup>& setups,
+                                        unsigned jobs, const PointDone& done = {});
+
 // The unit that makes db's one-node run under `setup` (its model, tracing
 // and grain; its node count is ignored) take `seconds`: compute time is
 // proportional to unit and the one-node run has no remote pages, so two runs
-// (a probe unit, and unit 0 for the message time) fix it.
-double fit_unit(const tracer::Database& db, const ExperimentSetup& setup, double seconds);
+// (a probe unit, and unit 0 for the message time) fix it; they run on up to
+// `jobs` threads.
+double fit_unit(const tracer::Database& db, const ExperimentSetup& setup, double seconds, unsigned jobs);
 
 // "3h12mn2s" as in the paper's Table 2 (also "51mn32s", "4.2s" below a minute).
 std::string paper_duration(double seconds);

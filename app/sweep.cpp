@@ -10,6 +10,7 @@
 #include <iostream>
 #include <limits>
 #include <sstream>
+#include <thread>
 
 #include "app/options.hpp"
 #include "app/scene_input.hpp"
@@ -59,7 +60,7 @@ struct RawSweep {
   std::string kind, topologies = "hypercube", nodes, cache, profile = "ipsc2", costs, out;
   std::string accel = "bvh", bvh_layout = "treelet", shadow_rays = "facing";
   std::string schedule = "dynamic", pixel_order = "scanline";
-  std::int64_t size = 64, page_size = 1024, grain = 4, prefetch = 0;
+  std::int64_t size = 64, page_size = 1024, grain = 4, prefetch = 0, jobs = 0;
 };
 
 po::options_description describe(SweepOptions& o, RawSweep& raw) {
@@ -84,6 +85,7 @@ po::options_description describe(SweepOptions& o, RawSweep& raw) {
       ("cost", po::value(&raw.costs), "costs over the profile: box=..,prim=..,shade=..,page=..,serve=..,msg=..,hop=..,bw=..")
       ("fit-seconds", po::value(&o.fit_seconds), "fit the compute unit so the one-node run takes this long")
       ("out", po::value(&raw.out), "output directory (default sweep-KIND)")
+      ("jobs,j", po::value(&raw.jobs), "runs side by side, each on a thread of its own (0, the default: one per core)")
       ("quiet,q", po::bool_switch(&o.quiet), "print nothing but errors");
   return d;
 }
@@ -96,6 +98,8 @@ void check_sweep(SweepOptions& o, const RawSweep& raw, const po::variables_map& 
   o.page_size = checked_page_size(raw.page_size);
   o.grain = in_range<std::uint32_t>(raw.grain, 1, 1 << 20, "--grain");
   o.prefetch = in_range<std::uint16_t>(raw.prefetch, 0, nodes::max_prefetch(nodes::MachineOptions{}), "--prefetch");
+  o.jobs = in_range<unsigned>(raw.jobs, 0, 1024, "--jobs");
+  if (o.jobs == 0) o.jobs = std::max(1u, std::thread::hardware_concurrency());
   if (vm.count("fit-seconds") && !(o.fit_seconds > 0 && std::isfinite(o.fit_seconds)))
     throw UsageError("--fit-seconds: expected a finite number of seconds above 0");
   o.topologies = split(raw.topologies);
@@ -203,10 +207,11 @@ SweepTable run_sweep(const SweepOptions& o, std::ostream* progress) {
   setup.model = o.model;
   setup.trace = o.trace;
   setup.nodes = 1;
-  if (o.fit_seconds > 0) setup.model.unit = fit_unit(db, setup, o.fit_seconds);
+  if (o.fit_seconds > 0) setup.model.unit = fit_unit(db, setup, o.fit_seconds, o.jobs);
   table.model = setup.model;
   if (!o.cache_pages.empty()) setup.cache_pages = o.cache_pages.front();
-  table.serial_seconds = run_point(db, setup).predicted_seconds;
+  // T1 first, then the table's points in its order.
+  std::vector<ExperimentSetup> setups{setup};
   const bool by_nodes = o.kind == SweepOptions::Kind::nodes;
   for (const std::string& topology : o.topologies) {
     const std::size_t count = by_nodes ? o.nodes.size() : o.cache_pages.size();
@@ -214,16 +219,28 @@ SweepTable run_sweep(const SweepOptions& o, std::ostream* progress) {
       setup.topology = topology;
       setup.nodes = by_nodes ? o.nodes[i] : o.nodes.front();
       if (!by_nodes) setup.cache_pages = o.cache_pages[i];
-      ExperimentPoint p = run_point(db, setup);
-      p.serial_seconds = table.serial_seconds;
-      if (progress)
-        *progress << p.topology << " N=" << p.nodes << " cache=" << p.cache_pages << ": "
-                  << paper_duration(p.predicted_seconds) << ", efficiency " << fixed(100 * p.efficiency(), 1)
-                  << "%, miss ratio " << fixed(100 * p.miss_ratio, 2) << "% (wall " << fixed(p.wall_seconds, 1)
-                  << " s)\n";
-      table.points.push_back(p);
+      setups.push_back(setup);
     }
   }
+  // Progress in the table's order; efficiency needs T1, which comes first.
+  double serial_seconds = 0;
+  const auto done = [&](std::size_t index, const ExperimentPoint& p) {
+    if (index == 0) {
+      serial_seconds = p.predicted_seconds;
+      return;
+    }
+    if (!progress) return;
+    ExperimentPoint shown = p;
+    shown.serial_seconds = serial_seconds;
+    *progress << p.topology << " N=" << p.nodes << " cache=" << p.cache_pages << ": "
+              << paper_duration(p.predicted_seconds) << ", efficiency " << fixed(100 * shown.efficiency(), 1)
+              << "%, miss ratio " << fixed(100 * p.miss_ratio, 2) << "% (wall " << fixed(p.wall_seconds, 1)
+              << " s)\n";
+  };
+  const std::vector<ExperimentPoint> points = run_points(db, setups, o.jobs, done);
+  table.serial_seconds = points.front().predicted_seconds;
+  table.points.assign(points.begin() + 1, points.end());
+  for (ExperimentPoint& p : table.points) p.serial_seconds = table.serial_seconds;
   return table;
 }
 

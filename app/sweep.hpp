@@ -8,6 +8,8 @@
 // one PNG per panel and DIR/<kind>.html (table + plots), and prints the table.
 // Every point is a deterministic virtual-time run; T1 (for speedup and
 // efficiency) is the one-node run of the same scene under the same model.
+// Points run side by side on --jobs threads; the tables do not depend on
+// how many, except for the wall time each point took.
 #pragma once
 
 #include <filesystem>
@@ -39,6 +41,7 @@ struct SweepOptions {
   tracer::TraceOptions trace;             // --shadow-rays
   double fit_seconds = 0;                 // > 0: fit model.unit so T1 takes this long
   std::filesystem::path out_dir;          // default: sweep-<kind>
+  unsigned jobs = 1;                      // points run side by side (--jobs 0: one per core)
   bool quiet = false;
 };
 

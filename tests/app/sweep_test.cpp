@@ -1,6 +1,7 @@
 // vmpray sweep: option errors, the CSV/JSON tables and SVG plots it writes
-// (parsed here), the HTML page linking only files it wrote, and the same
-// sweep giving the same predictions twice.
+// (parsed here), the HTML page linking only files it wrote, the same sweep
+// giving the same predictions twice and on any number of jobs, and which
+// failure a sweep of points run side by side reports.
 #include <gtest/gtest.h>
 
 #include <filesystem>
@@ -12,8 +13,10 @@
 #include <utility>
 #include <vector>
 
+#include "app/experiments.hpp"
 #include "app/options.hpp"
 #include "app/sweep.hpp"
+#include "tracer/generators.hpp"
 #include "tests/viz/xml_check.hpp"
 
 namespace {
@@ -75,6 +78,7 @@ TEST(SweepOptions, BadValuesNameTheOption) {
       {{"nodes", "--grain", "-1"}, "--grain: expected 1..1048576, got -1"},
       {{"nodes", "--prefetch", "-1"}, "--prefetch: expected 0..3, got -1"},
       {{"nodes", "--page-size", "-1"}, "--page-size: page size -1"},
+      {{"nodes", "--jobs", "-1"}, "--jobs: expected 0..1024, got -1"},
       {{"nodes", "--page-size", "1000"}, "--page-size: page size 1000"},
       // Every machine is checked before the first one runs.
       {{"nodes", "--nodes", "1,3"}, "--topology: topology 'hypercube': a hypercube needs a power of two nodes, not 3"},
@@ -263,6 +267,65 @@ TEST(Sweep, SameSweepGivesSamePredictions) {
     EXPECT_EQ(a.points[i].misses, b.points[i].misses);
     EXPECT_EQ(a.points[i].rays, b.points[i].rays);
     EXPECT_EQ(a.points[i].mean_hops, b.points[i].mean_hops);
+  }
+}
+
+// Points run side by side: the same figures as one by one, and the progress
+// lines in the table's order however the runs finish.
+TEST(Sweep, PointsRunSideBySideGiveTheTableOfOneByOne) {
+  auto o = parse({"nodes", "teapot:2", "--size", "12", "--nodes", "1,2,4,8", "--topology", "hypercube,ring",
+                  "--fit-seconds", "100"});
+  o.jobs = 1;
+  std::ostringstream one_progress;
+  const app::SweepTable one = app::run_sweep(o, &one_progress);
+  o.jobs = 3;
+  std::ostringstream three_progress;
+  const app::SweepTable three = app::run_sweep(o, &three_progress);
+  EXPECT_EQ(one.model.unit, three.model.unit);
+  EXPECT_EQ(one.serial_seconds, three.serial_seconds);
+  ASSERT_EQ(one.points.size(), 8u);
+  ASSERT_EQ(three.points.size(), one.points.size());
+  for (std::size_t i = 0; i < one.points.size(); ++i) {
+    const app::ExperimentPoint &a = one.points[i], &b = three.points[i];
+    EXPECT_EQ(a.topology, b.topology) << i;
+    EXPECT_EQ(a.nodes, b.nodes) << i;
+    EXPECT_EQ(a.predicted_seconds, b.predicted_seconds) << i;
+    EXPECT_EQ(a.serial_seconds, b.serial_seconds) << i;
+    EXPECT_EQ(a.misses, b.misses) << i;
+    EXPECT_EQ(a.messages, b.messages) << i;
+    EXPECT_EQ(a.rays, b.rays) << i;
+  }
+  const auto lines_of = [](const std::string& text) {
+    std::vector<std::string> lines;
+    std::istringstream in(text);
+    for (std::string line; std::getline(in, line);) lines.push_back(line.substr(0, line.find(" (wall")));
+    return lines;
+  };
+  const auto one_lines = lines_of(one_progress.str());
+  ASSERT_EQ(one_lines.size(), one.points.size());
+  EXPECT_EQ(lines_of(three_progress.str()), one_lines);
+  EXPECT_EQ(one_lines.front().rfind("hypercube:0 N=1 cache=", 0), 0u) << one_lines.front();
+  EXPECT_EQ(one_lines.back().rfind("ring:8 N=8 cache=", 0), 0u) << one_lines.back();
+}
+
+// Of several failing points the first in order is reported, as one by one,
+// and no point after a failure is reported done.
+TEST(Sweep, SideBySideRunsReportTheFirstFailureInOrder) {
+  tracer::Scene scene = tracer::generate_scene("teapot:2");
+  scene.camera.width = scene.camera.height = 8;
+  const tracer::Database db = tracer::build_database(scene, {});
+  std::vector<app::ExperimentSetup> setups(6);
+  setups[2].nodes = 3;  // no hypercube has 3 nodes
+  setups[4].nodes = 5;
+  for (const unsigned jobs : {1u, 2u, 6u}) {
+    std::vector<std::size_t> done;
+    try {
+      app::run_points(db, setups, jobs, [&](std::size_t i, const app::ExperimentPoint&) { done.push_back(i); });
+      ADD_FAILURE() << "no failure with " << jobs << " jobs";
+    } catch (const std::exception& e) {
+      EXPECT_NE(std::string(e.what()).find("not 3"), std::string::npos) << jobs << " jobs: " << e.what();
+    }
+    EXPECT_EQ(done, (std::vector<std::size_t>{0, 1})) << jobs << " jobs";
   }
 }
 
