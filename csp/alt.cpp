@@ -37,14 +37,26 @@ void Alt::watch(const Guard& g, detail::BellMark mark) {
   slot = mark;
 }
 
+// The guard is listed before its channel is told to ring the bell, and taken
+// off again if that fails, so that the destructor, which unregisters every
+// listed channel guard, leaves no channel ringing a bell that is gone (as a
+// push_back that ran out of memory after the channel was told once did).
 std::size_t Alt::add(Guard g) {
   if (on_channel(g.kind)) g.channel->require_bound(g.kind == Kind::room ? "Alt::add_room" : "Alt::add_input");
   if (g.kind == Kind::room && g.channel->capacity() == 0)
     throw std::logic_error("Alt::add_room: '" + g.channel->name() + "' is unbuffered");
-  if (bell_ && on_channel(g.kind)) watch(g, bell_->mark(guards_.size()));
   guards_.push_back(std::move(g));
+  const std::size_t index = guards_.size() - 1;
+  if (bell_ && on_channel(guards_.back().kind)) {
+    try {
+      watch(guards_.back(), bell_->mark(index));
+    } catch (...) {
+      guards_.pop_back();
+      throw;
+    }
+  }
   dirty_ = true;
-  return guards_.size() - 1;
+  return index;
 }
 
 void Alt::enable(std::size_t guard, bool on) {
