@@ -4,6 +4,7 @@
 #include <string>
 #include <utility>
 
+#include "app/memory_check.hpp"
 #include "app/progress.hpp"
 
 namespace app {
@@ -39,6 +40,9 @@ SerialComparison run_serial(const tracer::Database& db, const nodes::MachineOpti
 
 RenderResult render_machine(const Options& o, const tracer::Scene& scene) {
   tracer::Database db = build_database(scene, build_options(o));
+  // Before the machine is built: a complete graph of thousands of nodes would
+  // take minutes to set up before running out of memory.
+  check_machine_memory(o, scene.camera.width, scene.camera.height, db.header.page_count, memory_limit());
   RunReport report = describe_run(o, db);
   nodes::MachineOptions machine = o.machine;
   machine.trace = {.max_depth = o.max_depth,

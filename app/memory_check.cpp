@@ -192,23 +192,65 @@ MemoryLimit memory_limit() {
   return limit;
 }
 
+namespace {
+
+// "this machine's 4.3 GB", "the 200 MB this process may map (ulimit -v)".
+std::string available(const MemoryLimit& limit) {
+  switch (limit.source) {
+    case MemoryLimit::Source::control_group:
+      return "the " + about(limit.bytes) + " this process's control group may use";
+    case MemoryLimit::Source::address_space:
+      return "the " + about(limit.bytes) + " this process may map (ulimit -v)";
+    case MemoryLimit::Source::machine:
+      break;
+  }
+  return "this machine's " + about(limit.bytes);
+}
+
+// Resident bytes of a machine, measured on teapot at 16x16 (so that the
+// image weighs nothing) above the 1-node machine's, fitted over complete
+// graphs of 256 to 2048 nodes and hypercubes, rings, tori and meshes of
+// 1024 and 4096: a node's router, page server, page mailbox, their stacks
+// and state; a pixel computer's stack, tracer and channels; a link queue
+// with the router's guard, pending slot and counters for it, and in virtual
+// time its link process (stack and channel).
+constexpr std::uint64_t node_bytes = 44 * 1024, virtual_node_bytes = 64 * 1024;
+constexpr std::uint64_t worker_bytes = 10 * 1024;
+constexpr std::uint64_t link_queue_bytes = 930, virtual_link_queue_bytes = 9870;
+constexpr std::uint64_t page_entry = sizeof(std::int32_t);  // a node's page table, and a tracer's page stamps
+
+std::uint64_t link_queues(const topology::Topology& t) {
+  std::uint64_t ports = 0;
+  for (topology::NodeId n = 0; n < t.size(); ++n) ports += t.degree(n);
+  return ports * t.buffer_classes();
+}
+
+}  // namespace
+
 void check_image_memory(const Options& o, int width, int height, const MemoryLimit& limit) {
   const std::uint64_t needed = image_memory_bytes(o, width, height);
   if (needed <= limit.bytes) return;
-  std::string available;
-  switch (limit.source) {
-    case MemoryLimit::Source::machine:
-      available = "this machine's " + about(limit.bytes);
-      break;
-    case MemoryLimit::Source::control_group:
-      available = "the " + about(limit.bytes) + " this process's control group may use";
-      break;
-    case MemoryLimit::Source::address_space:
-      available = "the " + about(limit.bytes) + " this process may map (ulimit -v)";
-      break;
-  }
   throw UsageError("--width/--height: a " + std::to_string(width) + "x" + std::to_string(height) +
-                   " image needs about " + about(needed) + ", more than " + available);
+                   " image needs about " + about(needed) + ", more than " + available(limit));
+}
+
+std::uint64_t machine_memory_bytes(const Options& o, std::uint32_t page_count) {
+  const topology::Topology t = topology::parse_topology(o.machine.topology, o.machine.nodes);
+  const bool virtual_time = o.machine.timing.has_value();
+  const auto workers = static_cast<std::uint64_t>(o.machine.workers_per_node);
+  const std::uint64_t per_node = (virtual_time ? virtual_node_bytes : node_bytes) + workers * worker_bytes +
+                                 (1 + workers) * page_entry * page_count;
+  return t.size() * per_node + link_queues(t) * (virtual_time ? virtual_link_queue_bytes : link_queue_bytes);
+}
+
+void check_machine_memory(const Options& o, int width, int height, std::uint32_t page_count,
+                          const MemoryLimit& limit) {
+  const std::uint64_t needed = machine_memory_bytes(o, page_count) + image_memory_bytes(o, width, height);
+  if (needed <= limit.bytes) return;
+  const topology::Topology t = topology::parse_topology(o.machine.topology, o.machine.nodes);
+  throw UsageError("--nodes/--topology: " + t.spec() + " (" + std::to_string(t.size()) + " nodes, " +
+                   std::to_string(link_queues(t)) + " link queues) needs about " + about(needed) +
+                   " with its image, more than " + available(limit));
 }
 
 }  // namespace app

@@ -3,18 +3,20 @@
 // buffers will take at their peak are estimated from the options and the
 // image size, and an image whose estimate exceeds the memory there is is
 // refused at once, rather than by std::bad_alloc or the OOM killer after
-// minutes of work.
+// minutes of work. Once the database is built, the machine is checked the
+// same way: its nodes and links with the image (a complete graph of 4096
+// nodes has 16.8 million link queues, about 16 GB).
 //
-// The estimate counts what grows with the image (memory_check.cpp lists
-// each buffer): the float frames, the 8-bit copy the image writers encode,
-// the machine's pixel order, collected colours, pixel owners, the pixel
-// computers' tiles, tile records and their CSV text, and the ownership
-// picture. The scene, its database and the nodes' caches grow with the
-// scene, not the image, and are left out, as is the process's own few
-// megabytes.
-// Invariant: the estimate follows the renderers' allocations as they are;
-// a change to those buffers changes it too (memory_check_test.cpp holds it
-// to peak resident sizes measured on real runs).
+// The image's estimate counts what grows with the image (memory_check.cpp
+// lists each buffer): the float frames, the 8-bit copy the image writers
+// encode, the machine's pixel order, collected colours, pixel owners, the
+// pixel computers' tiles, tile records and their CSV text, and the
+// ownership picture. The machine's counts what grows with its nodes and
+// links (machine_memory_bytes below). The scene, its database and the
+// nodes' caches are left out, as is the process's own few megabytes.
+// Invariant: the estimates follow the renderers' allocations as they are;
+// a change to those buffers changes them too (memory_check_test.cpp holds
+// them to peak resident sizes measured on real runs).
 #pragma once
 
 #include <cstdint>
@@ -56,5 +58,21 @@ MemoryLimit memory_limit();
 // UsageError "--width/--height: a WxH image needs about X GB, more than this
 // machine's Y GB" when the estimate exceeds `limit`.
 void check_image_memory(const Options& options, int width, int height, const MemoryLimit& limit);
+
+// The bytes a machine takes beyond its image's buffers, with a database of
+// `page_count` pages: every node's processes and their fixed state, its
+// page table and its pixel computers' page stamps (4 bytes a page each),
+// and every link queue with the router's state for it, and in virtual time
+// the link process that carries it. Per-node and per-queue sizes are
+// measured (memory_check_test.cpp). Left out: the database's own pages,
+// which the host hands over as it distributes them, and the caches, which
+// fill only as far as the render touches pages.
+std::uint64_t machine_memory_bytes(const Options& options, std::uint32_t page_count);
+
+// UsageError "--nodes/--topology: complete:4096 (4096 nodes, 16773120 link
+// queues) needs about X GB with its image, more than this machine's Y GB"
+// when the machine's estimate and the image's together exceed `limit`.
+void check_machine_memory(const Options& options, int width, int height, std::uint32_t page_count,
+                          const MemoryLimit& limit);
 
 }  // namespace app

@@ -153,6 +153,23 @@ TEST_F(Cli, AnImageTooLargeForTheMemoryIsRefusedBeforeTheRender) {
   EXPECT_TRUE(fs::exists(dir_ / "out.png"));
 }
 
+// A machine whose nodes and links alone need more than the 2 GB this process
+// may map is refused once the database is built, before minutes of setting
+// up a complete graph of 2048 nodes and its 4 million link queues.
+TEST_F(Cli, AMachineTooLargeForTheMemoryIsRefusedBeforeItIsBuilt) {
+#if defined(__SANITIZE_ADDRESS__) || defined(__SANITIZE_THREAD__)
+  GTEST_SKIP() << "a sanitizer's shadow memory does not fit in 2 GB of address space";
+#endif
+  const Outcome r = run_vmpray("teapot --topology complete --nodes 2048 --width 16 --height 16 -o out.png",
+                               "stdout.txt", "ulimit -v 2000000");
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_EQ(r.err,
+            "vmpray: --nodes/--topology: complete:2048 (2048 nodes, 4192256 link queues) needs about 4.0 GB with its "
+            "image, more than the 2.0 GB this process may map (ulimit -v)\n");
+  EXPECT_EQ(r.out, "");
+  EXPECT_FALSE(fs::exists(dir_ / "out.png"));
+}
+
 // A machine whose process stacks do not fit in the address space this
 // process may map ends with one line naming a process that could not start:
 // the processes started before it, waiting for it, are unwound, not left to
