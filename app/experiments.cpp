@@ -11,7 +11,7 @@
 
 namespace app {
 
-ExperimentPoint run_point(const tracer::Database& db, const ExperimentSetup& setup) {
+nodes::MachineOptions machine_options(const ExperimentSetup& setup) {
   nodes::MachineOptions options;
   options.topology = setup.topology;
   options.nodes = setup.nodes;
@@ -22,7 +22,11 @@ ExperimentPoint run_point(const tracer::Database& db, const ExperimentSetup& set
   options.pixel_order = setup.pixel_order;
   options.timing = setup.model;
   options.trace = setup.trace;
-  const nodes::MachineResult result = nodes::run_machine(db, options);
+  return options;
+}
+
+ExperimentPoint run_point(const tracer::Database& db, const ExperimentSetup& setup) {
+  const nodes::MachineResult result = nodes::run_machine(db, machine_options(setup));
   const nodes::MachineReport& r = result.report;
   ExperimentPoint p;
   p.topology = r.topology;

@@ -53,6 +53,9 @@ struct ExperimentPoint {
   double efficiency() const { return nodes > 0 ? speedup() / nodes : 0; }
 };
 
+// The machine a setup runs.
+nodes::MachineOptions machine_options(const ExperimentSetup& setup);
+
 // One run of db's frame under setup; db is copied (the machine consumes its copy).
 ExperimentPoint run_point(const tracer::Database& db, const ExperimentSetup& setup);
 

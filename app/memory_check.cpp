@@ -41,6 +41,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <functional>
 #include <optional>
 #include <sstream>
 #include <string>
@@ -241,6 +242,22 @@ std::uint64_t machine_memory_bytes(const Options& o, std::uint32_t page_count) {
   const std::uint64_t per_node = (virtual_time ? virtual_node_bytes : node_bytes) + workers * worker_bytes +
                                  (1 + workers) * page_entry * page_count;
   return t.size() * per_node + link_queues(t) * (virtual_time ? virtual_link_queue_bytes : link_queue_bytes);
+}
+
+unsigned jobs_that_fit(const std::vector<nodes::MachineOptions>& machines, int width, int height,
+                       std::uint32_t page_count, unsigned jobs, const MemoryLimit& limit) {
+  std::vector<std::uint64_t> needs;
+  for (const nodes::MachineOptions& machine : machines) {
+    Options o;
+    o.machine = machine;
+    check_machine_memory(o, width, height, page_count, limit);
+    needs.push_back(machine_memory_bytes(o, page_count) + image_memory_bytes(o, width, height));
+  }
+  std::sort(needs.begin(), needs.end(), std::greater<>());
+  unsigned fit = 1;
+  std::uint64_t together = needs.empty() ? 0 : needs.front();
+  for (; fit < jobs && fit < needs.size() && together + needs[fit] <= limit.bytes; ++fit) together += needs[fit];
+  return fit;
 }
 
 void check_machine_memory(const Options& o, int width, int height, std::uint32_t page_count,

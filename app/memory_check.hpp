@@ -23,6 +23,7 @@
 #include <filesystem>
 #include <optional>
 #include <string>
+#include <vector>
 
 #include "app/options.hpp"
 
@@ -74,5 +75,12 @@ std::uint64_t machine_memory_bytes(const Options& options, std::uint32_t page_co
 // when the machine's estimate and the image's together exceed `limit`.
 void check_machine_memory(const Options& options, int width, int height, std::uint32_t page_count,
                           const MemoryLimit& limit);
+
+// For runs that may go side by side (a sweep's) on up to `jobs` threads: the
+// UsageError of check_machine_memory for the first machine that does not
+// fit alone; else how many of them, at most `jobs` and at least 1, fit at
+// once whichever run together (the largest ones do).
+unsigned jobs_that_fit(const std::vector<nodes::MachineOptions>& machines, int width, int height,
+                       std::uint32_t page_count, unsigned jobs, const MemoryLimit& limit);
 
 }  // namespace app

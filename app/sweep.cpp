@@ -12,6 +12,7 @@
 #include <sstream>
 #include <thread>
 
+#include "app/memory_check.hpp"
 #include "app/options.hpp"
 #include "app/scene_input.hpp"
 #include "app/timing_options.hpp"
@@ -85,7 +86,7 @@ po::options_description describe(SweepOptions& o, RawSweep& raw) {
       ("cost", po::value(&raw.costs), "costs over the profile: box=..,prim=..,shade=..,page=..,serve=..,msg=..,hop=..,bw=..")
       ("fit-seconds", po::value(&o.fit_seconds), "fit the compute unit so the one-node run takes this long")
       ("out", po::value(&raw.out), "output directory (default sweep-KIND)")
-      ("jobs,j", po::value(&raw.jobs), "runs side by side, each on a thread of its own (0, the default: one per core)")
+      ("jobs,j", po::value(&raw.jobs), "runs side by side, each on a thread of its own, as many as fit in the memory (0, the default: one per core)")
       ("quiet,q", po::bool_switch(&o.quiet), "print nothing but errors");
   return d;
 }
@@ -222,6 +223,11 @@ SweepTable run_sweep(const SweepOptions& o, std::ostream* progress) {
       setups.push_back(setup);
     }
   }
+  // A machine too large for the memory is refused before any runs; runs go
+  // side by side only as far as they fit together.
+  std::vector<nodes::MachineOptions> machines;
+  for (const ExperimentSetup& s : setups) machines.push_back(machine_options(s));
+  const unsigned jobs = jobs_that_fit(machines, o.size, o.size, db.header.page_count, o.jobs, memory_limit());
   // Progress in the table's order; efficiency needs T1, which comes first.
   double serial_seconds = 0;
   const auto done = [&](std::size_t index, const ExperimentPoint& p) {
@@ -237,7 +243,7 @@ SweepTable run_sweep(const SweepOptions& o, std::ostream* progress) {
               << "%, miss ratio " << fixed(100 * p.miss_ratio, 2) << "% (wall " << fixed(p.wall_seconds, 1)
               << " s)\n";
   };
-  const std::vector<ExperimentPoint> points = run_points(db, setups, o.jobs, done);
+  const std::vector<ExperimentPoint> points = run_points(db, setups, jobs, done);
   table.serial_seconds = points.front().predicted_seconds;
   table.points.assign(points.begin() + 1, points.end());
   for (ExperimentPoint& p : table.points) p.serial_seconds = table.serial_seconds;

@@ -8,8 +8,10 @@
 // one PNG per panel and DIR/<kind>.html (table + plots), and prints the table.
 // Every point is a deterministic virtual-time run; T1 (for speedup and
 // efficiency) is the one-node run of the same scene under the same model.
-// Points run side by side on --jobs threads; the tables do not depend on
-// how many, except for the wall time each point took.
+// Points run side by side on --jobs threads, no more than fit in the memory
+// together; the tables do not depend on how many, except for the wall time
+// each point took. A machine that does not fit alone is refused before any
+// run, as a render's is (memory_check.hpp).
 #pragma once
 
 #include <filesystem>
@@ -72,7 +74,8 @@ std::string sweep_json(const SweepTable& table);
 std::vector<std::filesystem::path> write_sweep(const SweepTable& table, const std::filesystem::path& dir,
                                                OutputFiles& outputs);
 
-// The whole subcommand: exit status 0, 1 (run error) or 2 (usage), errors one line on stderr.
+// The whole subcommand: exit status 0, 1 (run error) or 2 (usage, or a
+// machine too large for the memory), errors one line on stderr.
 int sweep_main(int argc, const char* const argv[]);
 
 }  // namespace app

@@ -11,6 +11,7 @@
 #include <optional>
 #include <string>
 #include <utility>
+#include <vector>
 
 #include "app/memory_check.hpp"
 #include "tests/support/command_line.hpp"
@@ -137,6 +138,34 @@ TEST(MemoryCheck, RefusesAMachineAboveTheLimitNamingTheOptions) {
   EXPECT_NO_THROW(app::check_machine_memory(o, 512, 512, 661, {needed}));
   EXPECT_THROW(app::check_machine_memory(o, 512, 512, 661, {needed - 1}), app::UsageError);
   EXPECT_NO_THROW(app::check_machine_memory(o, 16, 16, 661, {needed - 1}));
+}
+
+// Runs side by side: as many as fit together whichever run at once, so
+// counted from the largest; a machine that does not fit alone is refused.
+TEST(MemoryCheck, SideBySideRunsAreAsManyAsFitTogether) {
+  std::vector<nodes::MachineOptions> machines;
+  std::vector<std::uint64_t> needs;
+  for (const char* options : {"--nodes 1", "--nodes 4096", "--nodes 1024", "--topology ring --nodes 4096"}) {
+    const app::Options o = parse_words(options);
+    machines.push_back(o.machine);
+    needs.push_back(app::machine_memory_bytes(o, 661) + app::image_memory_bytes(o, 64, 64));
+  }
+  const std::uint64_t hypercube = needs[1], ring = needs[3], all = needs[0] + needs[1] + needs[2] + needs[3];
+  ASSERT_GT(hypercube, ring);
+  ASSERT_GT(ring, needs[2]);
+  EXPECT_EQ(app::jobs_that_fit(machines, 64, 64, 661, 4, {all}), 4u);
+  EXPECT_EQ(app::jobs_that_fit(machines, 64, 64, 661, 3, {all}), 3u);
+  EXPECT_EQ(app::jobs_that_fit(machines, 64, 64, 661, 4, {all - 1}), 3u);
+  EXPECT_EQ(app::jobs_that_fit(machines, 64, 64, 661, 4, {hypercube + ring}), 2u);
+  EXPECT_EQ(app::jobs_that_fit(machines, 64, 64, 661, 4, {hypercube}), 1u);
+  try {
+    app::jobs_that_fit(machines, 64, 64, 661, 4, {hypercube - 1});
+    ADD_FAILURE() << "a machine larger than the limit passed";
+  } catch (const app::UsageError& e) {
+    EXPECT_NE(std::string(e.what()).find("--nodes/--topology: hypercube:12 (4096 nodes, 49152 link queues)"),
+              std::string::npos)
+        << e.what();
+  }
 }
 
 TEST(MemoryCheck, RefusesAnImageAboveTheLimitNamingTheOptions) {

@@ -1,7 +1,8 @@
 // vmpray sweep: option errors, the CSV/JSON tables and SVG plots it writes
 // (parsed here), the HTML page linking only files it wrote, the same sweep
-// giving the same predictions twice and on any number of jobs, and which
-// failure a sweep of points run side by side reports.
+// giving the same predictions twice and on any number of jobs, which
+// failure a sweep of points run side by side reports, and a machine too
+// large for the memory refused before any run.
 #include <gtest/gtest.h>
 
 #include <filesystem>
@@ -17,6 +18,7 @@
 #include "app/options.hpp"
 #include "app/sweep.hpp"
 #include "tracer/generators.hpp"
+#include "tests/support/scratch.hpp"
 #include "tests/viz/xml_check.hpp"
 
 namespace {
@@ -327,6 +329,26 @@ TEST(Sweep, SideBySideRunsReportTheFirstFailureInOrder) {
     }
     EXPECT_EQ(done, (std::vector<std::size_t>{0, 1})) << jobs << " jobs";
   }
+}
+
+class SweepCli : public test::ScratchTest {
+ protected:
+  SweepCli() : ScratchTest("vmpray_sweep_cli_") {}
+};
+
+// A complete graph of 2048 nodes has 4 million link queues, each carried by
+// a process in virtual time: refused in one line, with nothing written.
+TEST_F(SweepCli, AMachineTooLargeForTheMemoryIsRefusedBeforeAnyRun) {
+#if defined(__SANITIZE_ADDRESS__) || defined(__SANITIZE_THREAD__)
+  GTEST_SKIP() << "a sanitizer's shadow memory does not fit in 2 GB of address space";
+#endif
+  const test::Outcome r = run_vmpray("sweep nodes --scene teapot:2 --size 8 --topology complete --nodes 1,2048 --out out",
+                                     "stdout.txt", "ulimit -v 2000000");
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_EQ(r.err,
+            "vmpray sweep: --nodes/--topology: complete:2048 (2048 nodes, 4192256 link queues) needs about 41.5 GB "
+            "with its image, more than the 2.0 GB this process may map (ulimit -v)\n");
+  EXPECT_FALSE(fs::exists(dir_ / "out"));
 }
 
 }  // namespace
