@@ -244,30 +244,41 @@ std::uint64_t machine_memory_bytes(const Options& o, std::uint32_t page_count) {
   return t.size() * per_node + link_queues(t) * (virtual_time ? virtual_link_queue_bytes : link_queue_bytes);
 }
 
+namespace {
+
+std::uint64_t machine_run_bytes(const Options& o, int width, int height, std::uint32_t page_count) {
+  return machine_memory_bytes(o, page_count) + image_memory_bytes(o, width, height);
+}
+
+void refuse_machine(const Options& o, std::uint64_t needed, const MemoryLimit& limit) {
+  const topology::Topology t = topology::parse_topology(o.machine.topology, o.machine.nodes);
+  throw UsageError("--nodes/--topology: " + t.spec() + " (" + std::to_string(t.size()) + " nodes, " +
+                   std::to_string(link_queues(t)) + " link queues) needs about " + about(needed) +
+                   " with its image, more than " + available(limit));
+}
+
+}  // namespace
+
+void check_machine_memory(const Options& o, int width, int height, std::uint32_t page_count,
+                          const MemoryLimit& limit) {
+  const std::uint64_t needed = machine_run_bytes(o, width, height, page_count);
+  if (needed > limit.bytes) refuse_machine(o, needed, limit);
+}
+
 unsigned jobs_that_fit(const std::vector<nodes::MachineOptions>& machines, int width, int height,
                        std::uint32_t page_count, unsigned jobs, const MemoryLimit& limit) {
   std::vector<std::uint64_t> needs;
   for (const nodes::MachineOptions& machine : machines) {
     Options o;
     o.machine = machine;
-    check_machine_memory(o, width, height, page_count, limit);
-    needs.push_back(machine_memory_bytes(o, page_count) + image_memory_bytes(o, width, height));
+    needs.push_back(machine_run_bytes(o, width, height, page_count));
+    if (needs.back() > limit.bytes) refuse_machine(o, needs.back(), limit);
   }
   std::sort(needs.begin(), needs.end(), std::greater<>());
   unsigned fit = 1;
   std::uint64_t together = needs.empty() ? 0 : needs.front();
   for (; fit < jobs && fit < needs.size() && together + needs[fit] <= limit.bytes; ++fit) together += needs[fit];
   return fit;
-}
-
-void check_machine_memory(const Options& o, int width, int height, std::uint32_t page_count,
-                          const MemoryLimit& limit) {
-  const std::uint64_t needed = machine_memory_bytes(o, page_count) + image_memory_bytes(o, width, height);
-  if (needed <= limit.bytes) return;
-  const topology::Topology t = topology::parse_topology(o.machine.topology, o.machine.nodes);
-  throw UsageError("--nodes/--topology: " + t.spec() + " (" + std::to_string(t.size()) + " nodes, " +
-                   std::to_string(link_queues(t)) + " link queues) needs about " + about(needed) +
-                   " with its image, more than " + available(limit));
 }
 
 }  // namespace app

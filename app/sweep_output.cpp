@@ -191,7 +191,7 @@ int sweep_main(int argc, const char* const argv[]) {
       std::cout << "wrote " << files.size() << " files in " << options.out_dir.string() << "\n";
     }
     return phase.finish(std::cout, "table");
-  } catch (const UsageError& e) {  // a machine too large for the memory
+  } catch (const UsageError& e) {  // found in the run: a machine too large for the memory
     std::cerr << "vmpray sweep: " << e.what() << "\n";
     return 2;
   } catch (const std::exception& e) {
