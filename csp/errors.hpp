@@ -1,7 +1,7 @@
 // Exceptions of the CSP runtime.
 // Poisoned ends a process normally (it is how a network shuts down); Deadlock,
-// ProcessesFailed and ProcessNotStarted are what Runtime::run() reports when
-// a run goes wrong.
+// ProcessesFailed, ProcessNotStarted and ThreadNotStarted are what
+// Runtime::run() reports when a run goes wrong.
 #pragma once
 
 #include <stdexcept>
@@ -25,8 +25,16 @@ struct Deadlock : std::runtime_error {
 
 // Thrown by Runtime::run() and par() when more than one process failed;
 // what() holds the first failure, then the next few and how many more.
+// out_of_memory() is true when any of them failed with std::bad_alloc, or
+// when no memory was left to record why they failed, so a caller can say
+// what to do about it.
 struct ProcessesFailed : std::runtime_error {
-  explicit ProcessesFailed(const std::string& summary) : std::runtime_error(summary) {}
+  ProcessesFailed(const std::string& summary, bool out_of_memory)
+      : std::runtime_error(summary), out_of_memory_(out_of_memory) {}
+  bool out_of_memory() const noexcept { return out_of_memory_; }
+
+ private:
+  bool out_of_memory_;
 };
 
 // Thrown by Runtime::run() when a spawned process could not start (no
@@ -36,6 +44,12 @@ struct ProcessesFailed : std::runtime_error {
 // error reports in its place, being the cause.
 struct ProcessNotStarted : std::runtime_error {
   explicit ProcessNotStarted(const std::string& what) : std::runtime_error(what) {}
+};
+
+// Thrown by Runtime::run() when one of its OS threads could not be started
+// or set up (no memory for its stack, or a limit on threads): no process ran.
+struct ThreadNotStarted : std::runtime_error {
+  explicit ThreadNotStarted(const std::string& what) : std::runtime_error(what) {}
 };
 
 }  // namespace csp

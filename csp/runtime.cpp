@@ -50,7 +50,16 @@ std::string message_of(const std::exception_ptr& e) {
   }
   text.pop_back();
   if (failures.size() > named) text += "; ...";
-  throw ProcessesFailed(text);
+  const bool out_of_memory = std::any_of(failures.begin(), failures.end(), [](const Failure& f) {
+    try {
+      std::rethrow_exception(f.error);
+    } catch (const std::bad_alloc&) {
+      return true;
+    } catch (...) {
+      return false;
+    }
+  });
+  throw ProcessesFailed(text, out_of_memory);
 }
 
 // What ProcessNotStarted says of one process.
@@ -386,7 +395,7 @@ void Runtime::run() {
   const auto give_up = [&](const std::string& what, std::size_t thread, const std::exception_ptr& why) {
     for (std::thread& t : threads) t.join();
     impl_->finished = true;
-    throw std::runtime_error("csp: could not " + what + " runtime thread " + std::to_string(thread + 1) + " of " +
+    throw ThreadNotStarted("csp: could not " + what + " runtime thread " + std::to_string(thread + 1) + " of " +
                              std::to_string(count) + ", so no process ran: " + detail::message_of(why));
   };
   try {
@@ -416,7 +425,8 @@ void Runtime::run() {
   }
   if (impl_->lost_failures > 0 && impl_->failures.empty())
     throw ProcessesFailed(std::to_string(impl_->lost_failures) +
-                          " processes failed, and no memory was left to record why");
+                              " processes failed, and no memory was left to record why",
+                          true);
 
   // Processes left waiting on one that failed deadlock: the failure is the cause.
   if (!impl_->failures.empty()) detail::rethrow_failures(impl_->failures);
@@ -518,7 +528,9 @@ void par(std::vector<std::function<void()>> processes) {
     throw ProcessNotStarted(detail::could_not_start(child_name(*parent, not_started_child), not_started));
   if (g.deadlock) detail::unwind_deadlock();
   if (!g.failures.empty()) detail::rethrow_failures(g.failures);
-  if (g.lost > 0) throw ProcessesFailed(std::to_string(g.lost) + " processes of a PAR failed, and no memory was left to record why");
+  if (g.lost > 0)
+    throw ProcessesFailed(std::to_string(g.lost) + " processes of a PAR failed, and no memory was left to record why",
+                          true);
   if (!g.poisons.empty()) std::rethrow_exception(g.poisons.front().error);
 }
 

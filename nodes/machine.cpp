@@ -281,10 +281,16 @@ MachineResult run_machine(tracer::Database db, const MachineOptions& options) {
   spawn_host(wiring, host);
   try {
     runtime.run();
+  } catch (const csp::ThreadNotStarted& e) {
+    throw csp::ThreadNotStarted(std::string(e.what()) + "; try fewer --threads (" + std::to_string(runtime.threads()) +
+                                " here), or see ulimit -v and ulimit -u");
   } catch (const csp::ProcessNotStarted& e) {
     throw csp::ProcessNotStarted(std::string(e.what()) + "; " + needs_more_memory(topology.size()));
   } catch (const std::bad_alloc&) {
     throw std::runtime_error("a process of the machine ran out of memory; " + needs_more_memory(topology.size()));
+  } catch (const csp::ProcessesFailed& e) {
+    if (!e.out_of_memory()) throw;
+    throw csp::ProcessesFailed(std::string(e.what()) + "; " + needs_more_memory(topology.size()), true);
   }
 
   MachineResult result;

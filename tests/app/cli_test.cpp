@@ -186,7 +186,8 @@ TEST_F(Cli, AMachineTooLargeForTheAddressSpaceEndsWithAnError) {
 
 // Wherever the memory runs out (ulimit -v from where the runtime threads
 // barely start to where the render fits), a run, in real or virtual time,
-// either succeeds or ends with one line and status 1: never an abort from
+// either succeeds or ends with one line and status 1 that points at the
+// limit (however many processes failed at once): never an abort from
 // an allocation that fails inside Boost.Fiber's noexcept scheduling calls,
 // nor a hang from a deadlock that finds no memory to describe itself.
 TEST_F(Cli, RunningOutOfAddressSpaceAnywhereEndsInSuccessOrOneLine) {
@@ -212,6 +213,7 @@ TEST_F(Cli, RunningOutOfAddressSpaceAnywhereEndsInSuccessOrOneLine) {
         ++failures;
         EXPECT_EQ(lines(err), 1u);
         EXPECT_EQ(err.rfind("vmpray: ", 0), 0u);
+        EXPECT_NE(err.find("ulimit -v"), std::string::npos);
         EXPECT_FALSE(fs::exists(dir_ / "out.png"));
       }
       fs::remove(dir_ / "out.png");

@@ -10,6 +10,7 @@
 #include <functional>
 #include <fstream>
 #include <future>
+#include <new>
 #include <optional>
 #include <sstream>
 #include <stdexcept>
@@ -100,6 +101,21 @@ TEST(Runtime, SummarisesSeveralFailures) {
     const std::string what = e.what();
     EXPECT_NE(what.find("'a' failed: first"), std::string::npos) << what;
     EXPECT_NE(what.find("'b': second"), std::string::npos) << what;
+    EXPECT_FALSE(e.out_of_memory());
+  }
+}
+
+// Several failures of which one is std::bad_alloc say that memory ran out,
+// so that a caller can add what to do about it.
+TEST(Runtime, SeveralFailuresSayWhenMemoryRanOut) {
+  csp::Runtime rt(1);
+  rt.spawn("a", 0, [] { throw std::runtime_error("first"); });
+  rt.spawn("b", 0, [] { throw std::bad_alloc(); });
+  try {
+    rt.run();
+    FAIL() << "run() did not throw";
+  } catch (const csp::ProcessesFailed& e) {
+    EXPECT_TRUE(e.out_of_memory()) << e.what();
   }
 }
 
@@ -137,6 +153,20 @@ TEST(Par, SummarisesSeveralChildFailures) {
   rt.run();
   EXPECT_NE(what.find("'parent.0' failed: x"), std::string::npos) << what;
   EXPECT_NE(what.find("'parent.1': y"), std::string::npos) << what;
+}
+
+TEST(Par, SeveralChildFailuresSayWhenMemoryRanOut) {
+  csp::Runtime rt(1);
+  std::optional<bool> out_of_memory;
+  rt.spawn("parent", 0, [&] {
+    try {
+      csp::par({[] { throw std::bad_alloc(); }, [] { throw std::bad_alloc(); }});
+    } catch (const csp::ProcessesFailed& e) {
+      out_of_memory = e.out_of_memory();
+    }
+  });
+  rt.run();
+  EXPECT_EQ(out_of_memory, std::optional<bool>(true));
 }
 
 TEST(Par, WorksOutsideARuntime) {
@@ -372,7 +402,7 @@ TEST(Runtime, AThreadThatCannotBeCreatedAbandonsTheRunBeforeAnyProcess) {
     const AddressSpaceLimit limit(mapped_bytes() + 4 * 1024 * 1024);
     try {
       rt.run();
-    } catch (const std::runtime_error& e) {
+    } catch (const csp::ThreadNotStarted& e) {
       error = e.what();
     }
   }
@@ -397,7 +427,7 @@ TEST(Runtime, AThreadThatCannotSetUpAbandonsTheRunBeforeAnyProcess) {
   try {
     rt.run();
     FAIL() << "run() did not throw";
-  } catch (const std::runtime_error& e) {
+  } catch (const csp::ThreadNotStarted& e) {
     EXPECT_STREQ(e.what(), "csp: could not set up runtime thread 3 of 4, so no process ran: std::bad_alloc");
   }
   EXPECT_EQ(ran, 0);
