@@ -22,6 +22,7 @@ WorkPlan::WorkPlan(std::uint32_t items, std::uint32_t grain, Schedule schedule, 
   if (schedule == Schedule::dynamic) return;
   for (int n = 0; n < nodes; ++n)
     for (int w = 0; w < workers_per_node; ++w) shares_.push_back(static_share(n, w));
+  started_.assign(shares_.size(), false);
 }
 
 std::optional<Tile> WorkPlan::next(int node, int worker) {
@@ -32,10 +33,12 @@ std::optional<Tile> WorkPlan::next(int node, int worker) {
     tile = {cursor_, std::min(grain_, items_ - cursor_)};
     cursor_ += tile.count;
   } else {
-    Tile& share = shares_[static_cast<std::size_t>(node * workers_ + worker)];
+    const auto me = static_cast<std::size_t>(node * workers_ + worker);
+    Tile& share = shares_[me];
     if (schedule_ == Schedule::static_split) tile = take_front(share, share.count);
     else if (share.count > 0) tile = take_front(share, affinity_chunk(share.count));
     else tile = steal();
+    if (schedule_ == Schedule::affinity) started_[me] = true;
   }
   if (tile.count == 0) return std::nullopt;
   handed_out_ += tile.count;
@@ -54,17 +57,29 @@ Tile WorkPlan::take_front(Tile& share, std::uint32_t most) {
   return tile;
 }
 
-// A chunk off the back of the largest share left (the first such, for
-// determinism): far from where its owner is working, and from the share that
-// would otherwise finish last.
+// What a steal may take of share i: all of it once its owner has started,
+// else all but the first tile its owner will take.
+std::uint32_t WorkPlan::stealable(std::size_t i) const {
+  const std::uint32_t count = shares_[i].count;
+  if (started_[i]) return count;
+  return count - std::min(count, affinity_chunk(count));
+}
+
+// A chunk off the back of the share with the most to steal (the first such,
+// for determinism): far from where its owner is working, and from the share
+// that would otherwise finish last. Nothing if no share has anything to
+// spare: what is left are first tiles that their owners will take.
 Tile WorkPlan::steal() {
-  auto victim = std::max_element(shares_.begin(), shares_.end(),
-                                 [](const Tile& a, const Tile& b) { return a.count < b.count; });
-  if (victim->count == 0) return {};
-  const std::uint32_t take = std::min(victim->count, affinity_chunk(victim->count));
-  victim->count -= take;
+  std::size_t victim = 0;
+  for (std::size_t i = 1; i < shares_.size(); ++i)
+    if (stealable(i) > stealable(victim)) victim = i;
+  const std::uint32_t spare = stealable(victim);
+  if (spare == 0) return {};
+  Tile& share = shares_[victim];
+  const std::uint32_t take = std::min(spare, affinity_chunk(share.count));
+  share.count -= take;
   ++steals_;
-  return {victim->first + victim->count, take};
+  return {share.first + share.count, take};
 }
 
 Tile WorkPlan::static_share(int node, int worker) const {

@@ -18,11 +18,15 @@
 //    items), so that a processor's rays stay near each other, its cache
 //    holds their pages, and big early tiles save farming messages; a worker
 //    whose share is used up takes 1/P of the largest share left, from its
-//    back.
+//    back. A share whose owner has not asked yet keeps the owner's first
+//    tile: where shares are a tile or two (small frames on many
+//    processors), a worker asking ahead would otherwise take whole shares
+//    from processors that have not started, and leave them idle.
 //
-// Invariants: every item is handed out exactly once over the plan's life; a
-// share is always one contiguous run; dynamic tiles are at most `grain`
-// items; the plan's answers depend only on the order of requests.
+// Invariants: every item is handed out exactly once over the plan's life
+// (every worker asks at least once, and its first request takes from its own
+// share); a share is always one contiguous run; dynamic tiles are at most
+// `grain` items; the plan's answers depend only on the order of requests.
 #pragma once
 
 #include <cstdint>
@@ -60,6 +64,7 @@ class WorkPlan {
   std::uint32_t affinity_chunk(std::uint32_t left) const;
   Tile take_front(Tile& share, std::uint32_t most);
   Tile steal();
+  std::uint32_t stealable(std::size_t share) const;
 
   std::uint32_t items_;
   std::uint32_t grain_;
@@ -70,6 +75,7 @@ class WorkPlan {
   std::uint32_t handed_out_ = 0;
   std::uint32_t steals_ = 0;
   std::vector<Tile> shares_;  // static and affinity: what is left of each worker's run
+  std::vector<bool> started_;  // affinity: whether each worker has taken from its share
 };
 
 }  // namespace nodes

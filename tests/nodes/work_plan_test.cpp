@@ -110,6 +110,26 @@ TEST(WorkPlan, AffinityStealsFromTheBackOfTheLargestShare) {
   EXPECT_EQ(plan.next(1, 0), (Tile{16, 1}));  // node 1 goes on at its front
 }
 
+// A worker asking ahead takes nothing of a share whose owner has not asked
+// yet but that share's first tile: with shares of one tile (small frames on
+// many processors) it would otherwise leave their owners idle.
+TEST(WorkPlan, AffinityLeavesEachOwnerItsFirstTile) {
+  WorkPlan plan(64, 16, Schedule::affinity, 4, 1);  // shares of one tile
+  EXPECT_EQ(plan.next(0, 0), (Tile{0, 16}));
+  EXPECT_FALSE(plan.next(0, 0));
+  for (std::uint32_t n = 1; n < 4; ++n) EXPECT_EQ(plan.next(static_cast<int>(n), 0), (Tile{16 * n, 16}));
+  EXPECT_EQ(plan.steals(), 0u);
+
+  WorkPlan larger(96, 16, Schedule::affinity, 2, 1);  // shares of three tiles
+  for (std::uint32_t first : {0u, 16u, 32u}) EXPECT_EQ(larger.next(0, 0), (Tile{first, 16}));
+  EXPECT_EQ(larger.next(0, 0), (Tile{80, 16}));  // from the back of node 1's share
+  EXPECT_EQ(larger.next(0, 0), (Tile{64, 16}));
+  EXPECT_FALSE(larger.next(0, 0));              // node 1's first tile stays
+  EXPECT_EQ(larger.next(1, 0), (Tile{48, 16}));
+  EXPECT_FALSE(larger.next(1, 0));
+  EXPECT_EQ(larger.steals(), 2u);
+}
+
 TEST(WorkPlan, ZeroGrainIsRejectedNamingTheOption) {
   try {
     WorkPlan(10, 0, Schedule::dynamic, 1, 1);
