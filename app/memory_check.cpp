@@ -266,12 +266,13 @@ void check_machine_memory(const Options& o, int width, int height, std::uint32_t
 }
 
 unsigned jobs_that_fit(const std::vector<nodes::MachineOptions>& machines, int width, int height,
-                       std::uint32_t page_count, unsigned jobs, const MemoryLimit& limit) {
+                       std::uint32_t page_count, std::size_t page_size, unsigned jobs, const MemoryLimit& limit) {
+  const std::uint64_t database_copy = std::uint64_t{page_count} * page_size;
   std::vector<std::uint64_t> needs;
   for (const nodes::MachineOptions& machine : machines) {
     Options o;
     o.machine = machine;
-    needs.push_back(machine_run_bytes(o, width, height, page_count));
+    needs.push_back(database_copy + machine_run_bytes(o, width, height, page_count));
     if (needs.back() > limit.bytes) refuse_machine(o, needs.back(), limit);
   }
   std::sort(needs.begin(), needs.end(), std::greater<>());

@@ -76,11 +76,13 @@ std::uint64_t machine_memory_bytes(const Options& options, std::uint32_t page_co
 void check_machine_memory(const Options& options, int width, int height, std::uint32_t page_count,
                           const MemoryLimit& limit);
 
-// For runs that may go side by side (a sweep's) on up to `jobs` threads: the
-// UsageError of check_machine_memory for the first machine that does not
+// For runs that may go side by side (a sweep's) on up to `jobs` threads,
+// each on its own copy of a database of `page_count` pages of `page_size`
+// bytes (the host hands its pages to the nodes, so a run keeps that copy):
+// the UsageError of check_machine_memory for the first run that does not
 // fit alone; else how many of them, at most `jobs` and at least 1, fit at
 // once whichever run together (the largest ones do).
 unsigned jobs_that_fit(const std::vector<nodes::MachineOptions>& machines, int width, int height,
-                       std::uint32_t page_count, unsigned jobs, const MemoryLimit& limit);
+                       std::uint32_t page_count, std::size_t page_size, unsigned jobs, const MemoryLimit& limit);
 
 }  // namespace app

@@ -227,7 +227,8 @@ SweepTable run_sweep(const SweepOptions& o, std::ostream* progress) {
   // side by side only as far as they fit together.
   std::vector<nodes::MachineOptions> machines;
   for (const ExperimentSetup& s : setups) machines.push_back(machine_options(s));
-  const unsigned jobs = jobs_that_fit(machines, o.size, o.size, db.header.page_count, o.jobs, memory_limit());
+  const unsigned jobs = jobs_that_fit(machines, o.size, o.size, db.header.page_count, db.header.page_size, o.jobs,
+                                     memory_limit());
   // Progress in the table's order; efficiency needs T1, which comes first.
   double serial_seconds = 0;
   const auto done = [&](std::size_t index, const ExperimentPoint& p) {

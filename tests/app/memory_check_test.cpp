@@ -142,24 +142,32 @@ TEST(MemoryCheck, RefusesAMachineAboveTheLimitNamingTheOptions) {
 
 // Runs side by side: as many as fit together whichever run at once, so
 // counted from the largest; a machine that does not fit alone is refused.
+// Each run holds a machine, an image and its own copy of the database.
 TEST(MemoryCheck, SideBySideRunsAreAsManyAsFitTogether) {
+  constexpr std::uint32_t pages = 661;
+  constexpr std::size_t page_size = 1024;
+  constexpr std::uint64_t database_copy = pages * page_size;
   std::vector<nodes::MachineOptions> machines;
   std::vector<std::uint64_t> needs;
   for (const char* options : {"--nodes 1", "--nodes 4096", "--nodes 1024", "--topology ring --nodes 4096"}) {
     const app::Options o = parse_words(options);
     machines.push_back(o.machine);
-    needs.push_back(app::machine_memory_bytes(o, 661) + app::image_memory_bytes(o, 64, 64));
+    needs.push_back(database_copy + app::machine_memory_bytes(o, pages) + app::image_memory_bytes(o, 64, 64));
   }
   const std::uint64_t hypercube = needs[1], ring = needs[3], all = needs[0] + needs[1] + needs[2] + needs[3];
   ASSERT_GT(hypercube, ring);
   ASSERT_GT(ring, needs[2]);
-  EXPECT_EQ(app::jobs_that_fit(machines, 64, 64, 661, 4, {all}), 4u);
-  EXPECT_EQ(app::jobs_that_fit(machines, 64, 64, 661, 3, {all}), 3u);
-  EXPECT_EQ(app::jobs_that_fit(machines, 64, 64, 661, 4, {all - 1}), 3u);
-  EXPECT_EQ(app::jobs_that_fit(machines, 64, 64, 661, 4, {hypercube + ring}), 2u);
-  EXPECT_EQ(app::jobs_that_fit(machines, 64, 64, 661, 4, {hypercube}), 1u);
+  const auto fit = [&](unsigned jobs, std::uint64_t limit) {
+    return app::jobs_that_fit(machines, 64, 64, pages, page_size, jobs, {limit});
+  };
+  EXPECT_EQ(fit(4, all), 4u);
+  EXPECT_EQ(fit(3, all), 3u);
+  EXPECT_EQ(fit(4, all - 1), 3u);
+  EXPECT_EQ(fit(4, all - database_copy), 3u);  // the machines fit, not with four copies of the database
+  EXPECT_EQ(fit(4, hypercube + ring), 2u);
+  EXPECT_EQ(fit(4, hypercube), 1u);
   try {
-    app::jobs_that_fit(machines, 64, 64, 661, 4, {hypercube - 1});
+    fit(4, hypercube - 1);
     ADD_FAILURE() << "a machine larger than the limit passed";
   } catch (const app::UsageError& e) {
     EXPECT_NE(std::string(e.what()).find("--nodes/--topology: hypercube:12 (4096 nodes, 49152 link queues)"),
