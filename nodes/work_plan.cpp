@@ -71,9 +71,12 @@ std::uint32_t WorkPlan::stealable(std::size_t i) const {
 // spare: what is left are first tiles that their owners will take.
 Tile WorkPlan::steal() {
   std::size_t victim = 0;
-  for (std::size_t i = 1; i < shares_.size(); ++i)
-    if (stealable(i) > stealable(victim)) victim = i;
-  const std::uint32_t spare = stealable(victim);
+  std::uint32_t spare = 0;
+  for (std::size_t i = 0; i < shares_.size(); ++i)
+    if (const std::uint32_t n = stealable(i); n > spare) {
+      victim = i;
+      spare = n;
+    }
   if (spare == 0) return {};
   Tile& share = shares_[victim];
   const std::uint32_t take = std::min(spare, affinity_chunk(share.count));
