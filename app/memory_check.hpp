@@ -12,8 +12,9 @@
 // encode, the machine's pixel order, collected colours, pixel owners, the
 // pixel computers' tiles, tile records and their CSV text, and the
 // ownership picture. The machine's counts what grows with its nodes and
-// links (machine_memory_bytes below). The scene, its database and the
-// nodes' caches are left out, as is the process's own few megabytes.
+// links (machine_memory_bytes below). The scene, its database (but for the
+// copy each of a sweep's side-by-side runs holds, jobs_that_fit below) and
+// the nodes' caches are left out, as is the process's own few megabytes.
 // Invariant: the estimates follow the renderers' allocations as they are;
 // a change to those buffers changes them too (memory_check_test.cpp holds
 // them to peak resident sizes measured on real runs).
