@@ -356,14 +356,20 @@ void Runtime::Impl::run_process(Process& p, const std::function<void()>& body) {
   detail::bind_fiber(&p);
   std::exception_ptr error;
   if (detail::run_body(body, error) == detail::Ending::failed) {
-    std::lock_guard<std::mutex> lk(failures_mutex);
-    detail::note_failure(failures, lost_failures, p.name, error);
+    {
+      std::lock_guard<std::mutex> lk(failures_mutex);
+      detail::note_failure(failures, lost_failures, p.name, error);
+    }
+    if (options.on_failure) try {
+        options.on_failure(p.name, error);
+      } catch (...) {
+      }
   }
   detail::bind_fiber(nullptr);
   tracker.remove(p);
 }
 
-Runtime::Runtime(unsigned threads) : Runtime(RuntimeOptions{threads, RuntimeOptions{}.stack_size, {}}) {}
+Runtime::Runtime(unsigned threads) : Runtime(RuntimeOptions{threads, RuntimeOptions{}.stack_size, {}, {}}) {}
 Runtime::Runtime(RuntimeOptions options) : impl_(std::make_unique<Impl>(std::move(options))) {}
 Runtime::~Runtime() = default;
 

@@ -38,6 +38,11 @@ struct RuntimeOptions {
   unsigned threads = 0;                   // 0: std::thread::hardware_concurrency()
   std::size_t stack_size = 256 * 1024;    // bytes per process fiber, with a guard page below (detail/stack.hpp)
   SchedulerFactory scheduler;             // empty: FifoScheduler on every thread
+  // Called on the failing process's thread, after it ended with an
+  // exception other than Poisoned and before run() returns: lets a program
+  // whose other processes wait on something outside the runtime (a wire to
+  // another OS process) stop them. Must not block; what it throws is dropped.
+  std::function<void(const std::string& process, std::exception_ptr error)> on_failure;
 };
 
 class Runtime {

@@ -10,7 +10,10 @@
 #include <string>
 #include <thread>
 
+#include <sys/resource.h>
+
 #include "nodes/mailbox.hpp"
+#include "nodes/report_wire.hpp"
 #include "topology/spec.hpp"
 
 namespace nodes {
@@ -43,6 +46,13 @@ struct Host {
   std::vector<std::uint16_t> owners;  // per pixel or corner sample in scanline order, filled by the collector
 };
 
+std::unique_ptr<NodeState> node_state(const PagePlacement& placement, int n, std::size_t page_size,
+                                      std::vector<std::vector<std::byte>> own, std::uint32_t cache_pages) {
+  auto state = std::make_unique<NodeState>();
+  state->svm = std::make_unique<NodeSvm>(NodeMemory(placement, n, page_size, std::move(own), cache_pages));
+  return state;
+}
+
 void validate(const MachineOptions& options) {
   if (options.workers_per_node < 1) throw std::invalid_argument("--workers-per-node must be at least 1");
   if (options.grain < 1) throw std::invalid_argument("--grain must be at least 1");
@@ -65,10 +75,7 @@ std::vector<std::unique_ptr<NodeState>> distribute(tracer::Database& db, const P
   for (int n = 0; n < placement.nodes(); ++n) {
     std::vector<std::vector<std::byte>> own(placement.own_count(n));
     for (std::uint32_t i = 0; i < own.size(); ++i) own[i] = std::move(db.pages[placement.page_of(n, i)]);
-    auto state = std::make_unique<NodeState>();
-    state->svm = std::make_unique<NodeSvm>(
-        NodeMemory(placement, n, db.header.page_size, std::move(own), cache_pages));
-    nodes.push_back(std::move(state));
+    nodes.push_back(node_state(placement, n, db.header.page_size, std::move(own), cache_pages));
   }
   db.pages.clear();
   db.pages.shrink_to_fit();  // the host keeps no copy
@@ -235,27 +242,116 @@ std::uint32_t cache_pages_for(const MachineOptions& options, const tracer::Datab
   return default_cache_pages(header);
 }
 
-MachineResult run_machine(tracer::Database db, const MachineOptions& options) {
-  validate(options);
-  const auto topology = topology::parse_topology(options.topology, options.nodes);
-  const std::uint32_t cache_pages = cache_pages_for(options, db.header);
-  const tracer::DatabaseHeader& header = db.header;
-  const PagePlacement placement(options.distribution, static_cast<int>(topology.size()), header.page_count);
-  auto nodes = distribute(db, placement, cache_pages);
+namespace {
 
+// Which nodes this process runs: all of them, or one rank's block.
+struct Share {
+  const RankPlan* plan = nullptr;  // null: the whole machine
+  Transport* transport = nullptr;
+  int rank = 0;
+
+  bool runs(NodeId n) const { return plan == nullptr || plan->runs(rank, n); }
+  std::size_t node_count(std::size_t nodes) const { return plan ? plan->count(rank) : nodes; }
+  NodeId first_node() const { return plan ? plan->first(rank) : 0; }
+};
+
+// What a split run adds to the processes: the bridge and its notes.
+struct SplitState {
+  FailureNote local_failure, remote_failure;
+  BridgeCounters bridge;
+};
+
+std::string message_of(const std::exception_ptr& error) {
+  try {
+    std::rethrow_exception(error);
+  } catch (const std::exception& e) {
+    return e.what();
+  } catch (...) {
+    return "unknown exception";
+  }
+}
+
+double cpu_seconds() {
+  rusage use{};
+  getrusage(RUSAGE_SELF, &use);
+  const auto seconds = [](const timeval& t) { return static_cast<double>(t.tv_sec) + 1e-6 * static_cast<double>(t.tv_usec); };
+  return seconds(use.ru_utime) + seconds(use.ru_stime);
+}
+
+// Runs the runtime, turning what ended it into one line with its hint.
+void run_runtime(csp::Runtime& runtime, std::size_t nodes, SplitState* split, int rank) {
+  try {
+    try {
+      runtime.run();
+    } catch (const csp::ThreadNotStarted& e) {
+      throw csp::ThreadNotStarted(std::string(e.what()) + "; try fewer --threads (" +
+                                  std::to_string(runtime.threads()) + " here), or see ulimit -v and ulimit -u");
+    } catch (const csp::ProcessNotStarted& e) {
+      throw csp::ProcessNotStarted(std::string(e.what()) + "; " + needs_more_memory(nodes));
+    } catch (const std::bad_alloc&) {
+      throw std::runtime_error("a process of the machine ran out of memory; " + needs_more_memory(nodes));
+    } catch (const csp::ProcessesFailed& e) {
+      if (!e.out_of_memory()) throw;
+      throw csp::ProcessesFailed(std::string(e.what()) + "; " + needs_more_memory(nodes), true);
+    }
+  } catch (const std::exception& e) {
+    if (split == nullptr) throw;
+    // This rank's own failure goes first; what else ended here followed from it.
+    if (const auto local = split->local_failure.get()) throw RankFailure(local->first, local->second);
+    if (const auto remote = split->remote_failure.get()) throw RankFailure(remote->first, remote->second);
+    throw RankFailure(rank, e.what());
+  }
+  if (split == nullptr) return;
+  if (const auto remote = split->remote_failure.get()) throw RankFailure(remote->first, remote->second);
+}
+
+struct Executed {
+  MachineResult result;
+  std::vector<RouterCounters> routers;  // split runs only: index = node, zero for other ranks' nodes
+};
+
+// The run of this process's share of the machine. nodes[n] is null for the
+// nodes another process runs; the result's per_node entries for those stay
+// empty and its image is empty unless this process runs node 0.
+Executed execute(const tracer::DatabaseHeader& header, const topology::Topology& topology,
+                      const PagePlacement& placement, std::uint32_t cache_pages,
+                      std::vector<std::unique_ptr<NodeState>>& nodes, const MachineOptions& options,
+                      const Share& share) {
   const auto started = std::chrono::steady_clock::now();
+  const double cpu_started = cpu_seconds();
   std::optional<MachineTiming> timing;
   if (options.timing) timing.emplace(*options.timing, static_cast<int>(topology.size()));
+  const std::size_t local_nodes = share.node_count(topology.size());
   csp::RuntimeOptions runtime_options;
-  runtime_options.threads = thread_count(options, topology.size());
+  runtime_options.threads = thread_count(options, local_nodes);
   if (timing) runtime_options = timing->runtime_options(runtime_options.stack_size);
+  std::optional<SplitState> split;
+  Network* network = nullptr;
+  if (share.plan) {
+    split.emplace();
+    // A process that fails leaves others waiting on it, and the bridge
+    // polling the wire keeps the runtime from calling that a deadlock: shut
+    // the network down, so the bridge tells the other ranks and ends.
+    runtime_options.on_failure = [&split, &network, rank = share.rank](const std::string& process,
+                                                                        std::exception_ptr error) {
+      split->local_failure.set(rank, "process '" + process + "' failed: " + message_of(error));
+      if (network) network->shutdown();
+    };
+  }
   csp::Runtime runtime(std::move(runtime_options));
   NetworkOptions net_options;
   net_options.buffer_capacity = options.buffer_capacity;
   net_options.ports_per_node = Ports::count(options.workers_per_node);
   net_options.trace_routes = options.trace_routes;
   if (timing) net_options.link = timing->model().link_model();
+  if (share.plan) {
+    net_options.local = [share](NodeId n) { return share.runs(n); };
+    net_options.placement = [first = share.first_node(), local_nodes, threads = runtime.threads()](NodeId n) {
+      return Network::block_placement(n - first, local_nodes, threads);
+    };
+  }
   Network net(runtime, topology, net_options);
+  network = &net;
 
   const bool corners = options.trace.spd_procedure;
   const int rows = header.camera.height + (corners ? 1 : 0);
@@ -273,27 +369,25 @@ MachineResult run_machine(tracer::Database db, const MachineOptions& options) {
                       timing ? &*timing : nullptr,
                       options.record_tiles ? run_clock(started, timing.has_value()) : RunClock{}};
   Host host;
-  host.plan = std::make_unique<WorkPlan>(items, options.grain, options.schedule, static_cast<int>(topology.size()),
-                                         options.workers_per_node);
-  host.frame = std::make_unique<FrameAssembler>(items, grid.positions);
-  host.owners.assign(items, 0);
-  for (std::size_t n = 0; n < nodes.size(); ++n) spawn_node(wiring, static_cast<NodeId>(n), *nodes[n]);
-  spawn_host(wiring, host);
-  try {
-    runtime.run();
-  } catch (const csp::ThreadNotStarted& e) {
-    throw csp::ThreadNotStarted(std::string(e.what()) + "; try fewer --threads (" + std::to_string(runtime.threads()) +
-                                " here), or see ulimit -v and ulimit -u");
-  } catch (const csp::ProcessNotStarted& e) {
-    throw csp::ProcessNotStarted(std::string(e.what()) + "; " + needs_more_memory(topology.size()));
-  } catch (const std::bad_alloc&) {
-    throw std::runtime_error("a process of the machine ran out of memory; " + needs_more_memory(topology.size()));
-  } catch (const csp::ProcessesFailed& e) {
-    if (!e.out_of_memory()) throw;
-    throw csp::ProcessesFailed(std::string(e.what()) + "; " + needs_more_memory(topology.size()), true);
+  for (std::size_t n = 0; n < nodes.size(); ++n)
+    if (nodes[n]) spawn_node(wiring, static_cast<NodeId>(n), *nodes[n]);
+  if (share.runs(0)) {
+    host.plan = std::make_unique<WorkPlan>(items, options.grain, options.schedule, static_cast<int>(topology.size()),
+                                           options.workers_per_node);
+    host.frame = std::make_unique<FrameAssembler>(items, grid.positions);
+    host.owners.assign(items, 0);
+    spawn_host(wiring, host);
   }
+  std::unique_ptr<Bridge> bridge;
+  if (share.plan) {
+    bridge = std::make_unique<Bridge>(*share.transport, *share.plan, net, split->local_failure,
+                                      split->remote_failure, split->bridge);
+    runtime.spawn("bridge", net.thread_of(share.first_node()), [&bridge] { bridge->run(); });
+  }
+  run_runtime(runtime, topology.size(), split ? &*split : nullptr, share.rank);
 
-  MachineResult result;
+  Executed executed;
+  MachineResult& result = executed.result;
   MachineReport& report = result.report;
   report.wall_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
   report.host_threads = runtime.thread_use();
@@ -311,17 +405,194 @@ MachineResult run_machine(tracer::Database db, const MachineOptions& options) {
   report.page_size = header.page_size;
   report.page_count = header.page_count;
   report.items = items;
-  for (const auto& node : nodes) report.per_node.push_back(node_report(*node));
+  report.per_node.resize(nodes.size());
+  for (std::size_t n = 0; n < nodes.size(); ++n)
+    if (nodes[n]) report.per_node[n] = node_report(*nodes[n]);
   report.schedule = options.schedule;
   report.pixel_order = options.pixel_order;
   report.grain = options.grain;
-  report.farmer = host.farmer;
-  report.farmer.steals = host.plan->steals();
-  report.collected = host.frame->received();
-  report.owners = std::move(host.owners);
   report.network = net.stats();
-  result.image = assemble_image(header, grid, host.frame->colors());
-  return result;
+  if (share.plan) {
+    RankReport rank;
+    rank.rank = share.rank;
+    rank.first_node = share.first_node();
+    rank.node_count = static_cast<std::uint32_t>(local_nodes);
+    rank.threads = runtime.threads();
+    rank.bridge = split->bridge;
+    rank.wall_seconds = report.wall_seconds;
+    rank.cpu_seconds = cpu_seconds() - cpu_started;
+    for (std::size_t n = 0; n < nodes.size(); ++n)
+      if (nodes[n]) rank.peak_scene_bytes += report.per_node[n].peak_resident_bytes;
+    report.ranks.push_back(rank);
+    report.cut_links = share.plan->cut_links();
+    // The routers' counters travel to rank 0 with the node reports.
+    executed.routers.resize(nodes.size());
+    for (std::size_t n = 0; n < nodes.size(); ++n)
+      if (nodes[n]) executed.routers[n] = net.router_counters(static_cast<NodeId>(n));
+  }
+  if (share.runs(0)) {
+    report.farmer = host.farmer;
+    report.farmer.steals = host.plan->steals();
+    report.collected = host.frame->received();
+    report.owners = std::move(host.owners);
+    result.image = assemble_image(header, grid, host.frame->colors());
+  }
+  return executed;
+}
+
+}  // namespace
+
+MachineResult run_machine(tracer::Database db, const MachineOptions& options) {
+  validate(options);
+  const auto topology = topology::parse_topology(options.topology, options.nodes);
+  const std::uint32_t cache_pages = cache_pages_for(options, db.header);
+  const PagePlacement placement(options.distribution, static_cast<int>(topology.size()), db.header.page_count);
+  auto nodes = distribute(db, placement, cache_pages);
+  return execute(db.header, topology, placement, cache_pages, nodes, options, Share{}).result;
+}
+
+namespace {
+
+enum class Setup : std::uint8_t { failed = 0, ok = 1 };
+
+// Rank 0: the header to every rank, then each node's own pages, end to end,
+// to the rank that runs it, one node at a time, so that the host holds at
+// most one node's share twice. Keeps its own nodes' pages.
+void send_setup(tracer::Database& db, const RankPlan& plan, const PagePlacement& placement,
+                std::uint32_t cache_pages, Transport& transport, std::vector<std::unique_ptr<NodeState>>& nodes) {
+  for (int q = 1; q < plan.ranks(); ++q) {
+    WireWriter w;
+    w.put(Setup::ok);
+    put_header(w, db.header);
+    w.put(cache_pages);
+    transport.post(q, Tag::setup, w.take());
+  }
+  const std::size_t page_size = db.header.page_size;
+  for (NodeId n = 0; n < plan.nodes(); ++n) {
+    const int owner = static_cast<int>(n);
+    const std::uint32_t own = placement.own_count(owner);
+    if (plan.runs(0, n)) {
+      std::vector<std::vector<std::byte>> pages(own);
+      for (std::uint32_t i = 0; i < own; ++i) pages[i] = std::move(db.pages[placement.page_of(owner, i)]);
+      nodes[n] = node_state(placement, owner, page_size, std::move(pages), cache_pages);
+      continue;
+    }
+    Bytes share;
+    share.reserve(std::size_t{own} * page_size);
+    for (std::uint32_t i = 0; i < own; ++i) {
+      auto& page = db.pages[placement.page_of(owner, i)];
+      share.insert(share.end(), page.begin(), page.end());
+      std::vector<std::byte>().swap(page);
+    }
+    transport.post(plan.rank_of(n), Tag::setup, std::move(share));
+    transport.flush();
+  }
+  db.pages.clear();
+  db.pages.shrink_to_fit();
+}
+
+// Any other rank: the header and its own nodes' pages from rank 0.
+tracer::DatabaseHeader receive_setup(const MachineOptions& options, const RankPlan& plan, int rank,
+                                     Transport& transport, std::vector<std::unique_ptr<NodeState>>& nodes) {
+  const Incoming first = transport.receive(Tag::setup, 0);
+  WireReader r(first.bytes);
+  if (r.get<Setup>() != Setup::ok) throw RankFailure(0, r.get_string());
+  tracer::DatabaseHeader header = get_header(r);
+  const auto cache_pages = r.get<std::uint32_t>();
+  const PagePlacement placement(options.distribution, static_cast<int>(plan.nodes()), header.page_count);
+  for (NodeId n = plan.first(rank); n < plan.first(rank) + plan.count(rank); ++n) {
+    const Incoming share = transport.receive(Tag::setup, 0);
+    const std::uint32_t own = placement.own_count(static_cast<int>(n));
+    if (share.bytes.size() != std::size_t{own} * header.page_size)
+      throw std::runtime_error("node " + std::to_string(n) + ": rank 0 sent " + std::to_string(share.bytes.size()) +
+                               " bytes of pages, not " + std::to_string(own) + " pages");
+    std::vector<std::vector<std::byte>> pages(own);
+    for (std::uint32_t i = 0; i < own; ++i) {
+      const auto* p = share.bytes.data() + std::size_t{i} * header.page_size;
+      pages[i].assign(p, p + header.page_size);
+    }
+    nodes[n] = node_state(placement, static_cast<int>(n), header.page_size, std::move(pages), cache_pages);
+  }
+  return header;
+}
+
+// Rank 0 folds another rank's reports into its own.
+void merge_rank(const Incoming& message, const RankPlan& plan, MachineReport& report,
+                std::vector<RouterCounters>& routers) {
+  WireReader r(message.bytes);
+  std::vector<csp::ThreadUse> threads;
+  report.ranks.push_back(get_rank_report(r, threads));
+  report.host_threads.insert(report.host_threads.end(), threads.begin(), threads.end());
+  for (NodeId n = plan.first(message.from); n < plan.first(message.from) + plan.count(message.from); ++n) {
+    report.per_node[n] = get_node_report(r);
+    routers[n] = get_router_counters(r);
+  }
+  if (!r.done()) throw std::runtime_error("rank " + std::to_string(message.from) + " sent a report too long");
+}
+
+}  // namespace
+
+void abandon_machine(Transport& transport, const std::string& why) {
+  for (int q = 1; q < transport.size(); ++q) {
+    WireWriter w;
+    w.put(Setup::failed);
+    w.put_string(why);
+    transport.post(q, Tag::setup, w.take());
+  }
+  transport.flush();
+}
+
+std::optional<MachineResult> run_machine_rank(std::optional<tracer::Database> db, const MachineOptions& options,
+                                              Transport& transport) {
+  const int rank = transport.rank();
+  if ((rank == 0) != db.has_value())
+    throw std::logic_error("run_machine_rank: rank 0, and only rank 0, holds the database");
+  // The same options on every rank: these fail on all of them alike.
+  validate(options);
+  if (options.timing)
+    throw std::invalid_argument("timing: virtual time cannot run over several processes (one clock orders the machine)");
+  const auto topology = topology::parse_topology(options.topology, options.nodes);
+  const RankPlan plan(topology, transport.size());
+  std::vector<std::unique_ptr<NodeState>> nodes(topology.size());
+  tracer::DatabaseHeader header;
+  std::uint32_t cache_pages = 0;
+  if (rank == 0) {
+    try {
+      cache_pages = cache_pages_for(options, db->header);
+      const PagePlacement placement(options.distribution, static_cast<int>(topology.size()), db->header.page_count);
+      send_setup(*db, plan, placement, cache_pages, transport, nodes);
+    } catch (const std::exception& e) {
+      abandon_machine(transport, e.what());
+      throw;
+    }
+    header = std::move(db->header);
+  } else {
+    header = receive_setup(options, plan, rank, transport, nodes);
+    cache_pages = cache_pages_for(options, header);
+  }
+  const PagePlacement placement(options.distribution, static_cast<int>(topology.size()), header.page_count);
+  Executed executed =
+      execute(header, topology, placement, cache_pages, nodes, options, Share{&plan, &transport, rank});
+  MachineReport& report = executed.result.report;
+  if (rank != 0) {
+    WireWriter w;
+    put_rank_report(w, report.ranks.front(), report.host_threads);
+    for (NodeId n = plan.first(rank); n < plan.first(rank) + plan.count(rank); ++n) {
+      put_node_report(w, report.per_node[n]);
+      put_router_counters(w, executed.routers[n]);
+    }
+    transport.post(0, Tag::report, w.take());
+    transport.flush();
+    return std::nullopt;
+  }
+  for (int q = 1; q < plan.ranks(); ++q)
+    merge_rank(transport.receive(Tag::report, q), plan, report, executed.routers);
+  std::vector<const RouterCounters*> routers;
+  for (const auto& r : executed.routers) routers.push_back(&r);
+  report.network = network_stats(topology, routers);
+  // Each rank traced its own first packets: keep the first ones of the machine.
+  if (report.network.routes.size() > options.trace_routes) report.network.routes.resize(options.trace_routes);
+  return std::move(executed.result);
 }
 
 SvmStats MachineReport::svm() const {

@@ -41,9 +41,11 @@
 
 #include <cstdint>
 #include <optional>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
+#include "nodes/bridge.hpp"
 #include "nodes/collector.hpp"
 #include "nodes/farmer.hpp"
 #include "nodes/network.hpp"
@@ -51,8 +53,10 @@
 #include "nodes/page_server.hpp"
 #include "nodes/pixel_order.hpp"
 #include "nodes/pixel_computer.hpp"
+#include "nodes/rank_plan.hpp"
 #include "nodes/svm.hpp"
 #include "nodes/timing.hpp"
+#include "nodes/transport.hpp"
 #include "nodes/work_plan.hpp"
 #include "tracer/database.hpp"
 #include "tracer/image.hpp"
@@ -98,6 +102,18 @@ struct NodeReport {
   std::uint64_t evictions = 0;          // cached pages dropped for others
 };
 
+// One OS process of a machine split over several (run_machine_rank).
+struct RankReport {
+  int rank = 0;
+  NodeId first_node = 0;
+  std::uint32_t node_count = 0;
+  unsigned threads = 0;
+  BridgeCounters bridge;            // what crossed the wire from and to this rank
+  double wall_seconds = 0;          // its run, from its set-up to its end
+  double cpu_seconds = 0;           // CPU time (user + system) its threads used meanwhile
+  std::uint64_t peak_scene_bytes = 0;  // own pages + cache slots ever used, over its nodes
+};
+
 struct MachineReport {
   std::string topology;  // canonical spec
   int nodes = 0;
@@ -121,6 +137,8 @@ struct MachineReport {
   FarmerCounters farmer;
   std::uint64_t collected = 0;
   NetworkStats network;
+  std::vector<RankReport> ranks;  // empty unless the machine ran over several processes
+  std::size_t cut_links = 0;      // links whose ends ran in different processes
 
   SvmStats svm() const;
   ServerCounters served() const;
@@ -154,6 +172,33 @@ std::uint32_t cache_pages_for(const MachineOptions& options, const tracer::Datab
 // owners). Throws std::invalid_argument for bad options (one line, naming
 // the option) and whatever a process throws.
 MachineResult run_machine(tracer::Database db, const MachineOptions& options);
+
+// ---- The machine split over the ranks of a Transport ----
+// Every rank calls run_machine_rank with the same options; rank 0 (the
+// host) passes the database and gets the result, every other rank passes
+// none and gets none. Rank r runs the nodes RankPlan gives it, each rank
+// holding only its own nodes' pages (rank 0 sends them) and caches; after
+// the run every rank sends its reports to rank 0, whose result equals the
+// one-process run's. Virtual time cannot be split (one clock orders the
+// whole machine): std::invalid_argument, before any work. A failure on any
+// rank ends every rank's call with RankFailure, within the time it takes
+// the others to notice (they poll the wire at least every millisecond).
+class RankFailure : public std::runtime_error {
+ public:
+  RankFailure(int rank, const std::string& line)
+      : std::runtime_error("rank " + std::to_string(rank) + ": " + line), rank_(rank) {}
+  int rank() const { return rank_; }
+
+ private:
+  int rank_;
+};
+
+std::optional<MachineResult> run_machine_rank(std::optional<tracer::Database> db, const MachineOptions& options,
+                                              Transport& transport);
+
+// Rank 0, when it cannot make the database: the other ranks, waiting in
+// run_machine_rank for their pages, end with RankFailure(0, why).
+void abandon_machine(Transport& transport, const std::string& why);
 
 // Route trace lines and the network summary, with the machine's kind names.
 std::string format_routes(const MachineReport& report);

@@ -30,19 +30,26 @@ Network::Network(csp::Runtime& runtime, topology::Topology topology, NetworkOpti
       routes_to_trace_(options_.trace_routes) {
   if (options_.buffer_capacity == 0) throw std::invalid_argument("network: buffer capacity must be at least 1");
   if (options_.ports_per_node == 0) throw std::invalid_argument("network: each node needs at least one local port");
+  if (options_.local && options_.link.enabled())
+    throw std::invalid_argument("network: a link model cannot carry links between processes");
   const std::size_t n = topology_.size();
   link_in_.resize(n);
   ports_.resize(n);
+  injections_.resize(n);
   for (NodeId node = 0; node < n; ++node) {
+    router_counters_.push_back(std::make_unique<RouterCounters>());
+    if (!is_local(node)) continue;
     for (NodeId from : topology_.neighbours(node))
-      for (unsigned c = 0; c < classes_; ++c)
+      for (unsigned c = 0; c < classes_; ++c) {
         link_in_[node].emplace_back(link_name(from, node, c), queue_capacity());
-    injections_.emplace_back("inject " + std::to_string(node), options_.buffer_capacity);
+        if (!is_local(from)) cut_.incoming.emplace_back(CutLink{from, node, c}, link_in_[node].back().writer());
+      }
+    injections_[node] = csp::Channel<Packet>("inject " + std::to_string(node), options_.buffer_capacity);
     for (unsigned j = 0; j < options_.ports_per_node; ++j)
       ports_[node].emplace_back("port " + std::to_string(node) + "." + std::to_string(j), queue_capacity());
-    router_counters_.push_back(std::make_unique<RouterCounters>());
   }
-  for (NodeId node = 0; node < n; ++node) wire_node(runtime, node);
+  for (NodeId node = 0; node < n; ++node)
+    if (is_local(node)) wire_node(runtime, node);
 }
 
 unsigned Network::thread_of(NodeId node) const {
@@ -65,8 +72,15 @@ void Network::wire_node(csp::Runtime& runtime, NodeId node) {
   for (topology::Port p = 0; p < neighbours.size(); ++p) {
     const NodeId m = neighbours[p];
     const std::size_t back = topology_.port_to(m, node);
-    for (unsigned c = 0; c < classes_; ++c)
-      ends.outputs.push_back(output_queue(runtime, node, link_in_[m][back * classes_ + c]));
+    for (unsigned c = 0; c < classes_; ++c) {
+      if (is_local(m)) {
+        ends.outputs.push_back(output_queue(runtime, node, link_in_[m][back * classes_ + c]));
+        continue;
+      }
+      cut_queues_.emplace_back("cut " + link_name(node, m, c), options_.buffer_capacity);
+      cut_.outgoing.emplace_back(CutLink{node, m, c}, cut_queues_.back().reader());
+      ends.outputs.push_back(cut_queues_.back().writer());
+    }
   }
   for (unsigned j = 0; j < options_.ports_per_node; ++j)
     ends.outputs.push_back(output_queue(runtime, node, ports_[node][j]));
@@ -98,6 +112,8 @@ csp::In<Packet> Network::port(NodeId node, unsigned port) const {
 }
 
 void Network::shutdown() {
+  shut_down_.store(true, std::memory_order_release);
+  for (auto& ch : cut_queues_) ch.poison();
   for (auto& ch : injections_) ch.poison();
   for (auto& ch : wires_) ch.poison();
   for (auto& node : link_in_)
@@ -107,20 +123,27 @@ void Network::shutdown() {
 }
 
 NetworkStats Network::stats() const {
+  std::vector<const RouterCounters*> routers;
+  for (const auto& r : router_counters_) routers.push_back(r.get());
+  return network_stats(topology_, routers);
+}
+
+NetworkStats network_stats(const topology::Topology& topology, const std::vector<const RouterCounters*>& routers) {
+  const unsigned classes = topology.buffer_classes();
   NetworkStats s;
-  for (NodeId node = 0; node < topology_.size(); ++node) {
-    const RouterCounters& r = *router_counters_[node];
+  for (NodeId node = 0; node < topology.size(); ++node) {
+    const RouterCounters& r = *routers.at(node);
     s.routers.push_back(r);
     s.hops.merge(r.hops);
     for (std::size_t kind = 0; kind < r.hops_by_kind.size(); ++kind)
       if (r.hops_by_kind[kind].packets) s.hops_by_kind[static_cast<std::uint8_t>(kind)].merge(r.hops_by_kind[kind]);
     s.routes.insert(s.routes.end(), r.routes.begin(), r.routes.end());
     // Link queues come first, classes_ per port, in port order.
-    const auto neighbours = topology_.neighbours(node);
+    const auto neighbours = topology.neighbours(node);
     for (topology::Port p = 0; p < neighbours.size(); ++p) {
       LinkStats link{node, neighbours[p], 0, 0};
-      for (unsigned c = 0; c < classes_; ++c) {
-        const LinkCounters& lc = r.sent[p * classes_ + c];
+      for (unsigned c = 0; c < classes && p * classes + c < r.sent.size(); ++c) {
+        const LinkCounters& lc = r.sent[p * classes + c];
         link.packets += lc.packets;
         link.bytes += lc.bytes;
       }

@@ -26,6 +26,14 @@
 // link processes and any reader of a port end with csp::Poisoned, so run()
 // returns with no fiber left blocked. Packets still in the network at
 // shutdown are dropped. stats() is valid after run().
+//
+// A machine split over OS processes (rank_plan.hpp) builds, on each rank, a
+// Network whose `local` nodes are that rank's: only their routers and ports
+// exist, and each link between a local and a remote node becomes, per
+// buffer class, one end for the rank's bridge (bridge.hpp): the local
+// router's output queue toward the remote node, whose reader is the
+// bridge, and the local router's input from it, whose only writer is the
+// bridge. The routers cannot tell such a link from any other.
 #pragma once
 
 #include <functional>
@@ -48,6 +56,19 @@ struct NetworkOptions {
   std::uint64_t trace_routes = 0;   // record the routes of the first this many packets injected
   LinkModel link;                   // optional per-hop latency and bandwidth
   std::function<unsigned(NodeId)> placement;  // thread of node n; default block
+  std::function<bool(NodeId)> local;          // nodes this process runs; default all
+};
+
+// One direction and buffer class of a link whose ends run in different processes.
+struct CutLink {
+  NodeId from = 0;
+  NodeId to = 0;
+  unsigned buffer_class = 0;
+};
+
+struct CutEnds {
+  std::vector<std::pair<CutLink, csp::In<Packet>>> outgoing;   // local `from`: its router's output queue
+  std::vector<std::pair<CutLink, csp::Out<Packet>>> incoming;  // local `to`: into its router
 };
 
 struct LinkStats {
@@ -80,8 +101,16 @@ class Network {
   csp::In<Packet> port(NodeId node, unsigned port = 0) const;
   unsigned thread_of(NodeId node) const;
 
+  bool is_local(NodeId node) const { return !options_.local || options_.local(node); }
+  // The links to and from other processes (empty unless `local` is set).
+  const CutEnds& cut_ends() const { return cut_; }
+
+  // Safe from any thread, more than once; after it, shut_down() is true.
   void shutdown();
+  bool shut_down() const { return shut_down_.load(std::memory_order_acquire); }
   NetworkStats stats() const;  // after Runtime::run() has returned
+  // Counters of one router (zero for a node this process does not run).
+  const RouterCounters& router_counters(NodeId node) const { return *router_counters_.at(node); }
 
   // Contiguous ranges of nodes per thread: node * threads / nodes.
   static unsigned block_placement(NodeId node, std::size_t nodes, unsigned threads);
@@ -100,11 +129,17 @@ class Network {
   std::vector<csp::Channel<Packet>> injections_;  // per node
   std::vector<std::vector<csp::Channel<Packet>>> ports_;
   std::vector<csp::Channel<Packet>> wires_;  // link model only: router -> link process
+  std::vector<csp::Channel<Packet>> cut_queues_;  // local router -> bridge, toward remote nodes
+  CutEnds cut_;
+  std::atomic<bool> shut_down_{false};
   // Counters live here so they outlive the processes; each is written by
   // exactly one process and read only after run().
   std::vector<std::unique_ptr<RouterCounters>> router_counters_;
   std::atomic<std::uint64_t> routes_to_trace_;  // RouterConfig::routes_to_trace
 };
+
+// The network's figures from every router's counters (index = node).
+NetworkStats network_stats(const topology::Topology& topology, const std::vector<const RouterCounters*>& routers);
 
 // "page 17: 5 → 4 → 6 → 7 (3 hops)"
 std::string format_route(const RouteRecord& record, const KindNamer& kind_name);

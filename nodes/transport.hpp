@@ -1,0 +1,137 @@
+// nodes::Transport: the wire between the OS processes (ranks) of a machine
+// split over several processes. The machine sends only byte strings through
+// it; MPI carries them between processes and hosts (mpi/mpi_transport.hpp),
+// LocalTransportGroup between ranks that are threads of one process, so the
+// ordinary test suite can split a machine without a launcher.
+//
+// Contract (what the machine relies on, and both implementations give):
+//  - post() and poll() never block: a fiber may call them (a fiber that
+//    blocked inside the wire would stall its whole thread).
+//  - Messages from one rank to another on one tag arrive in the order they
+//    were posted, each once, whole (order holds within a tag only).
+//  - A posted message belongs to the transport; progress() moves pending
+//    sends on and pending() counts those not yet complete. A rank ends only
+//    once pending() is 0.
+//  - All calls on one Transport come from one thread at a time.
+#pragma once
+
+#include <chrono>
+#include <cstddef>
+#include <cstdint>
+#include <cstring>
+#include <deque>
+#include <memory>
+#include <mutex>
+#include <optional>
+#include <stdexcept>
+#include <string>
+#include <type_traits>
+#include <vector>
+
+namespace nodes {
+
+using Bytes = std::vector<std::byte>;
+
+// The uses of the wire; each keeps its own order.
+enum class Tag : int { setup = 1, bridge = 2, report = 3 };
+
+struct Incoming {
+  int from = 0;
+  Bytes bytes;
+};
+
+class Transport {
+ public:
+  virtual ~Transport() = default;
+  virtual int rank() const = 0;
+  virtual int size() const = 0;
+  virtual void post(int to, Tag tag, Bytes message) = 0;
+  virtual std::optional<Incoming> poll(Tag tag) = 0;
+  virtual void progress() = 0;
+  virtual std::size_t pending() const = 0;
+
+  // For the set-up and the gathering of reports, outside any process: waits,
+  // sleeping between polls so that a waiting rank leaves its core idle, for
+  // a message on `tag` from `from` (any rank if negative). Messages from
+  // other ranks that arrive meanwhile are kept for later calls.
+  Incoming receive(Tag tag, int from = -1);
+  // Waits until every posted message is complete.
+  void flush();
+
+ private:
+  std::vector<std::deque<Incoming>> early_;  // per tag, messages receive() set aside
+};
+
+// Several ranks inside one process, one Transport each; each rank's calls
+// come from its own thread. Sends complete at once (the bytes are moved into
+// the receiver's queue).
+class LocalTransportGroup {
+ public:
+  explicit LocalTransportGroup(int ranks);
+  ~LocalTransportGroup();
+  Transport& rank(int r);
+  int size() const;
+
+ private:
+  struct Shared;
+  class Endpoint;
+  std::shared_ptr<Shared> shared_;
+  std::vector<std::unique_ptr<Endpoint>> endpoints_;
+};
+
+// Flat encoding of messages: values of trivially copyable types as their
+// bytes (every rank runs the same binary on the same architecture),
+// sequences with a 64-bit count before them. Reader throws
+// std::runtime_error on a message shorter than what is read from it.
+class WireWriter {
+ public:
+  template <class T>
+  void put(const T& value) {
+    static_assert(std::is_trivially_copyable_v<T>);
+    append(&value, sizeof(T));
+  }
+  template <class T>
+  void put_vector(const std::vector<T>& values) {
+    static_assert(std::is_trivially_copyable_v<T>);
+    put<std::uint64_t>(values.size());
+    append(values.data(), values.size() * sizeof(T));
+  }
+  void put_string(const std::string& s);
+  Bytes take() { return std::move(bytes_); }
+  std::size_t size() const { return bytes_.size(); }
+
+ private:
+  void append(const void* data, std::size_t n);
+  Bytes bytes_;
+};
+
+class WireReader {
+ public:
+  explicit WireReader(const Bytes& bytes) : bytes_(bytes) {}
+  template <class T>
+  T get() {
+    static_assert(std::is_trivially_copyable_v<T>);
+    T value;
+    std::memcpy(&value, take(sizeof(T)), sizeof(T));
+    return value;
+  }
+  template <class T>
+  std::vector<T> get_vector() {
+    static_assert(std::is_trivially_copyable_v<T>);
+    const auto n = get<std::uint64_t>();
+    if (n > (bytes_.size() - at_) / std::max<std::size_t>(sizeof(T), 1)) fail();
+    std::vector<T> values(n);
+    if (n) std::memcpy(values.data(), take(n * sizeof(T)), n * sizeof(T));
+    return values;
+  }
+  std::string get_string();
+  bool done() const { return at_ == bytes_.size(); }
+
+ private:
+  const std::byte* take(std::size_t n);
+  [[noreturn]] static void fail();
+  const Bytes& bytes_;
+  std::size_t at_ = 0;
+};
+
+}  // namespace nodes
