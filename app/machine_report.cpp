@@ -102,6 +102,42 @@ void json_routes(std::ostream& out, const nodes::NetworkStats& s) {
   out << "]";
 }
 
+// Which ranks ran which nodes, and what crossed between them.
+void print_ranks(std::ostream& out, const nodes::MachineReport& r) {
+  if (r.ranks.empty()) return;
+  const topology::Topology t = topology::parse_topology(r.topology);
+  std::size_t links = 0;
+  for (topology::NodeId n = 0; n < t.size(); ++n) links += t.degree(n);
+  out << "ranks          " << r.ranks.size() << " processes, " << r.cut_links << " of " << links / 2
+      << " links cut\n"
+      << "  " << std::setw(4) << "rank" << std::setw(13) << "nodes" << std::setw(8) << "threads" << std::setw(13)
+      << "packets out" << std::setw(13) << "bytes out" << std::setw(11) << "messages" << std::setw(13)
+      << "scene bytes" << std::setw(9) << "cpu s" << std::setw(9) << "wall s" << "\n";
+  for (const nodes::RankReport& k : r.ranks) {
+    const std::string nodes = std::to_string(k.first_node) + "-" + std::to_string(k.first_node + k.node_count - 1);
+    out << "  " << std::setw(4) << k.rank << std::setw(13) << nodes << std::setw(8) << k.threads << std::setw(13)
+        << k.bridge.packets_sent << std::setw(13) << k.bridge.bytes_sent << std::setw(11) << k.bridge.messages_sent
+        << std::setw(13) << k.peak_scene_bytes << std::setprecision(3) << std::setw(9) << k.cpu_seconds
+        << std::setw(9) << k.wall_seconds << "\n";
+  }
+}
+
+void json_ranks(std::ostream& out, const nodes::MachineReport& r, const std::string& indent) {
+  out << "[";
+  for (std::size_t i = 0; i < r.ranks.size(); ++i) {
+    const nodes::RankReport& k = r.ranks[i];
+    out << (i ? "," : "") << "\n" << indent << "  {\"rank\": " << k.rank << ", \"first_node\": " << k.first_node
+        << ", \"nodes\": " << k.node_count << ", \"threads\": " << k.threads
+        << ", \"packets_sent\": " << k.bridge.packets_sent << ", \"bytes_sent\": " << k.bridge.bytes_sent
+        << ", \"packets_received\": " << k.bridge.packets_received
+        << ", \"bytes_received\": " << k.bridge.bytes_received << ", \"messages_sent\": " << k.bridge.messages_sent
+        << ", \"wire_bytes_sent\": " << k.bridge.wire_bytes_sent << ", \"polls\": " << k.bridge.polls
+        << ", \"peak_scene_bytes\": " << k.peak_scene_bytes << ", \"cpu_seconds\": " << k.cpu_seconds
+        << ", \"wall_seconds\": " << k.wall_seconds << "}";
+  }
+  out << (r.ranks.empty() ? "" : "\n" + indent) << "]";
+}
+
 }  // namespace
 
 double MachineSummary::parallel_seconds() const {
@@ -140,6 +176,7 @@ void print_machine_report(std::ostream& out, const MachineSummary& m) {
       << " distinct pages per " << (m.corner_samples ? "sample" : "pixel") << "\n";
   print_per_node(out, r, m.corner_samples ? "samples" : "pixels");
   out << nodes::format_summary(r.network, topology::parse_topology(r.topology), kind_name);
+  print_ranks(out, r);
   out << std::setprecision(3) << "wall time      " << r.wall_seconds << " s on " << r.threads
       << " thread(s)";
   if (r.cost_model.empty())
@@ -180,6 +217,8 @@ void write_machine_json(std::ostream& out, const MachineSummary& m, const std::s
   json_network(out, r.network);
   out << ",\n" << in << "\"routes\": ";
   json_routes(out, r.network);
+  out << ",\n" << in << "\"cut_links\": " << r.cut_links << ", \"ranks\": ";
+  json_ranks(out, r, in);
   out << ",\n" << in << "\"wall_seconds\": " << r.wall_seconds;
   if (r.cost_model.empty()) {
     out << ", \"host_threads\": [";

@@ -10,18 +10,19 @@
 namespace app {
 namespace {
 
-// Runs db on the machine of `machine`, with a progress bar over what it
-// farms out: pixels, or the corner samples of the SPD procedure; `which`
-// follows the unit in the bar.
-nodes::MachineResult run_with_progress(tracer::Database db, nodes::MachineOptions machine,
-                                       const Options& o, const std::string& which = "") {
+// Runs db on the machine of `machine` (over the ranks of `ranks`, if
+// given), with a progress bar over what it farms out: pixels, or the corner
+// samples of the SPD procedure; `which` follows the unit in the bar.
+nodes::MachineResult run_with_progress(tracer::Database db, nodes::MachineOptions machine, const Options& o,
+                                       const std::string& which = "", nodes::Transport* ranks = nullptr) {
   const std::uint64_t w = db.header.camera.width, h = db.header.camera.height;
   const bool samples = machine.trace.spd_procedure;
   ProgressBar bar(samples ? (w + 1) * (h + 1) : w * h, (samples ? "samples" : "pixels") + which,
                   !o.quiet && stderr_is_terminal());
   // The collector calls this on its own thread only, so the bar needs no lock.
   machine.progress = [&bar](std::uint64_t done, std::uint64_t) { bar.update(done); };
-  nodes::MachineResult result = nodes::run_machine(std::move(db), machine);
+  nodes::MachineResult result =
+      ranks ? std::move(*nodes::run_machine_rank(std::move(db), machine, *ranks)) : nodes::run_machine(std::move(db), machine);
   bar.finish();
   return result;
 }
@@ -38,20 +39,32 @@ SerialComparison run_serial(const tracer::Database& db, const nodes::MachineOpti
 
 }  // namespace
 
-RenderResult render_machine(const Options& o, const tracer::Scene& scene) {
-  tracer::Database db = build_database(scene, build_options(o));
-  // Before the machine is built: a complete graph of thousands of nodes would
-  // take minutes to set up before running out of memory.
-  check_machine_memory(o, scene.camera.width, scene.camera.height, db.header.page_count, memory_limit());
-  RunReport report = describe_run(o, db);
+nodes::MachineOptions machine_options(const Options& o) {
   nodes::MachineOptions machine = o.machine;
   machine.trace = {.max_depth = o.max_depth,
                    .spd_procedure = o.spd_procedure,
                    .shadow_rays_to_all_lights = o.shadow_rays_all};
+  return machine;
+}
+
+RenderResult render_machine(const Options& o, const tracer::Scene& scene, nodes::Transport* ranks) {
+  tracer::Database db;
+  RunReport report;
+  try {
+    db = build_database(scene, build_options(o));
+    // Before the machine is built: a complete graph of thousands of nodes would
+    // take minutes to set up before running out of memory.
+    check_machine_memory(o, scene.camera.width, scene.camera.height, db.header.page_count, memory_limit());
+    report = describe_run(o, db);
+  } catch (const std::exception& e) {
+    if (ranks) nodes::abandon_machine(*ranks, e.what());  // they wait for their pages
+    throw;
+  }
+  const nodes::MachineOptions machine = machine_options(o);
   std::optional<SerialComparison> serial;
   // In virtual time T1 is cheap and deterministic: always there for speedup and efficiency.
   if (o.compare_serial || machine.timing) serial = run_serial(db, machine, o);
-  nodes::MachineResult result = run_with_progress(std::move(db), machine, o);
+  nodes::MachineResult result = run_with_progress(std::move(db), machine, o, "", ranks);
   report.rays = result.report.rays();
   report.render_seconds = result.report.wall_seconds;
   report.machine = MachineSummary{std::move(result.report), serial, o.spd_procedure};

@@ -2,7 +2,7 @@
 // hand it to nodes::run_machine (which spreads the pages over the processors
 // and farms out the pixels), and fill the run report with the machine's
 // figures. With --compare-serial the 1-node machine renders the same
-// database too, for speedup and efficiency. The image equals the one
+// database too, for speedup and efficiency (not over several ranks). The image equals the one
 // render_single makes from the same scene and options, bit for bit.
 #pragma once
 
@@ -12,8 +12,13 @@
 
 namespace app {
 
+// The machine's options from the command line's, with the tracing options.
+nodes::MachineOptions machine_options(const Options& options);
+
 // Throws tracer::DatabaseError, std::invalid_argument (a machine option) or
-// std::runtime_error, each one line.
-RenderResult render_machine(const Options& options, const tracer::Scene& scene);
+// std::runtime_error, each one line. With `ranks`, this process is rank 0
+// of a machine split over them (nodes::run_machine_rank); every other rank
+// runs nodes::run_machine_rank with machine_options(options) meanwhile.
+RenderResult render_machine(const Options& options, const tracer::Scene& scene, nodes::Transport* ranks = nullptr);
 
 }  // namespace app

@@ -6,9 +6,18 @@
 // Exit 0 on success, 2 for a bad command line (or an image too large for
 // this machine's memory, found once the scene is read), 1 for a runtime
 // error; errors are one line on stderr, and a failed run leaves no output file.
+//
+// Started by an MPI launcher (mpirun; vmpi::launched_by_mpi() reads its
+// environment) with more than one rank, the machine is split over the
+// ranks (app/ranks.hpp): rank 0 does all a one-process run does, the others
+// run their nodes. Every rank parses the same command line, so a bad one
+// fails on all alike and rank 0 alone says so; a failure on any rank after
+// that ends every rank, and rank 0 prints its one line. With one rank, or
+// without a launcher, vmpray runs in one process exactly as always.
 #include <chrono>
 #include <filesystem>
 #include <iostream>
+#include <optional>
 #include <string>
 #include <utility>
 #include <vector>
@@ -18,10 +27,12 @@
 #include "app/memory_check.hpp"
 #include "app/options.hpp"
 #include "app/output_files.hpp"
+#include "app/ranks.hpp"
 #include "app/report.hpp"
 #include "app/scene_input.hpp"
 #include "app/single.hpp"
 #include "app/sweep.hpp"
+#include "mpi/mpi_transport.hpp"
 
 namespace {
 
@@ -48,14 +59,21 @@ void check_distinct_outputs(const app::Options& o) {
                               outputs[i].second.string() + "'");
 }
 
-int run(const app::Options& o) {
+// The whole run in this process, or rank 0's part over `ranks`.
+int run(const app::Options& o, nodes::Transport* ranks = nullptr) {
   const auto t0 = std::chrono::steady_clock::now();
-  const tracer::Scene scene = app::load_scene(o);
+  tracer::Scene scene;
+  try {
+    scene = app::load_scene(o);
+    // Before the minutes of work that an image too large for the memory would waste.
+    app::check_image_memory(o, scene.camera.width, scene.camera.height, app::memory_limit());
+  } catch (const std::exception& e) {
+    if (ranks) nodes::abandon_machine(*ranks, e.what());  // they wait for their pages
+    throw;
+  }
   const double load_seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-  // Before the minutes of work that an image too large for the memory would waste.
-  app::check_image_memory(o, scene.camera.width, scene.camera.height, app::memory_limit());
-  app::RenderResult result = o.single ? app::render_single(o, scene) : app::render_machine(o, scene);
+  app::RenderResult result = o.single ? app::render_single(o, scene) : app::render_machine(o, scene, ranks);
   result.report.load_seconds = load_seconds;
   app::OutputPhase phase;
   app::OutputFiles& outputs = phase.files();  // removed again if a later step fails
@@ -73,9 +91,53 @@ int run(const app::Options& o) {
   return phase.finish(std::cout, "report");
 }
 
-}  // namespace
+// One rank of several: see the opening comment.
+int rank_main(int argc, char** argv, const vmpi::MpiSession& mpi) {
+  const bool host = mpi.rank() == 0;
+  const auto say = [host](const std::string& line) {
+    if (host) std::cerr << "vmpray: " << line << "\n";
+  };
+  if (argc > 1 && std::string(argv[1]) == "sweep") {
+    say("sweep runs its points in one process: run it without mpirun, or with -np 1");
+    return 2;
+  }
+  app::Options options;
+  try {
+    options = app::parse_options(argc, argv);
+    check_distinct_outputs(options);
+    app::check_rank_options(options, mpi.size());
+  } catch (const app::UsageError& e) {
+    say(std::string(e.what()) + " (see vmpray --help)");
+    return 2;
+  }
+  if (options.action != app::Options::Action::render) {
+    if (host) std::cout << (options.action == app::Options::Action::help ? app::usage_text() : "vmpray " VMPRAY_VERSION "\n");
+    return 0;
+  }
+  options.machine.threads = app::threads_per_rank(options.machine.threads, mpi.ranks_on_this_host());
+  try {
+    vmpi::MpiTransport transport;
+    if (host) return run(options, &transport);
+    app::serve_rank(options, transport);
+    return 0;
+  } catch (const nodes::RankFailure& e) {  // every rank knows: rank 0 says it
+    say(e.what());
+    return 1;
+  } catch (const app::UsageError& e) {  // rank 0: an image too large, the others told
+    say(e.what());
+    return 2;
+  } catch (const std::exception& e) {
+    if (host) {
+      say(e.what());
+      return 1;
+    }
+    // What the wire could not carry: this rank ends the job itself.
+    std::cerr << "vmpray: rank " << mpi.rank() << ": " << e.what() << "\n";
+    vmpi::MpiSession::abort(1);
+  }
+}
 
-int main(int argc, char** argv) {
+int one_process(int argc, char** argv) {
   if (argc > 1 && std::string(argv[1]) == "sweep") return app::sweep_main(argc - 1, argv + 1);
   app::Options options;
   try {
@@ -102,4 +164,18 @@ int main(int argc, char** argv) {
     std::cerr << "vmpray: " << e.what() << "\n";
     return 1;
   }
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  std::optional<vmpi::MpiSession> mpi;
+  if (vmpi::launched_by_mpi()) try {
+      mpi.emplace(argc, argv);
+    } catch (const std::exception& e) {
+      std::cerr << "vmpray: " << e.what() << "\n";
+      return 1;
+    }
+  if (mpi && mpi->size() > 1) return rank_main(argc, argv, *mpi);
+  return one_process(argc, argv);
 }

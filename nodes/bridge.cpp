@@ -13,6 +13,7 @@ enum class Record : std::uint8_t { packet = 1, credit, end, abort };
 
 constexpr std::chrono::microseconds shortest_poll{16};
 constexpr std::size_t poll_levels = 7;  // 16 us .. 1024 us
+constexpr std::chrono::microseconds hot_window{1000};  // since the last activity
 
 void put_link(WireWriter& w, const CutLink& link) {
   w.put<std::uint32_t>(link.from);
@@ -141,9 +142,14 @@ void Bridge::carry() {
     queue_credits();
     send_frames();
     transport_.progress();
-    // Back off while nothing happens; any activity polls again soon.
+    // Poll at the shortest interval while an answer is due (packets sent
+    // that have not come back as credits) or something happened lately;
+    // back off once all is quiet.
+    const auto now = std::chrono::steady_clock::now();
+    if (active) last_active_ = now;
+    const bool hot = unacknowledged_ > 0 || now - last_active_ < hot_window;
     alt_.enable(timeout_guards_[level_], false);
-    level_ = active ? 0 : std::min(level_ + 1, poll_levels - 1);
+    level_ = hot ? 0 : std::min(level_ + 1, poll_levels - 1);
     alt_.enable(timeout_guards_[level_], true);
     const std::size_t guard = alt_.select();
     if (guard >= guard_owner_.size()) continue;  // a timeout: poll the wire
@@ -151,7 +157,7 @@ void Bridge::carry() {
     if (!is_outgoing) continue;  // room in a local input: delivered at the top
     try {
       take_outgoing(outgoing_[index]);
-      level_ = 0;
+      last_active_ = std::chrono::steady_clock::now();
     } catch (const csp::Poisoned&) {
       stop();
     }
@@ -168,6 +174,7 @@ bool Bridge::take_outgoing(Outgoing& out) {
     put_link(w, out.link);
     put_packet(w, *packet);
     ++counters_.packets_sent;
+    ++unacknowledged_;
     counters_.bytes_sent += packet->payload.size();
     if (--out.credits == 0) {
       alt_.enable(out.guard, false);
@@ -226,8 +233,11 @@ void Bridge::receive(int from, const Bytes& bytes) {
         const auto it = outgoing_by_link_.find(key(link));
         if (it == outgoing_by_link_.end()) throw std::runtime_error("bridge: a credit for a link not cut here");
         Outgoing& out = outgoing_[it->second];
+        if (out.credits + count > capacity_ || count > unacknowledged_)
+          throw std::runtime_error("bridge: rank " + std::to_string(from) + " returned more credits than it owed");
         if (out.credits == 0) alt_.enable(out.guard, true);
         out.credits += count;
+        unacknowledged_ -= count;
         break;
       }
       case Record::end:

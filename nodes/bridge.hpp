@@ -21,10 +21,13 @@
 // the unsplit machine, acyclic by topology::next_hop's buffer classes.
 //
 // Polling: the transport moves and reports messages only when called. The
-// bridge polls it after every wake-up and, when nothing happens, waits
-// twice as long each time, from 16 us up to 1 ms, so a rank with nothing to
-// do sleeps (the runtime's thread sleeps until the timeout) instead of
-// spinning a core; any packet sent toward another rank wakes it at once.
+// bridge polls it after every wake-up, and every 16 us while an answer is
+// due (a packet it sent has not come back as a credit) or within 1 ms of
+// the last activity: an idle runtime thread watches for that short a
+// timeout without sleeping, so a page request that crosses ranks costs
+// tens of microseconds, not a sleep. Once all is quiet it waits twice as
+// long each time, up to 1 ms, so a rank with nothing to do sleeps instead
+// of spinning a core; any packet sent toward another rank wakes it at once.
 //
 // Orderly end: the machine's protocol ends with nothing in flight, and then
 // rank 0 shuts its network down. A bridge that sees its network shut down,
@@ -37,6 +40,7 @@
 #pragma once
 
 #include <atomic>
+#include <chrono>
 #include <cstdint>
 #include <deque>
 #include <mutex>
@@ -131,6 +135,8 @@ class Bridge {
   std::vector<std::pair<bool, std::size_t>> guard_owner_;  // per guard: (outgoing?, index); timeouts absent
   std::vector<std::size_t> staged_, owing_;  // incoming links with staged packets / credits owed
   std::size_t level_ = 0;                    // the timeout guard enabled
+  std::uint64_t unacknowledged_ = 0;         // packets sent whose credits have not come back
+  std::chrono::steady_clock::time_point last_active_{};
   std::vector<std::size_t> timeout_guards_;  // 16 us, 32 us, ... 1 ms
 };
 

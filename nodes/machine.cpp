@@ -99,6 +99,7 @@ struct Wiring {
   std::uint64_t processes;  // sending processes, for packet ids
   MachineTiming* timing;    // null unless in virtual time
   RunClock tile_clock;      // empty unless tiles are recorded
+  bool split = false;       // other processes run the other nodes (a bridge serves the wire)
 
   Outbox outbox(NodeId n, std::uint16_t port) const {
     const std::uint64_t ports = Ports::count(options.workers_per_node);
@@ -133,10 +134,11 @@ void spawn_node(const Wiring& w, NodeId n, NodeState& node) {
       charge = [&meter] { meter.charge(); };
     }
     SvmSource& source = node.svm->add_worker(std::move(fetch));
-    // On one thread nobody waits across threads, and first-in first-out
-    // order lets a router take more packets per wake-up; under virtual time
-    // the scheduler orders by clock.
-    const bool prioritised = !w.timing && w.runtime.threads() > 1;
+    // On the one thread of a whole machine nobody waits across threads or
+    // processes, and first-in first-out order lets a router take more
+    // packets per wake-up; under virtual time the scheduler orders by clock.
+    // A split machine's bridge polls the wire and needs the thread often.
+    const bool prioritised = !w.timing && (w.runtime.threads() > 1 || w.split);
     const std::uint32_t timeslice = prioritised ? timeslice_items : 0;
     w.runtime.spawn(
         name + " pixel computer " + std::to_string(i), thread,
@@ -367,7 +369,8 @@ Executed execute(const tracer::DatabaseHeader& header, const topology::Topology&
                       grid,
                       topology.size() * net_options.ports_per_node,
                       timing ? &*timing : nullptr,
-                      options.record_tiles ? run_clock(started, timing.has_value()) : RunClock{}};
+                      options.record_tiles ? run_clock(started, timing.has_value()) : RunClock{},
+                      share.plan != nullptr};
   Host host;
   for (std::size_t n = 0; n < nodes.size(); ++n)
     if (nodes[n]) spawn_node(wiring, static_cast<NodeId>(n), *nodes[n]);

@@ -8,7 +8,9 @@
 //  - Contiguous numbers follow each topology's shape, so few links are cut:
 //    a hypercube of 2^d nodes on 2^k ranks gives each rank a (d-k)-subcube
 //    (the high address bits name the rank), meshes and tori (numbered row by
-//    row) strips of rows, rings arcs, complete graphs blocks.
+//    row) strips of rows when the ranks divide the rows (otherwise strips
+//    that may end inside a row: balance first), rings arcs, complete graphs
+//    blocks.
 //  - cut_links() counts the undirected links whose two ends lie on
 //    different ranks; only those carry packets between processes.
 #pragma once

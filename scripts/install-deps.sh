@@ -7,6 +7,7 @@ packages=(
   libboost-fiber-dev libboost-context-dev libboost-program-options-dev
   libgtest-dev libgmock-dev libbenchmark-dev
   libpng-dev zlib1g-dev
+  libopenmpi-dev openmpi-bin
 )
 if [[ "${1:-}" == "--dev" ]]; then   # sanitizers' clang runtime and the fuzzer
   packages+=(clang-14 libclang-rt-14-dev)

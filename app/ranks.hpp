@@ -1,0 +1,25 @@
+// vmpray over several processes: what a run started by an MPI launcher
+// with more than one rank may ask for, and the part every rank but the
+// host plays. Rank 0 (the host) reads the scene, builds the database and
+// writes every output; the other ranks run their block of nodes
+// (nodes::run_machine_rank) and print nothing unless the wire itself fails.
+#pragma once
+
+#include "app/options.hpp"
+#include "nodes/transport.hpp"
+
+namespace app {
+
+// UsageError naming the option for what cannot run over `ranks` processes:
+// --single, --compare-serial, --timing virtual, and more ranks than nodes.
+void check_rank_options(const Options& options, int ranks);
+
+// --threads 0 over several ranks: the host's cores shared among the ranks
+// that run on it, at least one each.
+unsigned threads_per_rank(unsigned threads, int ranks_on_this_host);
+
+// A rank other than 0: its nodes, until the machine ends. Throws
+// nodes::RankFailure when any rank failed (rank 0 reports it).
+void serve_rank(const Options& options, nodes::Transport& transport);
+
+}  // namespace app
