@@ -45,6 +45,8 @@ void FifoScheduler::awakened(boost::fibers::context* ctx, ProcessProps& props) n
     dispatcher_ = ctx;
   } else if (props.process && props.process->priority == Priority::low) {
     ctx->ready_link(yielded ? ready_low_ : ready_low_woken_);
+    // A long computation offers the thread: timers due meanwhile go first.
+    dispatch_soon_ = dispatch_soon_ || yielded;
   } else {
     ctx->ready_link(ready_);
   }
@@ -52,7 +54,8 @@ void FifoScheduler::awakened(boost::fibers::context* ctx, ProcessProps& props) n
 
 boost::fibers::context* FifoScheduler::pick_next() noexcept {
   const bool none_ready = ready_.empty() && ready_low_woken_.empty() && ready_low_.empty();
-  if (dispatcher_ && (none_ready || take_notification() || ++picks_since_dispatch_ >= dispatch_period)) {
+  if (dispatcher_ && (none_ready || take_notification() || std::exchange(dispatch_soon_, false) ||
+                      ++picks_since_dispatch_ >= dispatch_period)) {
     picks_since_dispatch_ = 0;
     return std::exchange(dispatcher_, nullptr);
   }

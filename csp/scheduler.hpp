@@ -20,9 +20,11 @@
 // would take the core from one that has work (see idle_spin()). Boost's
 // dispatcher fiber (which moves timed-out and remotely woken fibers to the
 // ready queue, and reads the clock to do so) is kept aside and run at the
-// next switch after notify(), when nothing else is ready, or after every
-// `dispatch_period` picks: a process woken from another thread waits for one
-// switch, not for a round of the queue, and most switches read no clock.
+// next switch after notify(), after a low-priority process yields, when
+// nothing else is ready, or after every `dispatch_period` picks: a process
+// woken from another thread waits for one switch, not for a round of the
+// queue, a timer that fell due during a long computation fires when the
+// computation offers the thread, and most switches read no clock.
 #pragma once
 
 #include <atomic>
@@ -121,6 +123,7 @@ class FifoScheduler final : public Scheduler {
   boost::fibers::scheduler::ready_queue_type ready_low_;      // low priority, yielded
   boost::fibers::context* dispatcher_ = nullptr;  // set while it is ready
   unsigned picks_since_dispatch_ = 0;
+  bool dispatch_soon_ = false;  // a low-priority process yielded since the dispatcher last ran
   std::mutex mutex_;  // orders notify() against the check before sleeping
   std::condition_variable wakeup_;
   std::atomic<bool> notified_{false};  // a wake from another thread not yet dispatched
