@@ -1,42 +1,32 @@
 // Occam ALT: waits until one of several guards is ready and says which.
 //
-// Guards: channel inputs, room in a buffered channel's output (ready when a
-// write would not block), a timeout (ready `after` from the start of each
-// select), SKIP (always ready); each may be switched off with enable().
-// select() is a fair ALT — polling starts at a rotating favourite, one past
-// the last guard chosen, so among guards that stay ready each is chosen within
-// guard_count() selects. pri_select() polls from guard 0: lowest index wins.
+// - Guards: a channel input (ready when a read would not block), room in a
+//   buffered output (ready when a write would not block; for the channel's
+//   only writer), a timeout (ready `after` from the start of each select, in
+//   wall time even under virtual time; duration::max() never fires) and SKIP
+//   (always ready). enable(i, on) switches guard i off and on.
+// - select() is fair: polling starts one past the guard chosen last, so among
+//   guards that stay ready each is chosen within guard_count() selects.
+//   pri_select() polls from guard 0: the lowest ready index wins.
+// - After select() returns an input guard the caller reads that input, which
+//   does not block: a channel has a single reader. A poisoned channel counts
+//   as ready, and the read or write then throws Poisoned.
+// - Program errors throw std::logic_error: a select with no enabled guard
+//   (occam STOP), an unbound end as a guard, a room guard on an unbuffered
+//   channel, and a second guard on one channel in a doorbell ALT.
 //
-// Design (after Go's select): lock every enabled channel in address order,
-// poll; if nothing is ready, link one waiter record on every enabled channel
-// and park once. The first writer (or poison, or the timer) to claim the
-// waiter wins; on wake-up the ALT relocks its channels and unlinks the losing
-// records. Before locking, a lock-free pass over the channels' ready hints
-// usually finds a ready guard at the cost of one lock. After select() returns
-// i for an input guard, the caller reads that input: since a channel has a
-// single reader, the read does not block. Likewise a room guard is for the
-// channel's only writer, whose next write then does not block.
-// A poisoned channel counts as ready; the read or write throws Poisoned.
-// An unbound end (a default-constructed In or Out) is no guard: adding one is
-// a std::logic_error, as is a room guard on an unbuffered channel.
-// A select with no enabled guard (occam STOP) is a program error: it throws
-// std::logic_error rather than wait forever. A timeout is wall time, also
-// under the virtual-time scheduler (virtual_time.hpp), and one of
-// duration::max() never fires.
+// Example, a process that merges In<int>s a and b onto an Out<int> out and
+// stops after a quiet spell:
 //
-// Waiting::doorbell trades that linking for a bell: each channel guard
-// registers this ALT's bell, and its own mark bit in it, with its channel
-// once, and the channel rings it (detail/wait.hpp) when it may have become
-// ready for this ALT; a select polls only the guards whose channels rang
-// since they were last found not ready, and if none is ready parks on the
-// bell alone, then polls again. That makes a park cost one lock instead of
-// two locks and a record link per channel, a poll cost what rang rather than
-// how many guards there are, and the channels' other ends one bell ring per
-// write or freed slot. For a process that selects over many busy channels
-// and often finds none ready, such as a router. A channel has one reader and
-// one writer, so at most one doorbell ALT per end may watch it, and it takes
-// each channel once (a second guard on it is a std::logic_error); the ALT
-// unregisters when destroyed.
+//   csp::Alt alt;
+//   const std::size_t left = alt.add_input(a), right = alt.add_input(b);
+//   const std::size_t quiet = alt.add_timeout(std::chrono::milliseconds(10));
+//   for (;;) {
+//     const std::size_t i = alt.select();
+//     if (i == left) out.write(a.read());
+//     else if (i == right) out.write(b.read());
+//     else if (i == quiet) break;  // 10 ms with neither ready
+//   }
 #pragma once
 
 #include <chrono>
@@ -51,6 +41,27 @@ namespace csp {
 
 class Alt {
  public:
+  // How a select that finds nothing ready waits.
+  //
+  // relink (after Go's select): lock every enabled channel in address order
+  // and poll; if nothing is ready, link one waiter record on every enabled
+  // channel and park once. The first writer (or poison, or the timer) to
+  // claim the waiter wins; on wake-up the ALT relocks its channels and
+  // unlinks the losing records. Before locking, a lock-free pass over the
+  // channels' ready hints usually finds a ready guard at the cost of one lock.
+  //
+  // doorbell trades that linking for a bell: each channel guard registers
+  // this ALT's bell, and its own mark bit in it, with its channel once, and
+  // the channel rings it (detail/wait.hpp) when it may have become ready for
+  // this ALT; a select polls only the guards whose channels rang since they
+  // were last found not ready, and if none is ready parks on the bell alone,
+  // then polls again. A park then costs one lock instead of two locks and a
+  // record link per channel, a poll costs what rang rather than how many
+  // guards there are, and the channels' other ends pay one bell ring per
+  // write or freed slot. It suits a process that selects over many busy
+  // channels and often finds none ready, such as a router. A channel has one
+  // reader and one writer, so at most one doorbell ALT per end may watch it;
+  // the ALT unregisters when destroyed.
   enum class Waiting { relink, doorbell };
   explicit Alt(Waiting waiting = Waiting::relink);
   ~Alt();

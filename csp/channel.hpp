@@ -1,42 +1,31 @@
-// Occam channels: Channel<T> owns the shared state and hands out its ends,
-// In<T> (reading) and Out<T> (writing); ends are cheap copyable handles.
+// Occam channels. Channel<T> owns the shared state and hands out its two
+// ends, In<T> (reading) and Out<T> (writing): cheap copyable handles. A
+// channel has one reading and one writing process.
 //
-// Protocol and invariants (all under the channel's spinlock):
-// - capacity 0: rendezvous. A reader that finds a writer parked takes its
-//   value and wakes it; otherwise it parks with an empty slot that the next
-//   writer fills directly (so the writer returns without parking: the reader
-//   has taken the value). A writer that finds only an ALT reader fires the
-//   ALT, then parks until the ALT's read takes the value.
-// - capacity k: a bounded buffer of at most k values (its storage grows on
-//   demand up to k). Readers park only when it is empty, writers only when
-//   it holds k; a reader that frees a slot moves the first parked writer's
-//   value in and wakes that writer.
-// - An ALT may wait for room in a buffered channel (Alt::add_room): its
-//   record waits in room_waiters_, and the reader that frees a slot (with no
-//   parked writer to refill it) fires it. Poison fires it too.
-// - ready_hint()/room_hint() mirror ready_locked()/room_locked() for
-//   lock-free polling by an ALT: republished under the lock after every
-//   change of the buffer or the parked writers, so they may be stale to
-//   another thread; an ALT confirms a hint under the lock.
-// - At most one of (parked readers, parked writers with data) is non-empty.
-// - Poison is permanent and wakes every waiter; every later operation on
-//   either end throws Poisoned, even with values still buffered.
-// - try_write on a rendezvous channel succeeds only if a reader is parked in
-//   read(); a parked ALT would still have to run before taking the value.
-// - A doorbell ALT (alt.hpp) watching a channel is rung, under the lock, when
-//   a value is buffered or a writer parks (data_bell_), when a read frees a
-//   slot that no parked writer refills (room_bell_), and by poison.
-// Who wakes whom: writers wake readers (and fire ALTs), readers wake writers
-// (and fire room guards), poison wakes all; see detail/wait.hpp for the claiming rules.
+// - Capacity 0 (the default) is a rendezvous: write() returns once a reader
+//   has the value. Capacity k is a bounded buffer: a writer waits only while
+//   k values are held, a reader only while none is. Values keep their order.
+// - try_read() and try_write() never wait; read_for() waits at most a duration.
+// - Poison, from either end, is permanent and wakes every waiter: every later
+//   operation on either end throws Poisoned, even with values still buffered.
+// - A default-constructed or moved-from end is unbound: its operations throw
+//   std::logic_error, and an ALT (alt.hpp) refuses it as a guard.
+// - Waiting is for processes of a csp::Runtime (runtime.hpp); elsewhere a
+//   read or write that would wait throws std::logic_error.
 //
-// Unbound ends: a default-constructed In or Out, and one moved from, refers
-// to the unbound channel of its type, poisoned from the start, so that each
-// of its operations stops at the poison check it makes anyway and only
-// there, off the fast path, finds the channel unbound and throws
-// std::logic_error instead of Poisoned. Its other members check first; an
-// ALT refuses it as a guard. The unbound channel is never freed, and an end
-// refers to it without a share in its ownership, so making an end unbound
-// touches no reference count.
+// Example, a producer and a consumer (as csp::par processes):
+//
+//   csp::Channel<int> numbers("numbers");  // rendezvous
+//   csp::par({[out = numbers.writer()]() mutable {
+//               for (int i = 1; i <= 3; ++i) out.write(i);
+//               out.poison();  // the end of the stream
+//             },
+//             [in = numbers.reader()]() mutable {
+//               try {
+//                 for (;;) std::cout << in.read() << '\n';  // 1, 2, 3
+//               } catch (const csp::Poisoned&) {
+//               }
+//             }});
 #pragma once
 
 #include <algorithm>
@@ -58,6 +47,32 @@ template <class T> class Out;
 
 namespace detail {
 
+// The state of one channel. Protocol and invariants (all under the
+// channel's spinlock):
+// - capacity 0: a reader that finds a writer parked takes its value and
+//   wakes it; otherwise it parks with an empty slot that the next writer
+//   fills directly (so the writer returns without parking: the reader has
+//   taken the value). A writer that finds only an ALT reader fires the ALT,
+//   then parks until the ALT's read takes the value.
+// - capacity k: the ring holds at most k values and grows on demand up to
+//   k; a reader that frees a slot moves the first parked writer's value in
+//   and wakes that writer.
+// - An ALT may wait for room in a buffered channel (Alt::add_room): its
+//   record waits in room_waiters_, and the reader that frees a slot (with no
+//   parked writer to refill it) fires it. Poison fires it too.
+// - ready_hint()/room_hint() mirror ready_locked()/room_locked() for
+//   lock-free polling by an ALT: republished under the lock after every
+//   change of the buffer or the parked writers, so they may be stale to
+//   another thread; an ALT confirms a hint under the lock.
+// - At most one of (parked readers, parked writers with data) is non-empty.
+// - try_write on a rendezvous channel succeeds only if a reader is parked in
+//   read(); a parked ALT would still have to run before taking the value.
+// - A doorbell ALT (alt.hpp) watching a channel is rung, under the lock, when
+//   a value is buffered or a writer parks (data_bell_), when a read frees a
+//   slot that no parked writer refills (room_bell_), and by poison.
+// Who wakes whom: writers wake readers (and fire ALTs), readers wake writers
+// (and fire room guards), poison wakes all; see detail/wait.hpp for the
+// claiming rules.
 template <class T>
 class ChannelState final : public ChannelBase {
  public:
@@ -238,7 +253,12 @@ class ChannelState final : public ChannelBase {
   std::size_t count_ = 0;
 };
 
-// The channel of every unbound end of type T (see the top of this file).
+// The channel of every unbound end of type T. It is poisoned from the
+// start, so each operation of an unbound end stops at the poison check it
+// makes anyway and only there, off the fast path, finds the channel unbound
+// and throws std::logic_error instead of Poisoned; the ends' other members
+// check first. It is never freed, and an end refers to it without a share
+// in its ownership, so making an end unbound touches no reference count.
 template <class T>
 std::shared_ptr<ChannelState<T>> unbound_channel() {
   static ChannelState<T>* const channel = new ChannelState<T>(ChannelBase::Unbound{});
