@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "app/report.hpp"
+#include "app/wording.hpp"
 #include "nodes/messages.hpp"
 #include "topology/spec.hpp"
 
@@ -121,14 +122,14 @@ void print_machine_report(std::ostream& out, const MachineSummary& m) {
   const nodes::SvmStats svm = r.svm();
   const nodes::ServerCounters served = r.served();
   out << std::fixed << std::setprecision(1);
-  out << "machine        " << r.topology << ": " << r.nodes << " nodes, " << r.workers_per_node
-      << " pixel computer(s) each (prefetch " << r.prefetch << "), " << nodes::schedule_name(r.schedule)
-      << " schedule";
+  out << "machine        " << r.topology << ": " << count_of(r.nodes, "node") << ", "
+      << count_of(r.workers_per_node, "pixel computer") << " each (prefetch " << r.prefetch << "), "
+      << nodes::schedule_name(r.schedule) << " schedule";
   if (r.schedule != nodes::Schedule::static_split) out << " (grain " << r.grain;
   if (r.schedule == nodes::Schedule::affinity) out << ", " << r.farmer.steals << " steals";
   if (r.schedule != nodes::Schedule::static_split) out << ")";
-  out << " in " << nodes::pixel_order_name(r.pixel_order) << " order, " << r.threads << " thread(s), cache "
-      << r.cache_pages << " pages (" << double(r.cache_pages) * r.page_size / 1024.0 << " KB) per node";
+  out << " in " << nodes::pixel_order_name(r.pixel_order) << " order, " << count_of(r.threads, "thread")
+      << ", cache " << r.cache_pages << " pages (" << size_text(double(r.cache_pages) * r.page_size) << ") per node";
   if (const std::uint32_t used = largest_cache(r); used < r.cache_pages)
     out << ", holding every remote page (at most " << used << ")";
   out << "\n"
@@ -140,16 +141,15 @@ void print_machine_report(std::ostream& out, const MachineSummary& m) {
       << " distinct pages per " << (m.corner_samples ? "sample" : "pixel") << "\n";
   print_per_node(out, r, m.corner_samples ? "samples" : "pixels");
   out << nodes::format_summary(r.network, topology::parse_topology(r.topology), kind_name);
-  out << std::setprecision(3) << "wall time      " << r.wall_seconds << " s on " << r.threads
-      << " thread(s)";
+  out << std::setprecision(3) << "wall time      " << r.wall_seconds << " s on " << count_of(r.threads, "thread");
   if (r.cost_model.empty())
     out << std::setprecision(1) << ", idle " << 100 * r.idle_share() << "% of thread time" << std::setprecision(3);
   else out << "; predicted " << r.predicted_seconds << " s (" << r.cost_model << ")";
   out << "\n";
   if (m.serial)
     out << "speedup        " << m.speedup() << " (1 node: " << m.serial->seconds << " s on "
-        << m.serial->threads << " thread(s); " << r.nodes << " nodes: " << m.parallel_seconds()
-        << " s on " << r.threads << (r.cost_model.empty() ? "" : ", predicted")
+        << count_of(m.serial->threads, "thread") << "; " << count_of(r.nodes, "node") << ": "
+        << m.parallel_seconds() << " s on " << count_of(r.threads, "thread") << (r.cost_model.empty() ? "" : ", predicted")
         << "), efficiency " << m.efficiency() << "\n";
 }
 

@@ -17,6 +17,7 @@
 #include "app/machine_pictures.hpp"
 #include "app/memory_check.hpp"
 #include "app/options.hpp"
+#include "app/output_check.hpp"
 #include "app/output_files.hpp"
 #include "app/report.hpp"
 #include "app/scene_input.hpp"
@@ -49,6 +50,7 @@ void check_distinct_outputs(const app::Options& o) {
 }
 
 int run(const app::Options& o) {
+  app::check_output_paths(o);  // before the scene: a render is not done to be lost
   const auto t0 = std::chrono::steady_clock::now();
   const tracer::Scene scene = app::load_scene(o);
   const double load_seconds =
@@ -60,10 +62,13 @@ int run(const app::Options& o) {
   app::OutputPhase phase;
   app::OutputFiles& outputs = phase.files();  // removed again if a later step fails
   outputs.write(o.output, [&](const auto& path) { result.image.write_image(path.string()); });
-  if (!o.stats_path.empty()) outputs.write_text(o.stats_path, app::stats_json(result.report));
-  if (!o.quiet) app::print_report(std::cout, result.report);
+  // --stats - puts the JSON alone on standard output; the report people read goes to stderr.
+  std::ostream& report_out = o.stats_path == "-" ? std::cerr : std::cout;
+  if (o.stats_path == "-") std::cout << app::stats_json(result.report);
+  else if (!o.stats_path.empty()) outputs.write_text(o.stats_path, app::stats_json(result.report));
+  if (!o.quiet) app::print_report(report_out, result.report);
   // Asked for by name, so printed even when --quiet.
-  if (result.report.machine) std::cout << nodes::format_routes(result.report.machine->report);
+  if (result.report.machine) report_out << nodes::format_routes(result.report.machine->report);
   if (result.report.machine && !o.tiles_csv.empty())
     outputs.write_text(o.tiles_csv, app::tiles_csv(result.report.machine->report));
   if (result.report.machine)  // removes what it wrote if it fails; the image is written and not needed again

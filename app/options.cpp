@@ -7,6 +7,7 @@
 #include <sstream>
 
 #include "topology/spec.hpp"
+#include "topology/topology.hpp"
 #include "tracer/generators.hpp"
 #include "tracer/image.hpp"
 
@@ -30,7 +31,7 @@ po::options_description describe_render(Options& o, Raw& raw) {
       ("help,h", "show this help and exit")
       ("version", "show the version and exit")
       ("output,o", po::value(&o.output), "output image, .png or .ppm (default: SCENE.png)")
-      ("stats", po::value(&o.stats_path), "write the report as JSON to this file")
+      ("stats", po::value(&o.stats_path), "write the report as JSON to this file (- for standard output, the text report then going to stderr)")
       ("spd-procedure", po::bool_switch(&o.spd_procedure),
        "SPD testing procedure: pixel-corner eye rays, depth 5, no adaptive cut-off")
       ("accel", po::value(&raw.accel)->default_value("bvh"), "acceleration structure: bvh or grid")
@@ -108,7 +109,7 @@ void check_render(Options& o, const Raw& raw, const po::variables_map& vm) {
 // A bare kind takes --nodes (default 16); a full spec stands alone or must agree.
 void check_topology(nodes::MachineOptions& m, const Raw& raw, const po::variables_map& vm) {
   m.topology = raw.topology;
-  if (vm.count("nodes")) m.nodes = in_range<std::size_t>(raw.nodes, 1, 1 << 20, "--nodes");
+  if (vm.count("nodes")) m.nodes = in_range<std::size_t>(raw.nodes, 1, topology::max_nodes, "--nodes");
   else if (raw.topology.find(':') != std::string::npos) m.nodes.reset();
   try {
     topology::parse_topology(m.topology, m.nodes);

@@ -6,6 +6,7 @@
 #include <sstream>
 
 #include "app/options.hpp"
+#include "app/wording.hpp"
 
 namespace app {
 
@@ -30,7 +31,7 @@ void print_report(std::ostream& out, const RunReport& r) {
       << "image          " << r.output << " (" << r.width << "x" << r.height
       << (r.spd_procedure ? ", SPD procedure" : "") << ")\n"
       << "database       " << r.pages << " pages of " << r.page_size << " bytes = "
-      << r.database_bytes / 1024.0 << " KB (" << accel_description(r.accel, r.bvh_layout) << ", built in "
+      << size_text(double(r.database_bytes)) << " (" << accel_description(r.accel, r.bvh_layout) << ", built in "
       << r.build.accel_seconds << " s)\n"
       << "rays           " << s.rays() << ": primary " << s.primary << " (hit " << s.primary_hits
       << "), shadow " << s.shadow << ", reflected " << s.reflected << ", refracted "

@@ -1,6 +1,8 @@
 // Scene loading for the command line; see scene_input.hpp.
 #include "app/scene_input.hpp"
 
+#include <cerrno>
+#include <cstring>
 #include <filesystem>
 #include <stdexcept>
 
@@ -16,19 +18,24 @@ bool looks_like_path(const std::string& s) {
 }
 
 // Anything that exists and is not a directory is read as a file, so FIFOs,
-// /dev/stdin and process substitutions work as well as regular files.
+// /dev/stdin and process substitutions work as well as regular files. A
+// name that is no file says why in the system's words (strerror): no such
+// file, a loop of symbolic links, a path through a file, no permission.
 tracer::Scene read_scene(const std::string& spec) {
   std::error_code ec;
   const std::filesystem::file_status status = std::filesystem::status(spec, ec);
   const bool directory = std::filesystem::is_directory(status);
   if (spec == "-" || (std::filesystem::exists(status) && !directory)) return tracer::load_nff_file(spec);
-  const std::string not_a_file = directory ? "is a directory, not an NFF file" : "no such file";
+  const std::string not_a_file = directory ? "is a directory, not an NFF file"
+                                 : ec     ? ec.message()
+                                          : std::string(std::strerror(ENOENT));
   if (looks_like_path(spec)) throw std::runtime_error(spec + ": " + not_a_file);
   try {
     return tracer::generate_scene(spec);
   } catch (const std::invalid_argument& e) {
+    // A name that is neither a file nor a built-in is a bad argument, as a bad option value is.
     const std::string file_note = directory ? "that name " + not_a_file : "no file of that name";
-    throw std::runtime_error(std::string(e.what()) + " (and " + file_note + ")");
+    throw UsageError(std::string(e.what()) + " (and " + file_note + ")");
   }
 }
 

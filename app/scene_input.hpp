@@ -10,7 +10,9 @@
 
 namespace app {
 
-// Throws std::runtime_error with one line naming the file:line or the scene.
+// Throws std::runtime_error with one line naming the file:line or the scene;
+// UsageError (a bad argument) for a name that is neither a file nor a
+// built-in, or a built-in spec that is malformed.
 tracer::Scene load_scene(const Options& options);
 
 }  // namespace app

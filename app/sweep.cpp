@@ -13,6 +13,7 @@
 #include <thread>
 
 #include "app/memory_check.hpp"
+#include "app/output_check.hpp"
 #include "app/options.hpp"
 #include "app/scene_input.hpp"
 #include "app/timing_options.hpp"
@@ -125,8 +126,7 @@ void check_sweep(SweepOptions& o, const RawSweep& raw, const po::variables_map& 
     }
   o.out_dir = raw.out.empty() ? "sweep-" + raw.kind : raw.out;
   // Found out now rather than after the runs, when the tables are written.
-  if (std::filesystem::exists(o.out_dir) && !std::filesystem::is_directory(o.out_dir))
-    throw UsageError("--out: " + o.out_dir.string() + " exists and is not a directory");
+  check_writable_directory("--out", o.out_dir);
   o.accel = parse_accel(raw.accel);
   o.bvh_layout = parse_bvh_layout(raw.bvh_layout);
   o.schedule = parse_schedule(raw.schedule);

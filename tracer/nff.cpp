@@ -9,7 +9,9 @@
 
 #include <algorithm>
 #include <charconv>
+#include <cerrno>
 #include <cmath>
+#include <cstring>
 #include <fstream>
 #include <iostream>
 #include <iterator>
@@ -434,8 +436,9 @@ Scene parse_nff(std::istream& in, const std::string& source_name) {
 
 Scene load_nff_file(const std::string& path) {
   if (path == "-") return parse_nff(std::cin, "<stdin>");
+  errno = 0;
   std::ifstream file(path, std::ios::binary);
-  if (!file) throw SceneError(path + ": cannot open file");
+  if (!file) throw SceneError(path + ": cannot open: " + (errno ? std::strerror(errno) : "unknown error"));
   return parse_nff(file, path);
 }
 

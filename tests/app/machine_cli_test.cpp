@@ -314,7 +314,7 @@ TEST_F(MachineCli, AnOutputThatCannotBeWrittenLeavesNoOtherFile) {
   };
   for (const std::string& args : cases) {
     const Outcome r = run(std::string(kSmall) + " -q -o out.png " + args);
-    EXPECT_EQ(r.exit_code, 1) << args;
+    EXPECT_EQ(r.exit_code, 2) << args;  // refused before the scene is read (output_check.hpp)
     EXPECT_EQ(lines(r.err), 1u) << args << ": " << r.err;
     EXPECT_NE(r.err.find("nodir/"), std::string::npos) << args << ": " << r.err;
     for (const auto& entry : fs::directory_iterator(dir_)) {
@@ -360,7 +360,7 @@ TEST_F(MachineCli, TwoOutputsAtOnePathAreAnError) {
 TEST_F(MachineCli, AFailedRunLeavesWhatItDidNotWrite) {
   fs::create_directory(dir_ / "in_the_way.json");
   const Outcome r = run(std::string(kSmall) + " -q -o out.png --stats in_the_way.json");
-  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_EQ(r.exit_code, 2);
   EXPECT_NE(r.err.find("in_the_way.json"), std::string::npos) << r.err;
   EXPECT_TRUE(fs::is_directory(dir_ / "in_the_way.json"));
   EXPECT_FALSE(fs::exists(dir_ / "out.png"));
