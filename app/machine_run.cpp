@@ -4,6 +4,7 @@
 #include <string>
 #include <utility>
 
+#include "app/cpu_count.hpp"
 #include "app/memory_check.hpp"
 #include "app/progress.hpp"
 
@@ -45,6 +46,7 @@ RenderResult render_machine(const Options& o, const tracer::Scene& scene) {
   check_machine_memory(o, scene.camera.width, scene.camera.height, db.header.page_count, memory_limit());
   RunReport report = describe_run(o, db);
   nodes::MachineOptions machine = o.machine;
+  if (machine.threads == 0) machine.threads = usable_cpus();  // affinity and CPU quota, not the machine's cores
   machine.trace = {.max_depth = o.max_depth,
                    .spd_procedure = o.spd_procedure,
                    .shadow_rays_to_all_lights = o.shadow_rays_all};

@@ -12,6 +12,7 @@
 #include <sstream>
 #include <thread>
 
+#include "app/cpu_count.hpp"
 #include "app/memory_check.hpp"
 #include "app/output_check.hpp"
 #include "app/options.hpp"
@@ -101,7 +102,7 @@ void check_sweep(SweepOptions& o, const RawSweep& raw, const po::variables_map& 
   o.grain = in_range<std::uint32_t>(raw.grain, 1, 1 << 20, "--grain");
   o.prefetch = in_range<std::uint16_t>(raw.prefetch, 0, nodes::max_prefetch(nodes::MachineOptions{}), "--prefetch");
   o.jobs = in_range<unsigned>(raw.jobs, 0, 1024, "--jobs");
-  if (o.jobs == 0) o.jobs = std::max(1u, std::thread::hardware_concurrency());
+  if (o.jobs == 0) o.jobs = usable_cpus();
   if (vm.count("fit-seconds") && !(o.fit_seconds > 0 && std::isfinite(o.fit_seconds)))
     throw UsageError("--fit-seconds: expected a finite number of seconds above 0");
   o.topologies = split(raw.topologies);
