@@ -56,7 +56,7 @@ int run(const app::Options& o) {
   const double load_seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   // Before the minutes of work that an image too large for the memory would waste.
-  app::check_image_memory(o, scene.camera.width, scene.camera.height, app::memory_limit());
+  app::check_image_memory(o, scene, app::memory_limit());
   app::RenderResult result = o.single ? app::render_single(o, scene) : app::render_machine(o, scene);
   result.report.load_seconds = load_seconds;
   app::OutputPhase phase;

@@ -10,6 +10,7 @@
 #include "topology/topology.hpp"
 #include "tracer/generators.hpp"
 #include "tracer/image.hpp"
+#include "tracer/tessellate.hpp"
 
 namespace app {
 namespace po = boost::program_options;
@@ -47,7 +48,8 @@ po::options_description describe_render(Options& o, Raw& raw) {
       ("width", po::value(&raw.width), "image width (default: the scene's)")
       ("height", po::value(&raw.height), "image height (default: the scene's)")
       ("tessellate", po::value(&raw.tessellate),
-       "tessellate spheres and cones into triangles at this resolution")
+       ("tessellate spheres and cones into triangles at this resolution, 1.." +
+        std::to_string(tracer::kMaxTessellation) + " (12 r^2 triangles a sphere, 8 r a cone)").c_str())
       ("quiet,q", po::bool_switch(&o.quiet), "no progress bar and no report");
   return d;
 }
@@ -102,7 +104,7 @@ void check_render(Options& o, const Raw& raw, const po::variables_map& vm) {
   o.max_depth = in_range<int>(raw.max_depth, 1, 64, "--max-depth");
   if (vm.count("width")) o.width = in_range<int>(raw.width, 1, 16384, "--width");
   if (vm.count("height")) o.height = in_range<int>(raw.height, 1, 16384, "--height");
-  if (vm.count("tessellate")) o.tessellate = in_range<int>(raw.tessellate, 1, 256, "--tessellate");
+  if (vm.count("tessellate")) o.tessellate = in_range<int>(raw.tessellate, 1, tracer::kMaxTessellation, "--tessellate");
   if (!vm.count("output")) o.output = default_output(o.scene);
 }
 
@@ -116,6 +118,7 @@ void check_topology(nodes::MachineOptions& m, const Raw& raw, const po::variable
   } catch (const std::invalid_argument& e) {
     throw UsageError(std::string("--topology: ") + e.what());
   }
+  if (m.nodes) check_grid_shape(m.topology, *m.nodes);
 }
 
 void check_cache(Options& o, const Raw& raw, const po::variables_map& vm) {
@@ -230,6 +233,16 @@ nodes::PixelOrder parse_pixel_order(const std::string& name) {
   for (auto order : {nodes::PixelOrder::scanline, nodes::PixelOrder::hilbert})
     if (name == nodes::pixel_order_name(order)) return order;
   throw UsageError("--pixel-order: expected scanline or hilbert, got '" + name + "'");
+}
+
+void check_grid_shape(const std::string& kind, std::size_t nodes) {
+  if (kind != "mesh" && kind != "torus") return;
+  const auto [w, h] = topology::squarest_grid(nodes);
+  if (h > 1 || nodes <= 3) return;
+  throw UsageError("--topology " + kind + " --nodes " + std::to_string(nodes) + ": the only " + kind + " of " +
+                   std::to_string(nodes) + " nodes is " + std::to_string(w) + "x1, a line; give that shape (" +
+                   kind + ":" + std::to_string(w) + "x1), a ring, or a count with factors such as " +
+                   std::to_string(nodes - 1) + " or " + std::to_string(nodes + 1));
 }
 
 void check_grain(nodes::Schedule schedule, bool grain_given) {

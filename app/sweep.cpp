@@ -124,6 +124,7 @@ void check_sweep(SweepOptions& o, const RawSweep& raw, const po::variables_map& 
       } catch (const std::invalid_argument& e) {
         throw UsageError(std::string("--topology: ") + e.what());
       }
+      check_grid_shape(topology, n);
     }
   o.out_dir = raw.out.empty() ? "sweep-" + raw.kind : raw.out;
   // Found out now rather than after the runs, when the tables are written.

@@ -318,6 +318,7 @@ void Parser::view() {
   cam.hither = number("hither distance");
   if (cam.hither < 0) fail_here("'hither' must not be negative");
   keyword("resolution");
+  scene_.resolution_origin = source_ + ":" + std::to_string(lex_.line());
   cam.width = static_cast<int>(integer("image width", 1, kMaxResolution));
   cam.height = static_cast<int>(integer("image height", 1, kMaxResolution));
 }

@@ -1,7 +1,9 @@
 // What vmpray checks before its work and how it says so: every output path
 // before the scene is read, `--stats -` as standard output, the system's
 // reason for a file it cannot open, one wording, one range and one exit
-// status for each kind of bad argument.
+// status for each kind of bad argument; tessellations and images too large
+// for the memory refused by what asked for them; warnings for a scene that
+// would render as nothing and a mesh that would be a line.
 #include <gtest/gtest.h>
 #include <unistd.h>
 
@@ -161,6 +163,105 @@ TEST_F(Checks, TheReportSaysOneNodeAndLargeCachesInTheirUnit) {
   EXPECT_NE(r.out.find(": 1 node, 1 pixel computer each"), std::string::npos) << r.out;
   EXPECT_NE(r.out.find("cache 1000000000 pages (953.7 GB) per node"), std::string::npos) << r.out;
   EXPECT_EQ(r.out.find("1 nodes"), std::string::npos) << r.out;
+}
+
+}  // namespace
+
+namespace {
+
+// One range for --tessellate, in the help and the check, and the same as
+// the tessellator's own.
+TEST(OptionRanges, TessellateHasOneRange) {
+  EXPECT_NE(app::usage_text().find("this resolution, 1..64"), std::string::npos) << app::usage_text();
+  EXPECT_EQ(test::parse({"--tessellate", "64"}).tessellate, 64);
+  try {
+    test::parse({"--tessellate", "65"});
+    ADD_FAILURE() << "65 accepted";
+  } catch (const app::UsageError& e) {
+    EXPECT_STREQ(e.what(), "--tessellate: expected 1..64, got 65");
+  }
+}
+
+// A tessellation whose scene cannot fit in the memory is refused before it
+// is made, by the option or the scene spec that asked for it, instead of
+// running until an allocation fails; one that fits still renders.
+TEST_F(Checks, ATessellationTooLargeForTheMemoryIsRefusedBeforeItIsMade) {
+#if defined(__SANITIZE_ADDRESS__) || defined(__SANITIZE_THREAD__)
+  GTEST_SKIP() << "a sanitizer's shadow memory does not fit in 2 GB of address space";
+#endif
+  const auto limited = [&](const std::string& args) { return run_vmpray(args, "stdout.txt", "ulimit -v 2000000"); };
+  const std::pair<const char*, const char*> refused[] = {
+      {"balls:4 --tessellate 64 --width 8 --height 8 -o out.png",
+       "vmpray: --tessellate 64: the scene tessellated becomes 362790913 objects, needing about 261.2 GB, more than "
+       "the 2.0 GB this process may map (ulimit -v)\n"},
+      {"balls:4:t64 --width 8 --height 8 -o out.png",
+       "vmpray: scene 'balls:4:t64': the scene tessellated becomes 362790913 objects"},
+  };
+  for (const auto& [args, message] : refused) {
+    const Outcome r = limited(args);
+    EXPECT_EQ(r.exit_code, 2) << args << ": " << r.err;
+    EXPECT_EQ(r.err.rfind(message, 0), 0u) << r.err;
+    EXPECT_EQ(lines(r.err), 1u) << r.err;
+    EXPECT_FALSE(fs::exists(dir_ / "out.png"));
+  }
+  const Outcome fits = limited("balls:1 --tessellate 8 --width 8 --height 8 -q -o out.png");
+  EXPECT_EQ(fits.exit_code, 0) << fits.err;
+}
+
+// An image too large, at the size the scene's "resolution" set, is blamed
+// on that line of the scene, not on options that were not given.
+TEST_F(Checks, AnImageTooLargeFromTheSceneNamesItsLine) {
+#if defined(__SANITIZE_ADDRESS__) || defined(__SANITIZE_THREAD__)
+  GTEST_SKIP() << "a sanitizer's shadow memory does not fit in 2 GB of address space";
+#endif
+  std::ofstream(dir_ / "big.nff") << "v\nfrom 0 0 5\nat 0 0 0\nup 0 1 0\nangle 40\nhither 0.1\n"
+                                     "resolution 16384 16384\nl 0 0 5\ns 0 0 0 1\n";
+  const auto limited = [&](const std::string& args) { return run_vmpray(args, "stdout.txt", "ulimit -v 2000000"); };
+  const Outcome from_scene = limited("big.nff -o out.png");
+  EXPECT_EQ(from_scene.exit_code, 2);
+  EXPECT_EQ(from_scene.err,
+            "vmpray: big.nff:7: a 16384x16384 image needs about 8.1 GB, more than the 2.0 GB this process may map "
+            "(ulimit -v); --width and --height render it smaller\n");
+  const Outcome from_options = limited("big.nff --width 16384 -o out.png");
+  EXPECT_EQ(from_options.exit_code, 2);
+  EXPECT_EQ(from_options.err.rfind("vmpray: --width/--height: a 16384x16384 image", 0), 0u) << from_options.err;
+}
+
+// A scene that would render as nothing says so on stderr, and renders.
+TEST_F(Checks, ASceneWithNoLightsOrNoObjectsIsWarnedOf) {
+  std::ofstream(dir_ / "dark.nff") << "v from 0 0 5 at 0 0 0 up 0 1 0 angle 40 hither 0.1 resolution 8 8\ns 0 0 0 1\n";
+  std::ofstream(dir_ / "empty.nff") << "v from 0 0 5 at 0 0 0 up 0 1 0 angle 40 hither 0.1 resolution 8 8\nl 0 0 5\n";
+  const std::pair<const char*, const char*> warned[] = {
+      {"dark.nff", "vmpray: warning: dark.nff has no lights ('l'): every surface it shows renders black\n"},
+      {"empty.nff", "vmpray: warning: empty.nff has no objects: the image is its background colour alone\n"},
+  };
+  for (const auto& [scene, warning] : warned) {
+    const Outcome r = run(std::string(scene) + " -q --nodes 2 -o out.png");
+    EXPECT_EQ(r.exit_code, 0) << r.err;
+    EXPECT_EQ(r.err, warning);
+    EXPECT_TRUE(fs::exists(dir_ / "out.png"));
+    fs::remove(dir_ / "out.png");
+  }
+  std::ofstream(dir_ / "lit.nff") << kTinyScene;
+  EXPECT_EQ(run("lit.nff -q --nodes 2 -o out.png").err, "");
+}
+
+// A bare mesh or torus of a count with no factors would be a line: refused
+// with the shape to give instead; any other count gets its squarest shape,
+// which the report names.
+TEST_F(Checks, AMeshThatWouldBeALineIsRefusedAndTheShapeIsReported) {
+  for (const char* kind : {"mesh", "torus"}) {
+    const Outcome r = run(std::string("tetra:1 --topology ") + kind + " --nodes 17 -o out.png");
+    EXPECT_EQ(r.exit_code, 2);
+    EXPECT_EQ(r.err, std::string("vmpray: --topology ") + kind + " --nodes 17: the only " + kind +
+                         " of 17 nodes is 17x1, a line; give that shape (" + kind +
+                         ":17x1), a ring, or a count with factors such as 16 or 18 (see vmpray --help)\n");
+  }
+  EXPECT_NO_THROW(test::parse({"--topology", "mesh:17x1"}));
+  EXPECT_NO_THROW(test::parse({"--topology", "mesh", "--nodes", "3"}));
+  const Outcome r = run("tetra:1 --topology mesh --nodes 8 --width 8 --height 8 -o out.png");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_NE(r.out.find("machine        mesh:4x2: 8 nodes"), std::string::npos) << r.out;
 }
 
 }  // namespace
