@@ -3,7 +3,8 @@
 // reason for a file it cannot open, one wording, one range and one exit
 // status for each kind of bad argument; tessellations and images too large
 // for the memory refused by what asked for them; warnings for a scene that
-// would render as nothing and a mesh that would be a line.
+// would render as nothing and a mesh that would be a line; JSON that is
+// UTF-8 whatever the file names.
 #include <gtest/gtest.h>
 #include <unistd.h>
 
@@ -14,6 +15,7 @@
 #include <utility>
 
 #include "app/output_check.hpp"
+#include "app/report.hpp"
 #include "app/wording.hpp"
 #include "tests/support/command_line.hpp"
 #include "tests/support/scratch.hpp"
@@ -262,6 +264,50 @@ TEST_F(Checks, AMeshThatWouldBeALineIsRefusedAndTheShapeIsReported) {
   const Outcome r = run("tetra:1 --topology mesh --nodes 8 --width 8 --height 8 -o out.png");
   ASSERT_EQ(r.exit_code, 0) << r.err;
   EXPECT_NE(r.out.find("machine        mesh:4x2: 8 nodes"), std::string::npos) << r.out;
+}
+
+}  // namespace
+
+namespace {
+
+// Whether `s` is UTF-8 as RFC 3629 has it, decoded code point by code point.
+bool valid_utf8(const std::string& s) {
+  for (std::size_t i = 0; i < s.size();) {
+    const auto b = static_cast<unsigned char>(s[i]);
+    const int extra = b < 0x80 ? 0 : (b >> 5) == 6 ? 1 : (b >> 4) == 14 ? 2 : (b >> 3) == 30 ? 3 : -1;
+    if (extra < 0 || i + extra >= s.size()) return false;
+    std::uint32_t code = extra == 0 ? b : b & (0x3f >> extra);
+    for (int k = 1; k <= extra; ++k) {
+      const auto c = static_cast<unsigned char>(s[i + k]);
+      if ((c >> 6) != 2) return false;
+      code = code << 6 | (c & 0x3f);
+    }
+    const std::uint32_t least[] = {0, 0x80, 0x800, 0x10000};
+    if (code < least[extra] || code > 0x10ffff || (code >= 0xd800 && code <= 0xdfff)) return false;
+    i += extra + 1;
+  }
+  return true;
+}
+
+TEST(JsonString, KeepsUtf8AndReplacesWhatIsNot) {
+  EXPECT_EQ(app::json_string("caf\xc3\xa9 \xe2\x82\xac"), "\"caf\xc3\xa9 \xe2\x82\xac\"");
+  EXPECT_EQ(app::json_string("lat\xe9.nff"), "\"lat\\ufffd.nff\"");
+  EXPECT_EQ(app::json_string("\xc0\xaf"), "\"\\ufffd\\ufffd\"") << "an overlong '/'";
+  EXPECT_EQ(app::json_string("\xed\xa0\x80"), "\"\\ufffd\\ufffd\\ufffd\"") << "a surrogate";
+  EXPECT_EQ(app::json_string("\xe2\x82"), "\"\\ufffd\\ufffd\"") << "cut short";
+  EXPECT_EQ(app::json_string("a\"b\\\n"), "\"a\\\"b\\\\\\u000a\"");
+}
+
+// A scene whose file name is not UTF-8 (Latin-1 here) still gives a valid
+// UTF-8 JSON report.
+TEST_F(Checks, StatsJsonIsUtf8WhateverTheFileName) {
+  const std::string name = "lat\xe9.nff";
+  std::ofstream(dir_ / name) << kTinyScene;
+  const Outcome r = run("'" + name + "' --nodes 2 -q -o out.png --stats s.json");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const std::string json = test::read_file(dir_ / "s.json");
+  EXPECT_TRUE(valid_utf8(json));
+  EXPECT_NE(json.find("\"scene\": \"lat\\ufffd.nff\""), std::string::npos) << json;
 }
 
 }  // namespace
