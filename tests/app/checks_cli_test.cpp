@@ -4,7 +4,7 @@
 // status for each kind of bad argument; tessellations and images too large
 // for the memory refused by what asked for them; warnings for a scene that
 // would render as nothing and a mesh that would be a line; JSON that is
-// UTF-8 whatever the file names.
+// UTF-8 whatever the file names; a scene file parsed as a stream.
 #include <gtest/gtest.h>
 #include <unistd.h>
 
@@ -308,6 +308,28 @@ TEST_F(Checks, StatsJsonIsUtf8WhateverTheFileName) {
   const std::string json = test::read_file(dir_ / "s.json");
   EXPECT_TRUE(valid_utf8(json));
   EXPECT_NE(json.find("\"scene\": \"lat\\ufffd.nff\""), std::string::npos) << json;
+}
+
+}  // namespace
+
+namespace {
+
+// A gzip of 150 MB of blanks around a one-sphere scene loads in an address
+// space of 100 MB (ulimit -v): the scene is parsed as it is inflated, so
+// memory follows the scene and not the size of the file.
+TEST_F(Checks, ASceneFileLargerThanTheMemoryLoadsAsAStream) {
+#if defined(__SANITIZE_ADDRESS__) || defined(__SANITIZE_THREAD__)
+  GTEST_SKIP() << "a sanitizer's shadow memory does not fit in 100 MB of address space";
+#endif
+  const std::string make = "cd '" + dir_.string() +
+                           "' && { printf 'v from 0 0 5 at 0 0 0 up 0 1 0 angle 40 hither 0.1 resolution 8 8\\nl 0 0 5\\n';"
+                           " yes '                                                               ' | head -c 150000000;"
+                           " printf 's 0 0 0 1\\n'; } | gzip -1 > blank.nff.gz";
+  ASSERT_EQ(std::system(make.c_str()), 0);
+  ASSERT_LT(fs::file_size(dir_ / "blank.nff.gz"), 10'000'000u);
+  const Outcome r = run_vmpray("blank.nff.gz --single --stats s.json -q -o out.png", "stdout.txt", "ulimit -v 100000");
+  EXPECT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_NE(test::read_file(dir_ / "s.json").find("\"objects\": 1,"), std::string::npos);
 }
 
 }  // namespace
