@@ -8,6 +8,7 @@
 #include <tuple>
 #include <vector>
 
+#include "app/options.hpp"
 #include "app/report.hpp"
 #include "app/wording.hpp"
 #include "nodes/messages.hpp"
@@ -96,10 +97,16 @@ void json_network(std::ostream& out, const nodes::NetworkStats& s) {
   out << "}";
 }
 
+// [{"id": 17, "kind": "page_request", "nodes": [5, 4, 6]}, ...]
 void json_routes(std::ostream& out, const nodes::NetworkStats& s) {
   out << "[";
-  for (std::size_t i = 0; i < s.routes.size(); ++i)
-    out << (i ? ", " : "") << json_string(nodes::format_route(s.routes[i], kind_name));
+  for (std::size_t i = 0; i < s.routes.size(); ++i) {
+    const nodes::RouteRecord& r = s.routes[i];
+    out << (i ? ", " : "") << "{\"id\": " << r.id << ", \"kind\": " << json_string(kind_name(r.kind))
+        << ", \"nodes\": [";
+    for (std::size_t k = 0; k < r.route.size(); ++k) out << (k ? ", " : "") << r.route[k];
+    out << "]}";
+  }
   out << "]";
 }
 
@@ -151,6 +158,32 @@ void print_machine_report(std::ostream& out, const MachineSummary& m) {
         << count_of(m.serial->threads, "thread") << "; " << count_of(r.nodes, "node") << ": "
         << m.parallel_seconds() << " s on " << count_of(r.threads, "thread") << (r.cost_model.empty() ? "" : ", predicted")
         << "), efficiency " << m.efficiency() << "\n";
+}
+
+void print_routes(std::ostream& out, const nodes::MachineReport& report) {
+  const auto& routes = report.network.routes;
+  if (routes.empty()) return;
+  out << "routes         " << count_of(routes.size(), "packet") << " traced, hop by hop:\n";
+  for (const nodes::RouteRecord& r : routes) out << "  " << nodes::format_route(r, kind_name) << "\n";
+}
+
+std::vector<std::uint8_t> parse_trace_kinds(const std::string& names) {
+  std::vector<std::uint8_t> kinds;
+  std::string known;
+  for (int k = 1; k < nodes::message_kind_count; ++k)
+    known += (known.empty() ? "" : ", ") + std::string(nodes::message_kind_name(static_cast<std::uint8_t>(k)));
+  std::size_t at = 0;
+  do {
+    const std::size_t comma = std::min(names.find(',', at), names.size());
+    const std::string name = names.substr(at, comma - at);
+    int kind = 1;
+    while (kind < nodes::message_kind_count && nodes::message_kind_name(static_cast<std::uint8_t>(kind)) != name) ++kind;
+    if (kind == nodes::message_kind_count)
+      throw UsageError("--trace-kind: expected packet kinds among " + known + ", got '" + name + "'");
+    kinds.push_back(static_cast<std::uint8_t>(kind));
+    at = comma + 1;
+  } while (at <= names.size());
+  return kinds;
 }
 
 void write_machine_json(std::ostream& out, const MachineSummary& m, const std::string& indent) {

@@ -68,7 +68,7 @@ int run(const app::Options& o) {
   else if (!o.stats_path.empty()) outputs.write_text(o.stats_path, app::stats_json(result.report));
   if (!o.quiet) app::print_report(report_out, result.report);
   // Asked for by name, so printed even when --quiet.
-  if (result.report.machine) report_out << nodes::format_routes(result.report.machine->report);
+  if (result.report.machine) app::print_routes(report_out, result.report.machine->report);
   if (result.report.machine && !o.tiles_csv.empty())
     outputs.write_text(o.tiles_csv, app::tiles_csv(result.report.machine->report));
   if (result.report.machine)  // removes what it wrote if it fails; the image is written and not needed again

@@ -6,6 +6,7 @@
 #include <boost/program_options.hpp>
 #include <sstream>
 
+#include "app/machine_report.hpp"
 #include "topology/spec.hpp"
 #include "topology/topology.hpp"
 #include "tracer/generators.hpp"
@@ -20,7 +21,7 @@ namespace {
 struct Raw {
   std::string accel, bvh_layout, shadow_rays;
   std::int64_t page_size = 0, max_depth = 0, width = 0, height = 0, tessellate = 0;
-  std::string topology, schedule, pixel_order, distribution;
+  std::string topology, schedule, pixel_order, distribution, trace_kind;
   std::int64_t nodes = 0, threads = 0, cache_pages = 0, cache_kb = 0, grain = 0, workers = 0,
                prefetch = 0, trace_routes = 0;
   TimingChoice timing;
@@ -85,7 +86,10 @@ po::options_description describe_machine(Options& o, Raw& raw) {
       ("distribution", po::value(&raw.distribution)->default_value("modulo"),
        "page p on node p mod N (modulo), or consecutive runs of pages (block)")
       ("trace-routes", po::value(&raw.trace_routes)->default_value(0),
-       "print the routes of the first N packets hop by hop")
+       "print the routes of the first N packets injected, hop by hop, 0..1048576 (of the kinds --trace-kind names)")
+      ("trace-kind", po::value(&raw.trace_kind),
+       "with --trace-routes: trace packets of these kinds only, comma-separated: work_request, work, stop, result, "
+       "page_request, page_reply, worker_done, server_stop, server_done")
       ("tiles", po::value(&o.tiles_csv),
        "write a CSV row per tile: node, worker, first item, items, start and end seconds (wall, or virtual "
        "with --timing virtual), page requests and rays")
@@ -144,6 +148,10 @@ void check_machine(Options& o, const Raw& raw, const po::variables_map& vm) {
   m.workers_per_node = in_range<int>(raw.workers, 1, 64, "--workers-per-node");
   m.prefetch = in_range<std::uint16_t>(raw.prefetch, 0, nodes::max_prefetch(m), "--prefetch");
   m.trace_routes = in_range<std::uint64_t>(raw.trace_routes, 0, 1 << 20, "--trace-routes");
+  if (vm.count("trace-kind")) {
+    if (m.trace_routes == 0) throw UsageError("--trace-kind: chooses the packets --trace-routes N traces; give that too");
+    m.trace_kinds = parse_trace_kinds(raw.trace_kind);
+  }
   m.schedule = parse_schedule(raw.schedule);
   m.pixel_order = parse_pixel_order(raw.pixel_order);
   if (raw.distribution == "modulo") m.distribution = nodes::Distribution::modulo;

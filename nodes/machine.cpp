@@ -254,6 +254,7 @@ MachineResult run_machine(tracer::Database db, const MachineOptions& options) {
   net_options.buffer_capacity = options.buffer_capacity;
   net_options.ports_per_node = Ports::count(options.workers_per_node);
   net_options.trace_routes = options.trace_routes;
+  net_options.trace_kinds = options.trace_kinds;
   if (timing) net_options.link = timing->model().link_model();
   Network net(runtime, topology, net_options);
 

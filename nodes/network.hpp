@@ -46,6 +46,7 @@ struct NetworkOptions {
   std::size_t buffer_capacity = 4;  // packets per output queue and per injection channel, at least 1
   unsigned ports_per_node = 1;      // local ports per node
   std::uint64_t trace_routes = 0;   // record the routes of the first this many packets injected
+  std::vector<std::uint8_t> trace_kinds;  // of these kinds only (empty: every kind)
   LinkModel link;                   // optional per-hop latency and bandwidth
   std::function<unsigned(NodeId)> placement;  // thread of node n; default block
 };
@@ -104,6 +105,7 @@ class Network {
   // exactly one process and read only after run().
   std::vector<std::unique_ptr<RouterCounters>> router_counters_;
   std::atomic<std::uint64_t> routes_to_trace_;  // RouterConfig::routes_to_trace
+  std::array<bool, 256> kinds_to_trace_{};      // RouterConfig::kinds_to_trace, from trace_kinds
 };
 
 // "page 17: 5 → 4 → 6 → 7 (3 hops)"
