@@ -40,7 +40,8 @@ SerialComparison run_serial(const tracer::Database& db, const nodes::MachineOpti
 }  // namespace
 
 RenderResult render_machine(const Options& o, const tracer::Scene& scene) {
-  tracer::Database db = build_database(scene, build_options(o));
+  tracer::Database db = in_phase("building the database", !o.quiet && stderr_is_terminal(),
+                                 [&] { return build_database(scene, build_options(o)); });
   // Before the machine is built: a complete graph of thousands of nodes would
   // take minutes to set up before running out of memory.
   check_machine_memory(o, scene.camera.width, scene.camera.height, db.header.page_count, memory_limit());

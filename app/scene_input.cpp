@@ -8,6 +8,7 @@
 #include <stdexcept>
 
 #include "app/memory_check.hpp"
+#include "app/progress.hpp"
 #include "tracer/generators.hpp"
 #include "tracer/nff.hpp"
 #include "tracer/tessellate.hpp"
@@ -56,15 +57,18 @@ std::vector<std::string> scene_warnings(const tracer::Scene& scene) {
 // as an image or a machine is (memory_check.hpp).
 tracer::Scene load_scene(const Options& o) {
   const MemoryLimit limit = memory_limit();
-  tracer::Scene scene = read_scene(o.scene, [&](const tracer::Scene& untessellated, int resolution) {
-    check_tessellation_memory("scene '" + o.scene + "'", untessellated, resolution, limit);
+  const bool shown = !o.quiet && stderr_is_terminal();
+  tracer::Scene scene = in_phase("reading " + (o.scene == "-" ? std::string("standard input") : o.scene), shown, [&] {
+    return read_scene(o.scene, [&](const tracer::Scene& untessellated, int resolution) {
+      check_tessellation_memory("scene '" + o.scene + "'", untessellated, resolution, limit);
+    });
   });
   for (const std::string& warning : scene_warnings(scene)) std::cerr << "vmpray: warning: " << warning << "\n";
   if (o.width > 0) scene.camera.width = o.width;
   if (o.height > 0) scene.camera.height = o.height;
   if (o.tessellate > 0) {
     check_tessellation_memory("--tessellate " + std::to_string(o.tessellate), scene, o.tessellate, limit);
-    tracer::tessellate(scene, o.tessellate);
+    in_phase("tessellating", shown, [&] { tracer::tessellate(scene, o.tessellate); });
   }
   return scene;
 }
