@@ -8,7 +8,9 @@
 #include <tuple>
 #include <vector>
 
+#include "app/options.hpp"
 #include "app/report.hpp"
+#include "app/wording.hpp"
 #include "nodes/messages.hpp"
 #include "topology/spec.hpp"
 
@@ -95,10 +97,16 @@ void json_network(std::ostream& out, const nodes::NetworkStats& s) {
   out << "}";
 }
 
+// [{"id": 17, "kind": "page_request", "nodes": [5, 4, 6]}, ...]
 void json_routes(std::ostream& out, const nodes::NetworkStats& s) {
   out << "[";
-  for (std::size_t i = 0; i < s.routes.size(); ++i)
-    out << (i ? ", " : "") << json_string(nodes::format_route(s.routes[i], kind_name));
+  for (std::size_t i = 0; i < s.routes.size(); ++i) {
+    const nodes::RouteRecord& r = s.routes[i];
+    out << (i ? ", " : "") << "{\"id\": " << r.id << ", \"kind\": " << json_string(kind_name(r.kind))
+        << ", \"nodes\": [";
+    for (std::size_t k = 0; k < r.route.size(); ++k) out << (k ? ", " : "") << r.route[k];
+    out << "]}";
+  }
   out << "]";
 }
 
@@ -157,14 +165,14 @@ void print_machine_report(std::ostream& out, const MachineSummary& m) {
   const nodes::SvmStats svm = r.svm();
   const nodes::ServerCounters served = r.served();
   out << std::fixed << std::setprecision(1);
-  out << "machine        " << r.topology << ": " << r.nodes << " nodes, " << r.workers_per_node
-      << " pixel computer(s) each (prefetch " << r.prefetch << "), " << nodes::schedule_name(r.schedule)
-      << " schedule";
+  out << "machine        " << r.topology << ": " << count_of(r.nodes, "node") << ", "
+      << count_of(r.workers_per_node, "pixel computer") << " each (prefetch " << r.prefetch << "), "
+      << nodes::schedule_name(r.schedule) << " schedule";
   if (r.schedule != nodes::Schedule::static_split) out << " (grain " << r.grain;
   if (r.schedule == nodes::Schedule::affinity) out << ", " << r.farmer.steals << " steals";
   if (r.schedule != nodes::Schedule::static_split) out << ")";
-  out << " in " << nodes::pixel_order_name(r.pixel_order) << " order, " << r.threads << " thread(s), cache "
-      << r.cache_pages << " pages (" << double(r.cache_pages) * r.page_size / 1024.0 << " KB) per node";
+  out << " in " << nodes::pixel_order_name(r.pixel_order) << " order, " << count_of(r.threads, "thread")
+      << ", cache " << r.cache_pages << " pages (" << size_text(double(r.cache_pages) * r.page_size) << ") per node";
   if (const std::uint32_t used = largest_cache(r); used < r.cache_pages)
     out << ", holding every remote page (at most " << used << ")";
   out << "\n"
@@ -177,17 +185,42 @@ void print_machine_report(std::ostream& out, const MachineSummary& m) {
   print_per_node(out, r, m.corner_samples ? "samples" : "pixels");
   out << nodes::format_summary(r.network, topology::parse_topology(r.topology), kind_name);
   print_ranks(out, r);
-  out << std::setprecision(3) << "wall time      " << r.wall_seconds << " s on " << r.threads
-      << " thread(s)";
+  out << std::setprecision(3) << "wall time      " << r.wall_seconds << " s on " << count_of(r.threads, "thread");
   if (r.cost_model.empty())
     out << std::setprecision(1) << ", idle " << 100 * r.idle_share() << "% of thread time" << std::setprecision(3);
   else out << "; predicted " << r.predicted_seconds << " s (" << r.cost_model << ")";
   out << "\n";
   if (m.serial)
     out << "speedup        " << m.speedup() << " (1 node: " << m.serial->seconds << " s on "
-        << m.serial->threads << " thread(s); " << r.nodes << " nodes: " << m.parallel_seconds()
-        << " s on " << r.threads << (r.cost_model.empty() ? "" : ", predicted")
+        << count_of(m.serial->threads, "thread") << "; " << count_of(r.nodes, "node") << ": "
+        << m.parallel_seconds() << " s on " << count_of(r.threads, "thread") << (r.cost_model.empty() ? "" : ", predicted")
         << "), efficiency " << m.efficiency() << "\n";
+}
+
+void print_routes(std::ostream& out, const nodes::MachineReport& report) {
+  const auto& routes = report.network.routes;
+  if (routes.empty()) return;
+  out << "routes         " << count_of(routes.size(), "packet") << " traced, hop by hop:\n";
+  for (const nodes::RouteRecord& r : routes) out << "  " << nodes::format_route(r, kind_name) << "\n";
+}
+
+std::vector<std::uint8_t> parse_trace_kinds(const std::string& names) {
+  std::vector<std::uint8_t> kinds;
+  std::string known;
+  for (int k = 1; k < nodes::message_kind_count; ++k)
+    known += (known.empty() ? "" : ", ") + std::string(nodes::message_kind_name(static_cast<std::uint8_t>(k)));
+  std::size_t at = 0;
+  do {
+    const std::size_t comma = std::min(names.find(',', at), names.size());
+    const std::string name = names.substr(at, comma - at);
+    int kind = 1;
+    while (kind < nodes::message_kind_count && nodes::message_kind_name(static_cast<std::uint8_t>(kind)) != name) ++kind;
+    if (kind == nodes::message_kind_count)
+      throw UsageError("--trace-kind: expected packet kinds among " + known + ", got '" + name + "'");
+    kinds.push_back(static_cast<std::uint8_t>(kind));
+    at = comma + 1;
+  } while (at <= names.size());
+  return kinds;
 }
 
 void write_machine_json(std::ostream& out, const MachineSummary& m, const std::string& indent) {

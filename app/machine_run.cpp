@@ -4,6 +4,7 @@
 #include <string>
 #include <utility>
 
+#include "app/cpu_count.hpp"
 #include "app/memory_check.hpp"
 #include "app/progress.hpp"
 
@@ -41,6 +42,7 @@ SerialComparison run_serial(const tracer::Database& db, const nodes::MachineOpti
 
 nodes::MachineOptions machine_options(const Options& o) {
   nodes::MachineOptions machine = o.machine;
+  if (machine.threads == 0) machine.threads = usable_cpus();  // affinity and CPU quota, not the machine's cores
   machine.trace = {.max_depth = o.max_depth,
                    .spd_procedure = o.spd_procedure,
                    .shadow_rays_to_all_lights = o.shadow_rays_all};
@@ -51,7 +53,8 @@ RenderResult render_machine(const Options& o, const tracer::Scene& scene, nodes:
   tracer::Database db;
   RunReport report;
   try {
-    db = build_database(scene, build_options(o));
+    db = in_phase("building the database", !o.quiet && stderr_is_terminal(),
+                  [&] { return build_database(scene, build_options(o)); });
     // Before the machine is built: a complete graph of thousands of nodes would
     // take minutes to set up before running out of memory.
     check_machine_memory(o, scene.camera.width, scene.camera.height, db.header.page_count, memory_limit());

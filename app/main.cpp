@@ -26,6 +26,7 @@
 #include "app/machine_pictures.hpp"
 #include "app/memory_check.hpp"
 #include "app/options.hpp"
+#include "app/output_check.hpp"
 #include "app/output_files.hpp"
 #include "app/ranks.hpp"
 #include "app/report.hpp"
@@ -61,27 +62,31 @@ void check_distinct_outputs(const app::Options& o) {
 
 // The whole run in this process, or rank 0's part over `ranks`.
 int run(const app::Options& o, nodes::Transport* ranks = nullptr) {
-  const auto t0 = std::chrono::steady_clock::now();
   tracer::Scene scene;
+  double load_seconds = 0;
   try {
+    app::check_output_paths(o);  // before the scene: a render is not done to be lost
+    const auto t0 = std::chrono::steady_clock::now();
     scene = app::load_scene(o);
+    load_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     // Before the minutes of work that an image too large for the memory would waste.
-    app::check_image_memory(o, scene.camera.width, scene.camera.height, app::memory_limit());
+    app::check_image_memory(o, scene, app::memory_limit());
   } catch (const std::exception& e) {
     if (ranks) nodes::abandon_machine(*ranks, e.what());  // they wait for their pages
     throw;
   }
-  const double load_seconds =
-      std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   app::RenderResult result = o.single ? app::render_single(o, scene) : app::render_machine(o, scene, ranks);
   result.report.load_seconds = load_seconds;
   app::OutputPhase phase;
   app::OutputFiles& outputs = phase.files();  // removed again if a later step fails
   outputs.write(o.output, [&](const auto& path) { result.image.write_image(path.string()); });
-  if (!o.stats_path.empty()) outputs.write_text(o.stats_path, app::stats_json(result.report));
-  if (!o.quiet) app::print_report(std::cout, result.report);
+  // --stats - puts the JSON alone on standard output; the report people read goes to stderr.
+  std::ostream& report_out = o.stats_path == "-" ? std::cerr : std::cout;
+  if (o.stats_path == "-") std::cout << app::stats_json(result.report);
+  else if (!o.stats_path.empty()) outputs.write_text(o.stats_path, app::stats_json(result.report));
+  if (!o.quiet) app::print_report(report_out, result.report);
   // Asked for by name, so printed even when --quiet.
-  if (result.report.machine) std::cout << nodes::format_routes(result.report.machine->report);
+  if (result.report.machine) app::print_routes(report_out, result.report.machine->report);
   if (result.report.machine && !o.tiles_csv.empty())
     outputs.write_text(o.tiles_csv, app::tiles_csv(result.report.machine->report));
   if (result.report.machine)  // removes what it wrote if it fails; the image is written and not needed again

@@ -27,6 +27,7 @@
 #include <vector>
 
 #include "app/options.hpp"
+#include "tracer/scene.hpp"
 
 namespace app {
 
@@ -60,6 +61,21 @@ MemoryLimit memory_limit();
 // UsageError "--width/--height: a WxH image needs about X GB, more than this
 // machine's Y GB" when the estimate exceeds `limit`.
 void check_image_memory(const Options& options, int width, int height, const MemoryLimit& limit);
+// The same for the scene's image, naming the scene's "FILE:LINE" instead of
+// the options when the size is the one its "resolution" set.
+void check_image_memory(const Options& options, const tracer::Scene& scene, const MemoryLimit& limit);
+
+// The peak bytes of a scene tessellated at `resolution` and its database:
+// every object it would then have (tracer::tessellated_object_count) as a
+// scene object and as a database primitive with its share of the
+// acceleration structure and of the pages.
+std::uint64_t tessellation_memory_bytes(const tracer::Scene& scene, int resolution);
+
+// UsageError "ORIGIN: the scene tessellated becomes N objects, needing about
+// X GB, more than this machine's Y GB" when the estimate exceeds `limit`;
+// `origin` names what asked for it ("--tessellate 64", "scene 'rings:1:t60'").
+void check_tessellation_memory(const std::string& origin, const tracer::Scene& scene, int resolution,
+                               const MemoryLimit& limit);
 
 // The bytes a machine takes beyond its image's buffers, with a database of
 // `page_count` pages: every node's processes and their fixed state, its

@@ -6,9 +6,12 @@
 #include <boost/program_options.hpp>
 #include <sstream>
 
+#include "app/machine_report.hpp"
 #include "topology/spec.hpp"
+#include "topology/topology.hpp"
 #include "tracer/generators.hpp"
 #include "tracer/image.hpp"
+#include "tracer/tessellate.hpp"
 
 namespace app {
 namespace po = boost::program_options;
@@ -18,7 +21,7 @@ namespace {
 struct Raw {
   std::string accel, bvh_layout, shadow_rays;
   std::int64_t page_size = 0, max_depth = 0, width = 0, height = 0, tessellate = 0;
-  std::string topology, schedule, pixel_order, distribution;
+  std::string topology, schedule, pixel_order, distribution, trace_kind;
   std::int64_t nodes = 0, threads = 0, cache_pages = 0, cache_kb = 0, grain = 0, workers = 0,
                prefetch = 0, trace_routes = 0;
   TimingChoice timing;
@@ -30,7 +33,7 @@ po::options_description describe_render(Options& o, Raw& raw) {
       ("help,h", "show this help and exit")
       ("version", "show the version and exit")
       ("output,o", po::value(&o.output), "output image, .png or .ppm (default: SCENE.png)")
-      ("stats", po::value(&o.stats_path), "write the report as JSON to this file")
+      ("stats", po::value(&o.stats_path), "write the report as JSON to this file (- for standard output, the text report then going to stderr)")
       ("spd-procedure", po::bool_switch(&o.spd_procedure),
        "SPD testing procedure: pixel-corner eye rays, depth 5, no adaptive cut-off")
       ("accel", po::value(&raw.accel)->default_value("bvh"), "acceleration structure: bvh or grid")
@@ -46,7 +49,8 @@ po::options_description describe_render(Options& o, Raw& raw) {
       ("width", po::value(&raw.width), "image width (default: the scene's)")
       ("height", po::value(&raw.height), "image height (default: the scene's)")
       ("tessellate", po::value(&raw.tessellate),
-       "tessellate spheres and cones into triangles at this resolution")
+       ("tessellate spheres and cones into triangles at this resolution, 1.." +
+        std::to_string(tracer::kMaxTessellation) + " (12 r^2 triangles a sphere, 8 r a cone)").c_str())
       ("quiet,q", po::bool_switch(&o.quiet), "no progress bar and no report");
   return d;
 }
@@ -63,7 +67,7 @@ po::options_description describe_machine(Options& o, Raw& raw) {
       ("nodes", po::value(&raw.nodes),
        ("processors, at most " + std::to_string(topology::max_nodes) + " (default 16, or the full spec's)").c_str())
       ("threads", po::value(&raw.threads)->default_value(0),
-       "OS threads carrying the processors (0: hardware cores; at most --nodes)")
+       "OS threads carrying the processors, 0..4096 (0: the CPUs this process may use, by its affinity and CPU quota; at most --nodes)")
       ("cache-pages", po::value(&raw.cache_pages),
        "remote pages cached per node (default: 1/8 of the database, at least 64 pages)")
       ("cache-kb", po::value(&raw.cache_kb), "the cache per node in KB instead of pages")
@@ -82,7 +86,10 @@ po::options_description describe_machine(Options& o, Raw& raw) {
       ("distribution", po::value(&raw.distribution)->default_value("modulo"),
        "page p on node p mod N (modulo), or consecutive runs of pages (block)")
       ("trace-routes", po::value(&raw.trace_routes)->default_value(0),
-       "print the routes of the first N packets hop by hop")
+       "print the routes of the first N packets injected, hop by hop, 0..1048576 (of the kinds --trace-kind names)")
+      ("trace-kind", po::value(&raw.trace_kind),
+       "with --trace-routes: trace packets of these kinds only, comma-separated: work_request, work, stop, result, "
+       "page_request, page_reply, worker_done, server_stop, server_done")
       ("tiles", po::value(&o.tiles_csv),
        "write a CSV row per tile: node, worker, first item, items, start and end seconds (wall, or virtual "
        "with --timing virtual), page requests and rays")
@@ -101,20 +108,21 @@ void check_render(Options& o, const Raw& raw, const po::variables_map& vm) {
   o.max_depth = in_range<int>(raw.max_depth, 1, 64, "--max-depth");
   if (vm.count("width")) o.width = in_range<int>(raw.width, 1, 16384, "--width");
   if (vm.count("height")) o.height = in_range<int>(raw.height, 1, 16384, "--height");
-  if (vm.count("tessellate")) o.tessellate = in_range<int>(raw.tessellate, 1, 256, "--tessellate");
+  if (vm.count("tessellate")) o.tessellate = in_range<int>(raw.tessellate, 1, tracer::kMaxTessellation, "--tessellate");
   if (!vm.count("output")) o.output = default_output(o.scene);
 }
 
 // A bare kind takes --nodes (default 16); a full spec stands alone or must agree.
 void check_topology(nodes::MachineOptions& m, const Raw& raw, const po::variables_map& vm) {
   m.topology = raw.topology;
-  if (vm.count("nodes")) m.nodes = in_range<std::size_t>(raw.nodes, 1, 1 << 20, "--nodes");
+  if (vm.count("nodes")) m.nodes = in_range<std::size_t>(raw.nodes, 1, topology::max_nodes, "--nodes");
   else if (raw.topology.find(':') != std::string::npos) m.nodes.reset();
   try {
     topology::parse_topology(m.topology, m.nodes);
   } catch (const std::invalid_argument& e) {
     throw UsageError(std::string("--topology: ") + e.what());
   }
+  if (m.nodes) check_grid_shape(m.topology, *m.nodes);
 }
 
 void check_cache(Options& o, const Raw& raw, const po::variables_map& vm) {
@@ -140,6 +148,10 @@ void check_machine(Options& o, const Raw& raw, const po::variables_map& vm) {
   m.workers_per_node = in_range<int>(raw.workers, 1, 64, "--workers-per-node");
   m.prefetch = in_range<std::uint16_t>(raw.prefetch, 0, nodes::max_prefetch(m), "--prefetch");
   m.trace_routes = in_range<std::uint64_t>(raw.trace_routes, 0, 1 << 20, "--trace-routes");
+  if (vm.count("trace-kind")) {
+    if (m.trace_routes == 0) throw UsageError("--trace-kind: chooses the packets --trace-routes N traces; give that too");
+    m.trace_kinds = parse_trace_kinds(raw.trace_kind);
+  }
   m.schedule = parse_schedule(raw.schedule);
   m.pixel_order = parse_pixel_order(raw.pixel_order);
   if (raw.distribution == "modulo") m.distribution = nodes::Distribution::modulo;
@@ -229,6 +241,16 @@ nodes::PixelOrder parse_pixel_order(const std::string& name) {
   for (auto order : {nodes::PixelOrder::scanline, nodes::PixelOrder::hilbert})
     if (name == nodes::pixel_order_name(order)) return order;
   throw UsageError("--pixel-order: expected scanline or hilbert, got '" + name + "'");
+}
+
+void check_grid_shape(const std::string& kind, std::size_t nodes) {
+  if (kind != "mesh" && kind != "torus") return;
+  const auto [w, h] = topology::squarest_grid(nodes);
+  if (h > 1 || nodes <= 3) return;
+  throw UsageError("--topology " + kind + " --nodes " + std::to_string(nodes) + ": the only " + kind + " of " +
+                   std::to_string(nodes) + " nodes is " + std::to_string(w) + "x1, a line; give that shape (" +
+                   kind + ":" + std::to_string(w) + "x1), a ring, or a count with factors such as " +
+                   std::to_string(nodes - 1) + " or " + std::to_string(nodes + 1));
 }
 
 void check_grain(nodes::Schedule schedule, bool grain_given) {

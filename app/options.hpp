@@ -78,6 +78,11 @@ tracer::BuildOptions build_options(const Options& o);
 nodes::Schedule parse_schedule(const std::string& name);
 // --pixel-order: "scanline" or "hilbert"; UsageError otherwise.
 nodes::PixelOrder parse_pixel_order(const std::string& name);
+// A bare mesh or torus whose node count has no factors would be a line
+// (mesh --nodes 17 is 17x1): UsageError asking for the shape or another
+// count, since a line is not what "mesh" promises. Other kinds, full specs
+// and counts up to 3 (whose only grids are lines) pass.
+void check_grid_shape(const std::string& kind, std::size_t nodes);
 // --grain given (grain_given) with the static schedule: UsageError, since
 // that schedule hands out fixed shares and the grain would change nothing.
 void check_grain(nodes::Schedule schedule, bool grain_given);

@@ -3,8 +3,8 @@
 
 #include <algorithm>
 #include <optional>
-#include <thread>
 
+#include "app/cpu_count.hpp"
 #include "app/machine_run.hpp"
 #include "topology/spec.hpp"
 
@@ -25,7 +25,7 @@ void check_rank_options(const Options& o, int ranks) {
 
 unsigned threads_per_rank(unsigned threads, int ranks_on_this_host) {
   if (threads != 0) return threads;
-  const unsigned cores = std::max(1u, std::thread::hardware_concurrency());
+  const unsigned cores = usable_cpus();
   return std::max(1u, cores / static_cast<unsigned>(std::max(ranks_on_this_host, 1)));
 }
 

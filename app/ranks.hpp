@@ -14,8 +14,8 @@ namespace app {
 // --single, --compare-serial, --timing virtual, and more ranks than nodes.
 void check_rank_options(const Options& options, int ranks);
 
-// --threads 0 over several ranks: the host's cores shared among the ranks
-// that run on it, at least one each.
+// --threads 0 over several ranks: the CPUs this process may use, shared
+// among the ranks that run on this host, at least one each.
 unsigned threads_per_rank(unsigned threads, int ranks_on_this_host);
 
 // A rank other than 0: its nodes, until the machine ends. Throws

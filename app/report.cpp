@@ -6,18 +6,52 @@
 #include <sstream>
 
 #include "app/options.hpp"
+#include "app/wording.hpp"
 
 namespace app {
 
+namespace {
+
+// The length of the well-formed UTF-8 sequence at s[i] (RFC 3629: no
+// overlong forms, no surrogates, nothing above U+10FFFF), 0 if there is none.
+std::size_t utf8_sequence(const std::string& s, std::size_t i) {
+  const auto byte = [&](std::size_t k) { return static_cast<unsigned char>(s[k]); };
+  const unsigned char b = byte(i);
+  std::size_t length = 0;
+  unsigned char lo = 0x80, hi = 0xbf;  // the range of the second byte
+  if (b < 0x80) return 1;
+  if (b >= 0xc2 && b <= 0xdf) length = 2;
+  else if (b >= 0xe0 && b <= 0xef) length = 3, lo = b == 0xe0 ? 0xa0 : 0x80, hi = b == 0xed ? 0x9f : 0xbf;
+  else if (b >= 0xf0 && b <= 0xf4) length = 4, lo = b == 0xf0 ? 0x90 : 0x80, hi = b == 0xf4 ? 0x8f : 0xbf;
+  else return 0;
+  if (i + length > s.size()) return 0;
+  if (byte(i + 1) < lo || byte(i + 1) > hi) return 0;
+  for (std::size_t k = 2; k < length; ++k)
+    if (byte(i + k) < 0x80 || byte(i + k) > 0xbf) return 0;
+  return length;
+}
+
+}  // namespace
+
+// JSON text is UTF-8 (RFC 8259): a byte that is not part of a well-formed
+// sequence, as in a file name in Latin-1, becomes U+FFFD.
 std::string json_string(const std::string& s) {
   std::string out = "\"";
-  for (char c : s) {
+  for (std::size_t i = 0; i < s.size();) {
+    const char c = s[i];
+    const std::size_t length = utf8_sequence(s, i);
+    if (length == 0) {
+      out += "\\ufffd";
+      ++i;
+      continue;
+    }
     if (c == '"' || c == '\\') out += '\\', out += c;
     else if (static_cast<unsigned char>(c) < 0x20) {
       char buf[8];
-      std::snprintf(buf, sizeof buf, "\\u%04x", c);
+      std::snprintf(buf, sizeof buf, "\\u%04x", static_cast<unsigned>(c));
       out += buf;
-    } else out += c;
+    } else out.append(s, i, length);
+    i += length;
   }
   return out + "\"";
 }
@@ -30,7 +64,7 @@ void print_report(std::ostream& out, const RunReport& r) {
       << "image          " << r.output << " (" << r.width << "x" << r.height
       << (r.spd_procedure ? ", SPD procedure" : "") << ")\n"
       << "database       " << r.pages << " pages of " << r.page_size << " bytes = "
-      << r.database_bytes / 1024.0 << " KB (" << accel_description(r.accel, r.bvh_layout) << ", built in "
+      << size_text(double(r.database_bytes)) << " (" << accel_description(r.accel, r.bvh_layout) << ", built in "
       << r.build.accel_seconds << " s)\n"
       << "rays           " << s.rays() << ": primary " << s.primary << " (hit " << s.primary_hits
       << "), shadow " << s.shadow << ", reflected " << s.reflected << ", refracted "

@@ -5,12 +5,23 @@
 // Image-size and tessellation options are applied here, before any build.
 #pragma once
 
+#include <string>
+#include <vector>
+
 #include "app/options.hpp"
 #include "tracer/scene.hpp"
 
 namespace app {
 
-// Throws std::runtime_error with one line naming the file:line or the scene.
+// What makes a scene render as nothing: no objects (the background alone),
+// or no lights (every surface black). One line each, naming the scene.
+std::vector<std::string> scene_warnings(const tracer::Scene& scene);
+
+// Prints scene_warnings on stderr ("vmpray: warning: ..."); the render goes on.
+// Throws std::runtime_error with one line naming the file:line or the scene;
+// UsageError (a bad argument) for a name that is neither a file nor a
+// built-in, a built-in spec that is malformed, or a tessellation (--tessellate,
+// or a spec's tRES) too large for the memory, refused before it is made.
 tracer::Scene load_scene(const Options& options);
 
 }  // namespace app

@@ -32,7 +32,8 @@ RunReport describe_run(const Options& o, const tracer::Database& db) {
 }
 
 RenderResult render_single(const Options& o, const tracer::Scene& scene) {
-  const tracer::Database db = build_database(scene, build_options(o));
+  const tracer::Database db = in_phase("building the database", !o.quiet && stderr_is_terminal(),
+                                       [&] { return build_database(scene, build_options(o)); });
   RunReport report = describe_run(o, db);
   tracer::InMemoryPageSource pages(db);
   const tracer::TraceOptions trace{.max_depth = o.max_depth,

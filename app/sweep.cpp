@@ -12,7 +12,9 @@
 #include <sstream>
 #include <thread>
 
+#include "app/cpu_count.hpp"
 #include "app/memory_check.hpp"
+#include "app/output_check.hpp"
 #include "app/options.hpp"
 #include "app/scene_input.hpp"
 #include "app/timing_options.hpp"
@@ -100,7 +102,7 @@ void check_sweep(SweepOptions& o, const RawSweep& raw, const po::variables_map& 
   o.grain = in_range<std::uint32_t>(raw.grain, 1, 1 << 20, "--grain");
   o.prefetch = in_range<std::uint16_t>(raw.prefetch, 0, nodes::max_prefetch(nodes::MachineOptions{}), "--prefetch");
   o.jobs = in_range<unsigned>(raw.jobs, 0, 1024, "--jobs");
-  if (o.jobs == 0) o.jobs = std::max(1u, std::thread::hardware_concurrency());
+  if (o.jobs == 0) o.jobs = usable_cpus();
   if (vm.count("fit-seconds") && !(o.fit_seconds > 0 && std::isfinite(o.fit_seconds)))
     throw UsageError("--fit-seconds: expected a finite number of seconds above 0");
   o.topologies = split(raw.topologies);
@@ -122,11 +124,11 @@ void check_sweep(SweepOptions& o, const RawSweep& raw, const po::variables_map& 
       } catch (const std::invalid_argument& e) {
         throw UsageError(std::string("--topology: ") + e.what());
       }
+      check_grid_shape(topology, n);
     }
   o.out_dir = raw.out.empty() ? "sweep-" + raw.kind : raw.out;
   // Found out now rather than after the runs, when the tables are written.
-  if (std::filesystem::exists(o.out_dir) && !std::filesystem::is_directory(o.out_dir))
-    throw UsageError("--out: " + o.out_dir.string() + " exists and is not a directory");
+  check_writable_directory("--out", o.out_dir);
   o.accel = parse_accel(raw.accel);
   o.bvh_layout = parse_bvh_layout(raw.bvh_layout);
   o.schedule = parse_schedule(raw.schedule);

@@ -10,6 +10,7 @@
 
 #include "app/output_files.hpp"
 #include "app/options.hpp"
+#include "app/report.hpp"
 #include "app/sweep.hpp"
 #include "app/viz/plot.hpp"
 #include "app/viz/plot_raster.hpp"
@@ -26,14 +27,8 @@ std::string number(double v) {
   return out.str();
 }
 
-std::string quoted(const std::string& s) {
-  std::string out = "\"";
-  for (char c : s) {
-    if (c == '"' || c == '\\') out += '\\';
-    if (static_cast<unsigned char>(c) >= 0x20) out += c;
-  }
-  return out + "\"";
-}
+// As the render's report quotes: valid UTF-8 whatever the scene's file name.
+std::string quoted(const std::string& s) { return json_string(s); }
 
 const char* const csv_header =
     "scene,topology,nodes,cache_pages,predicted_seconds,predicted_hms,speedup,efficiency,miss_ratio,"

@@ -345,6 +345,7 @@ Executed execute(const tracer::DatabaseHeader& header, const topology::Topology&
   net_options.buffer_capacity = options.buffer_capacity;
   net_options.ports_per_node = Ports::count(options.workers_per_node);
   net_options.trace_routes = options.trace_routes;
+  net_options.trace_kinds = options.trace_kinds;
   if (timing) net_options.link = timing->model().link_model();
   if (share.plan) {
     net_options.local = [share](NodeId n) { return share.runs(n); };

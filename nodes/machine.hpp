@@ -79,6 +79,7 @@ struct MachineOptions {
   std::uint16_t prefetch = 1;          // tiles a worker has asked for beyond the one it traces
   Distribution distribution = Distribution::modulo;
   std::uint64_t trace_routes = 0;      // record the routes of the first N packets
+  std::vector<std::uint8_t> trace_kinds;  // of these MessageKinds only (empty: every kind)
   bool record_tiles = false;           // a TileSpan per tile in each NodeReport's work.spans
   std::size_t buffer_capacity = 4;     // packets per network queue
   tracer::TraceOptions trace;

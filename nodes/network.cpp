@@ -32,6 +32,7 @@ Network::Network(csp::Runtime& runtime, topology::Topology topology, NetworkOpti
   if (options_.ports_per_node == 0) throw std::invalid_argument("network: each node needs at least one local port");
   if (options_.local && options_.link.enabled())
     throw std::invalid_argument("network: a link model cannot carry links between processes");
+  for (const std::uint8_t kind : options_.trace_kinds) kinds_to_trace_[kind] = true;
   const std::size_t n = topology_.size();
   link_in_.resize(n);
   ports_.resize(n);
@@ -84,7 +85,8 @@ void Network::wire_node(csp::Runtime& runtime, NodeId node) {
   }
   for (unsigned j = 0; j < options_.ports_per_node; ++j)
     ends.outputs.push_back(output_queue(runtime, node, ports_[node][j]));
-  RouterConfig config{options_.trace_routes > 0 ? &routes_to_trace_ : nullptr};
+  RouterConfig config{options_.trace_routes > 0 ? &routes_to_trace_ : nullptr,
+                      options_.trace_kinds.empty() ? nullptr : &kinds_to_trace_};
   auto router = std::make_shared<Router>(topology_, node, std::move(ends), config,
                                          *router_counters_[node]);
   runtime.spawn("router " + std::to_string(node), thread_of(node), [router] { router->run(); });

@@ -54,6 +54,7 @@ struct NetworkOptions {
   std::size_t buffer_capacity = 4;  // packets per output queue and per injection channel, at least 1
   unsigned ports_per_node = 1;      // local ports per node
   std::uint64_t trace_routes = 0;   // record the routes of the first this many packets injected
+  std::vector<std::uint8_t> trace_kinds;  // of these kinds only (empty: every kind)
   LinkModel link;                   // optional per-hop latency and bandwidth
   std::function<unsigned(NodeId)> placement;  // thread of node n; default block
   std::function<bool(NodeId)> local;          // nodes this process runs; default all
@@ -136,6 +137,7 @@ class Network {
   // exactly one process and read only after run().
   std::vector<std::unique_ptr<RouterCounters>> router_counters_;
   std::atomic<std::uint64_t> routes_to_trace_;  // RouterConfig::routes_to_trace
+  std::array<bool, 256> kinds_to_trace_{};      // RouterConfig::kinds_to_trace, from trace_kinds
 };
 
 // The network's figures from every router's counters (index = node).

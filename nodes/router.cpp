@@ -83,13 +83,14 @@ void Router::accept_injection(Packet& packet) const {
   ++counters_.injected;
   packet.source = self_;
   packet.hops = 0;
-  packet.traced = packet.traced || take_route_to_trace();
+  packet.traced = packet.traced || take_route_to_trace(packet.kind);
   packet.route.clear();
   if (packet.traced) packet.route.push_back(self_);
 }
 
-bool Router::take_route_to_trace() const {
+bool Router::take_route_to_trace(std::uint8_t kind) const {
   if (config_.routes_to_trace == nullptr) return false;
+  if (config_.kinds_to_trace != nullptr && !(*config_.kinds_to_trace)[kind]) return false;
   std::uint64_t left = config_.routes_to_trace->load(std::memory_order_relaxed);
   while (left > 0)
     if (config_.routes_to_trace->compare_exchange_weak(left, left - 1, std::memory_order_relaxed)) return true;

@@ -85,6 +85,9 @@ struct RouterConfig {
   // injection takes one while any are left, so the first packets injected
   // are traced, however their senders number them. Null: none traced.
   std::atomic<std::uint64_t>* routes_to_trace = nullptr;
+  // The packet kinds traced, by kind; null: every kind. Packets of other
+  // kinds take no route from routes_to_trace.
+  const std::array<bool, 256>* kinds_to_trace = nullptr;
 };
 
 class Router {
@@ -102,7 +105,7 @@ class Router {
   void build_alt();
   void receive(std::size_t source, Packet packet);
   void accept_injection(Packet& packet) const;
-  bool take_route_to_trace() const;
+  bool take_route_to_trace(std::uint8_t kind) const;
   bool try_send(std::size_t queue, Packet& packet);
   void hold(std::size_t source, Packet packet, std::size_t queue);
   void admit_pending(std::size_t queue);

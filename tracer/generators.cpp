@@ -60,7 +60,7 @@ std::vector<std::string_view> split(std::string_view spec) {
 
 }  // namespace
 
-Scene generate_scene(std::string_view spec) {
+Scene generate_scene(std::string_view spec, const TessellationCheck& before_tessellating) {
   std::vector<std::string_view> parts = split(spec);
   const Entry* entry = nullptr;
   for (const Entry& e : table())
@@ -76,11 +76,14 @@ Scene generate_scene(std::string_view spec) {
   if (next < parts.size()) {
     if (!parts[next].starts_with('t')) bad_spec(spec, "expected tRES after the size, got '" + std::string(parts[next]) + "'");
     tess = parse_int(spec, parts[next++].substr(1), "a tessellation level after 't'");
-    if (tess < 1) bad_spec(spec, "tessellation level must be at least 1");
+    if (tess < 1 || tess > kMaxTessellation)
+      bad_spec(spec, "expected a tessellation level of 1.." + std::to_string(kMaxTessellation) + ", got " +
+                         std::to_string(tess));
   }
   if (next != parts.size()) bad_spec(spec, "expected NAME[:SIZE][:tRES]");
   try {
     Scene scene = entry->make(size);
+    if (tess != 0 && before_tessellating) before_tessellating(scene, tess);
     if (tess != 0) tessellate(scene, tess);
     scene.name = std::string(spec);
     return scene;

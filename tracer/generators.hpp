@@ -13,6 +13,7 @@
 // 3 129, and no size gives 3 754 exactly).
 #pragma once
 
+#include <functional>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -26,9 +27,14 @@ struct BuiltinScene {
   std::string description;  // one line, for --help
 };
 
+// Called with the scene and the resolution before a spec's tRES tessellates
+// it, so that a caller may refuse a tessellation too large for it (by
+// throwing) before it is made.
+using TessellationCheck = std::function<void(const Scene& scene, int resolution)>;
+
 // Throws std::invalid_argument naming the spec for an unknown name, a size
 // out of range or a malformed spec.
-Scene generate_scene(std::string_view spec);
+Scene generate_scene(std::string_view spec, const TessellationCheck& before_tessellating = {});
 
 // Every accepted NAME with a one-line description, in --help order.
 std::vector<BuiltinScene> builtin_scenes();

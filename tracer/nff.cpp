@@ -1,120 +1,255 @@
-// NFF parser: a token reader over the whole (inflated) text, and one small
-// function per entity. Every check that can fail names the line of the token
-// that broke it, or for a fault of a whole entity (a polygon's shape, a
-// material, a second view) the line of its keyword; see nff.hpp for the
-// choices made where NFF is silent.
+// NFF parser: a token reader over the input as it is read (and inflated), a
+// chunk at a time, and one small function per entity. Every check that can
+// fail names the line of the token that broke it, or for a fault of a whole
+// entity (a polygon's shape, a material, a second view) the line of its
+// keyword; see nff.hpp for the choices made where NFF is silent.
 #include "tracer/nff.hpp"
 
 #include <zlib.h>
 
 #include <algorithm>
 #include <charconv>
+#include <cerrno>
 #include <cmath>
+#include <cstring>
 #include <fstream>
 #include <iostream>
 #include <iterator>
 #include <limits>
+#include <vector>
 
 namespace tracer {
 namespace {
 
-bool is_gzip(std::string_view data) {
-  return data.size() >= 2 && static_cast<unsigned char>(data[0]) == 0x1f &&
-         static_cast<unsigned char>(data[1]) == 0x8b;
-}
+// Bytes of the input in chunks, so that the text is read as it is parsed
+// and never held whole: memory follows the scene, not the file.
+class ByteSource {
+ public:
+  virtual ~ByteSource() = default;
+  // Up to `size` bytes into `buffer`; 0 only at the end of the input.
+  virtual std::size_t read(char* buffer, std::size_t size) = 0;
+};
 
-// Zero bytes after the last member: tape or block padding, which gzip(1)
-// ignores too.
-bool only_zero_bytes(const Bytef* data, uInt size) {
-  return std::all_of(data, data + size, [](Bytef b) { return b == 0; });
-}
+class MemorySource final : public ByteSource {
+ public:
+  explicit MemorySource(std::string_view data) : data_(data) {}
+  std::size_t read(char* buffer, std::size_t size) override {
+    const std::size_t n = std::min(size, data_.size());
+    std::copy_n(data_.data(), n, buffer);
+    data_.remove_prefix(n);
+    return n;
+  }
 
-// Inflates a gzip stream (several members allowed, as gzip(1) writes them,
-// and trailing zero padding).
-std::string inflate_gzip(std::string_view data, const std::string& source) {
-  z_stream zs{};
-  if (inflateInit2(&zs, 16 + MAX_WBITS) != Z_OK) throw SceneError(source + ": cannot initialise zlib");
-  zs.next_in = reinterpret_cast<Bytef*>(const_cast<char*>(data.data()));
-  zs.avail_in = static_cast<uInt>(data.size());
-  std::string out;
-  char chunk[1 << 16];
-  int status = Z_OK;
-  while (status != Z_STREAM_END || !only_zero_bytes(zs.next_in, zs.avail_in)) {
-    if (status == Z_STREAM_END) inflateReset(&zs);  // next gzip member
-    zs.next_out = reinterpret_cast<Bytef*>(chunk);
-    zs.avail_out = sizeof chunk;
-    status = inflate(&zs, Z_NO_FLUSH);
-    if (status != Z_OK && status != Z_STREAM_END) {
-      inflateEnd(&zs);
-      throw SceneError(source + ": corrupt or truncated gzip data");
+ private:
+  std::string_view data_;
+};
+
+class StreamSource final : public ByteSource {
+ public:
+  StreamSource(std::istream& in, const std::string& source) : in_(in), source_(source) {}
+  std::size_t read(char* buffer, std::size_t size) override {
+    errno = 0;
+    try {
+      in_.read(buffer, static_cast<std::streamsize>(size));
+    } catch (const std::ios_base::failure&) {  // a stream that throws, e.g. on a directory
+      throw SceneError(source_ + ": cannot read (is it a regular file?)");
     }
-    out.append(chunk, sizeof chunk - zs.avail_out);
-    if (out.size() > kMaxInflatedBytes) {
-      inflateEnd(&zs);
-      throw SceneError(source + ": gzip data inflates to more than 1 GiB");
-    }
-    if (status == Z_OK && zs.avail_in == 0 && zs.avail_out != 0) {
-      inflateEnd(&zs);
-      throw SceneError(source + ": truncated gzip data");
+    if (in_.bad()) throw SceneError(source_ + ": read error" + (errno ? std::string(": ") + std::strerror(errno) : ""));
+    return static_cast<std::size_t>(in_.gcount());
+  }
+
+ private:
+  std::istream& in_;
+  const std::string& source_;
+};
+
+// The first bytes of another source, read ahead to tell gzip by its magic,
+// then the rest of it.
+class PeekedSource final : public ByteSource {
+ public:
+  explicit PeekedSource(ByteSource& rest) : rest_(rest) {
+    while (head_.size() < 2) {
+      char c[2];
+      const std::size_t n = rest_.read(c, 2 - head_.size());
+      if (n == 0) break;
+      head_.append(c, n);
     }
   }
-  inflateEnd(&zs);
-  return out;
-}
+  bool is_gzip() const {
+    return head_.size() == 2 && static_cast<unsigned char>(head_[0]) == 0x1f &&
+           static_cast<unsigned char>(head_[1]) == 0x8b;
+  }
+  std::size_t read(char* buffer, std::size_t size) override {
+    if (at_ == head_.size()) return rest_.read(buffer, size);
+    const std::size_t n = std::min(size, head_.size() - at_);
+    std::copy_n(head_.data() + at_, n, buffer);
+    at_ += n;
+    return n;
+  }
+
+ private:
+  ByteSource& rest_;
+  std::string head_;
+  std::size_t at_ = 0;
+};
+
+// Inflates a gzip stream as it is read: several members allowed, as gzip(1)
+// writes them, and zero bytes after the last (tape or block padding, which
+// gzip(1) ignores too); at most kMaxInflatedBytes in all.
+class GzipSource final : public ByteSource {
+ public:
+  GzipSource(ByteSource& raw, const std::string& source) : raw_(raw), source_(source) {
+    if (inflateInit2(&zs_, 16 + MAX_WBITS) != Z_OK) throw SceneError(source_ + ": cannot initialise zlib");
+  }
+  GzipSource(const GzipSource&) = delete;
+  GzipSource& operator=(const GzipSource&) = delete;
+  ~GzipSource() override { inflateEnd(&zs_); }
+
+  std::size_t read(char* buffer, std::size_t size) override {
+    for (;;) {
+      if (zs_.avail_in == 0 && !refill()) {
+        if (status_ != Z_STREAM_END) throw SceneError(source_ + ": truncated gzip data");
+        return 0;
+      }
+      if (status_ == Z_STREAM_END && !next_member()) continue;
+      zs_.next_out = reinterpret_cast<Bytef*>(buffer);
+      zs_.avail_out = static_cast<uInt>(size);
+      status_ = inflate(&zs_, Z_NO_FLUSH);
+      if (status_ != Z_OK && status_ != Z_STREAM_END && !(status_ == Z_BUF_ERROR && zs_.avail_in == 0))
+        throw SceneError(source_ + ": corrupt or truncated gzip data");
+      if (status_ == Z_BUF_ERROR) status_ = Z_OK;
+      const std::size_t produced = size - zs_.avail_out;
+      inflated_ += produced;
+      if (inflated_ > kMaxInflatedBytes) throw SceneError(source_ + ": gzip data inflates to more than 1 GiB");
+      if (produced > 0) return produced;
+    }
+  }
+
+ private:
+  bool refill() {
+    const std::size_t n = raw_.read(in_.data(), in_.size());
+    zs_.next_in = reinterpret_cast<Bytef*>(in_.data());
+    zs_.avail_in = static_cast<uInt>(n);
+    return n > 0;
+  }
+
+  // After a member's end: false while the input holds zero padding (which
+  // it consumes; a member after padding is refused), true once a next
+  // member has begun.
+  bool next_member() {
+    if (padding_ || *zs_.next_in == 0) {
+      padding_ = true;
+      if (!std::all_of(zs_.next_in, zs_.next_in + zs_.avail_in, [](Bytef b) { return b == 0; }))
+        throw SceneError(source_ + ": corrupt or truncated gzip data");
+      zs_.avail_in = 0;
+      return false;
+    }
+    inflateReset(&zs_);
+    status_ = Z_OK;
+    return true;
+  }
+
+  ByteSource& raw_;
+  const std::string& source_;
+  z_stream zs_{};
+  int status_ = Z_OK;
+  bool padding_ = false;
+  std::uint64_t inflated_ = 0;
+  std::vector<char> in_ = std::vector<char>(1 << 16);
+};
+
+inline constexpr std::size_t kMaxTokenBytes = 1024;
+
+std::string describe(std::string_view token);
 
 // Whitespace-separated tokens; '#' anywhere, even right after a token, ends
 // the token and comments out the rest of its line. A line ends at "\n",
 // "\r\n" or a lone "\r" (old Mac files). line() is the line of the last token
 // read, so an error at end of file points at the line that was cut short.
+// The input is read a chunk at a time; a token is at most kMaxTokenBytes
+// (no NFF number or keyword comes near), so memory stays bounded however
+// long the file or its comments and blanks.
 class Lexer {
  public:
-  explicit Lexer(std::string_view text) : text_(text) {}
+  Lexer(ByteSource& input, const std::string& source) : input_(input), source_(source) {}
 
-  std::string_view next() {
-    skip_blanks();
-    if (pos_ < text_.size()) token_line_ = line_;
-    std::size_t start = pos_;
-    while (pos_ < text_.size() && !is_blank(text_[pos_]) && text_[pos_] != '#') ++pos_;
-    return text_.substr(start, pos_ - start);
+  // The next token, "" at the end; valid until the next call of next() or peek().
+  const std::string& next() {
+    if (!ahead_) read_token(ahead_token_);
+    ahead_ = false;
+    current_ = std::move(ahead_token_.text);
+    if (!ahead_token_.at_end) token_line_ = ahead_token_.line;
+    return current_;
   }
 
-  std::string_view peek() {
-    Lexer saved = *this;
-    std::string_view token = next();
-    *this = saved;
-    return token;
+  // The token next() would return, without taking it.
+  const std::string& peek() {
+    if (!ahead_) read_token(ahead_token_);
+    ahead_ = true;
+    return ahead_token_.text;
   }
 
   int line() const { return token_line_; }
 
  private:
-  static bool is_blank(char c) {
+  struct Token {
+    std::string text;
+    int line = 0;
+    bool at_end = false;
+  };
+
+  static bool is_blank(int c) {
     return c == ' ' || c == '\t' || c == '\n' || c == '\r' || c == '\f' || c == '\v';
   }
 
-  // A '\r' followed by '\n' is left to the '\n' to count.
-  bool ends_line(std::size_t at) const {
-    return text_[at] == '\n' || (text_[at] == '\r' && (at + 1 == text_.size() || text_[at + 1] != '\n'));
+  // The next byte, -1 at the end of the input.
+  int peek_byte() {
+    if (pos_ == end_ && !at_end_) {
+      end_ = input_.read(buffer_.data(), buffer_.size());
+      pos_ = 0;
+      at_end_ = end_ == 0;
+    }
+    return pos_ < end_ ? static_cast<unsigned char>(buffer_[pos_]) : -1;
   }
 
+  // A '\r' followed by '\n' is left to the '\n' to count.
   void skip_blanks() {
-    while (pos_ < text_.size()) {
-      char c = text_[pos_];
+    for (int c = peek_byte(); c >= 0; c = peek_byte()) {
       if (c == '#') {
-        while (pos_ < text_.size() && text_[pos_] != '\n' && text_[pos_] != '\r') ++pos_;
+        while ((c = peek_byte()) >= 0 && c != '\n' && c != '\r') ++pos_;
       } else if (is_blank(c)) {
-        line_ += ends_line(pos_);
         ++pos_;
+        if (c == '\n' || (c == '\r' && peek_byte() != '\n')) ++line_;
       } else {
         return;
       }
     }
   }
 
-  std::string_view text_;
-  std::size_t pos_ = 0;
+  void read_token(Token& token) {
+    skip_blanks();
+    token.text.clear();
+    token.at_end = peek_byte() < 0;
+    token.line = line_;
+    for (int c = peek_byte(); c >= 0 && !is_blank(c) && c != '#'; c = peek_byte()) {
+      if (token.text.size() == kMaxTokenBytes)
+        throw SceneError(source_ + ":" + std::to_string(line_) + ": expected a token of at most " +
+                         std::to_string(kMaxTokenBytes) + " bytes, got " + describe(token.text + "..."));
+      token.text.push_back(static_cast<char>(c));
+      ++pos_;
+    }
+  }
+
+  ByteSource& input_;
+  const std::string& source_;
+  std::vector<char> buffer_ = std::vector<char>(1 << 16);  // on the heap: a parser may run on a small stack
+  std::size_t pos_ = 0, end_ = 0;
+  bool at_end_ = false;
   int line_ = 1;
   int token_line_ = 1;
+  Token ahead_token_;
+  bool ahead_ = false;
+  std::string current_;
 };
 
 // How a token is shown in an error: quoted, shortened, bytes escaped.
@@ -182,22 +317,22 @@ bool looks_numeric(std::string_view token) {
 
 class Parser {
  public:
-  Parser(std::string_view text, const std::string& source) : lex_(text), source_(source) {
+  Parser(ByteSource& input, const std::string& source) : lex_(input, source), source_(source) {
     scene_.name = source;
   }
 
   // Input with no entity at all (an empty file, or a pipe that failed) is
   // refused rather than rendered as an empty scene.
   Scene run() {
-    std::string_view key = lex_.next();
+    std::string key = lex_.next();
     if (key.empty()) throw SceneError(source_ + ": no NFF entity in the input (is it empty?)");
     for (; !key.empty(); key = lex_.next()) entity(key);
     return std::move(scene_);
   }
 
  private:
-  void entity(std::string_view key) {
-    const std::string_view previous_key = entity_key_;
+  void entity(const std::string& key) {
+    const std::string previous_key = entity_key_;
     const int previous_line = entity_line_;
     entity_key_ = key;
     entity_line_ = lex_.line();
@@ -235,7 +370,7 @@ class Parser {
   }
 
   double number(std::string_view what) {
-    std::string_view token = lex_.next();
+    const std::string& token = lex_.next();
     double value;
     if (!parse_double(token, value)) fail(std::string("a finite number (") + std::string(what) + ")", token);
     // The database stores floats: a larger number would become infinite there.
@@ -258,7 +393,7 @@ class Parser {
   }
 
   long long integer(std::string_view what, long long lo, long long hi) {
-    const std::string_view token = lex_.next();
+    const std::string& token = lex_.next();
     std::string_view digits = token;
     long long value = 0;
     const bool sign_ok = strip_plus(digits);
@@ -270,7 +405,7 @@ class Parser {
   }
 
   void keyword(std::string_view expected) {
-    std::string_view token = lex_.next();
+    const std::string& token = lex_.next();
     if (token == expected) return;
     std::string quoted(1, '\'');  // built by append: GCC 12 -O3 warns falsely on "'" + string
     quoted.append(expected).push_back('\'');
@@ -290,7 +425,7 @@ class Parser {
   Lexer lex_;
   const std::string& source_;
   Scene scene_;
-  std::string_view entity_key_;  // the entity being read, and its keyword's line
+  std::string entity_key_;  // the entity being read, and its keyword's line
   int entity_line_ = 0;
   int view_line_ = 0;  // of the "v" read so far, 0 before it
 };
@@ -316,6 +451,7 @@ void Parser::view() {
   cam.hither = number("hither distance");
   if (cam.hither < 0) fail_here("'hither' must not be negative");
   keyword("resolution");
+  scene_.resolution_origin = source_ + ":" + std::to_string(lex_.line());
   cam.width = static_cast<int>(integer("image width", 1, kMaxResolution));
   cam.height = static_cast<int>(integer("image height", 1, kMaxResolution));
 }
@@ -413,29 +549,32 @@ void Parser::patch() {
 
 }  // namespace
 
+namespace {
+
+Scene parse_source(ByteSource& raw, const std::string& source_name) {
+  PeekedSource input(raw);
+  if (!input.is_gzip()) return Parser(input, source_name).run();
+  GzipSource inflated(input, source_name);
+  return Parser(inflated, source_name).run();
+}
+
+}  // namespace
+
 Scene parse_nff(std::string_view text, const std::string& source_name) {
-  if (is_gzip(text)) {
-    std::string inflated = inflate_gzip(text, source_name);
-    return Parser(inflated, source_name).run();
-  }
-  return Parser(text, source_name).run();
+  MemorySource input(text);
+  return parse_source(input, source_name);
 }
 
 Scene parse_nff(std::istream& in, const std::string& source_name) {
-  std::string text;
-  try {
-    text.assign(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
-  } catch (const std::ios_base::failure&) {  // e.g. the path is a directory
-    throw SceneError(source_name + ": cannot read (is it a regular file?)");
-  }
-  if (in.bad()) throw SceneError(source_name + ": read error");
-  return parse_nff(std::string_view(text), source_name);
+  StreamSource input(in, source_name);
+  return parse_source(input, source_name);
 }
 
 Scene load_nff_file(const std::string& path) {
   if (path == "-") return parse_nff(std::cin, "<stdin>");
+  errno = 0;
   std::ifstream file(path, std::ios::binary);
-  if (!file) throw SceneError(path + ": cannot open file");
+  if (!file) throw SceneError(path + ": cannot open: " + (errno ? std::strerror(errno) : "unknown error"));
   return parse_nff(file, path);
 }
 

@@ -82,6 +82,7 @@ struct Object {
 struct Scene {
   std::string name;  // file name or generator spec, for reports
   Camera camera;
+  std::string resolution_origin;  // "FILE:LINE" of the NFF "resolution" that set the size; empty for built-ins
   Color background{0, 0, 0};
   std::vector<Light> lights;
   std::vector<Material> materials;

@@ -2,6 +2,8 @@
 // lib_output_polygon_cylcone (see tessellate.hpp for the scheme).
 #include "tracer/tessellate.hpp"
 
+#include <algorithm>
+
 #include <cmath>
 #include <numbers>
 #include <stdexcept>
@@ -96,6 +98,19 @@ std::vector<Patch> tessellate_cone(const Cone& cone, int r) {
     apex_pt = next_apex, apex_n = n, base_pt = next_base, base_n = n;
   }
   return out;
+}
+
+std::uint64_t tessellated_object_count(const Scene& scene, int resolution) {
+  const auto r = static_cast<std::uint64_t>(std::max(resolution, 0));
+  std::uint64_t count = 0;
+  for (const Object& o : scene.objects) {
+    const auto* s = std::get_if<Sphere>(&o.shape);
+    const auto* c = std::get_if<Cone>(&o.shape);
+    if (s && !inside_only(*s)) count += 12 * r * r;
+    else if (c && !inside_only(*c)) count += 8 * r;
+    else ++count;
+  }
+  return count;
 }
 
 void tessellate(Scene& scene, int resolution) {

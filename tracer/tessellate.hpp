@@ -15,6 +15,7 @@
 // outside instead.
 #pragma once
 
+#include <cstdint>
 #include <vector>
 
 #include "tracer/scene.hpp"
@@ -25,6 +26,12 @@ inline constexpr int kMaxTessellation = 64;
 
 std::vector<Patch> tessellate_sphere(const Sphere& sphere, int resolution);
 std::vector<Patch> tessellate_cone(const Cone& cone, int resolution);
+
+// How many objects tessellate(scene, resolution) would leave, counting its
+// triangles as 12 r^2 a sphere and 8 r a cone (a true cone's dropped apex
+// triangles included, so an upper bound): for a caller to weigh a
+// tessellation before making it. No range check on the resolution.
+std::uint64_t tessellated_object_count(const Scene& scene, int resolution);
 
 // Replaces every sphere and cone of the scene (except the inside-only ones,
 // see above) by its triangles. Throws

@@ -42,9 +42,9 @@ TEST_F(Cli, MissingSceneFileIsARuntimeErrorWithNoOutput) {
   EXPECT_FALSE(fs::exists(dir_ / "out.png"));
 }
 
-TEST_F(Cli, UnknownBuiltinIsARuntimeError) {
+TEST_F(Cli, UnknownBuiltinIsABadArgument) {
   const Outcome r = run("nosuchscene -o out.png");
-  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_EQ(r.exit_code, 2);
   EXPECT_EQ(lines(r.err), 1u) << r.err;
   EXPECT_FALSE(fs::exists(dir_ / "out.png"));
 }

@@ -93,11 +93,11 @@ TEST(Options, OptionsThatWouldChangeNothingAreErrors) {
 TEST(Options, AnExplicitZeroSizeOrTessellationIsAnError) {
   EXPECT_EQ(error_of({"--width", "0"}), "--width: expected 1..16384, got 0");
   EXPECT_EQ(error_of({"--height", "0"}), "--height: expected 1..16384, got 0");
-  EXPECT_EQ(error_of({"--tessellate", "0"}), "--tessellate: expected 1..256, got 0");
-  const Options o = parse({"--width", "16384", "--height", "1", "--tessellate", "256"});
+  EXPECT_EQ(error_of({"--tessellate", "0"}), "--tessellate: expected 1..64, got 0");
+  const Options o = parse({"--width", "16384", "--height", "1", "--tessellate", "64"});
   EXPECT_EQ(o.width, 16384);
   EXPECT_EQ(o.height, 1);
-  EXPECT_EQ(o.tessellate, 256);
+  EXPECT_EQ(o.tessellate, 64);
 }
 
 // --single has no machine to give these to; ignoring them would mislead.

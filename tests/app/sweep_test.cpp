@@ -122,9 +122,32 @@ TEST(SweepOptions, AnOutputPathThatIsAFileIsAnError) {
     parse({"nodes", "--out", file.c_str()});
     ADD_FAILURE() << "accepted";
   } catch (const app::UsageError& e) {
-    EXPECT_EQ(std::string(e.what()), "--out: " + file.string() + " exists and is not a directory");
+    EXPECT_EQ(std::string(e.what()), "--out: cannot write in '" + file.string() + "': " + file.string() +
+                                         ": Not a directory");
   }
   fs::remove(file);
+}
+
+// A directory to be made under a file, or in a directory that is not
+// there, is refused as soon: the nearest existing parent must take it.
+TEST(SweepOptions, AnOutputDirectoryThatCannotBeMadeIsAnError) {
+  const fs::path file = fresh_dir("vmpray_sweep_out_parent");
+  std::ofstream(file) << "not a directory\n";
+  const std::pair<fs::path, std::string> refused[] = {
+      {file / "sub", file.string() + ": Not a directory"},
+      {file / "a" / "b", file.string() + ": Not a directory"},
+  };
+  for (const auto& [out, reason] : refused) {
+    try {
+      parse({"nodes", "--out", out.c_str()});
+      ADD_FAILURE() << "accepted " << out;
+    } catch (const app::UsageError& e) {
+      EXPECT_EQ(std::string(e.what()), "--out: cannot write in '" + out.string() + "': " + reason);
+    }
+  }
+  fs::remove(file);
+  EXPECT_EQ(parse({"nodes", "--out", (fs::temp_directory_path() / "vmpray_no_such_dir" / "out").c_str()}).out_dir,
+            fs::temp_directory_path() / "vmpray_no_such_dir" / "out");
 }
 
 TEST(SweepOptions, ShadowRaysAndAccelReachTheRuns) {

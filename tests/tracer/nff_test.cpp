@@ -7,9 +7,13 @@
 #include <zlib.h>
 
 #include <cmath>
+#include <cstdint>
+#include <istream>
 #include <ostream>
+#include <streambuf>
 #include <sstream>
 #include <string>
+#include <utility>
 
 #include "scene_stats.hpp"
 
@@ -287,6 +291,80 @@ INSTANTIATE_TEST_SUITE_P(
         BadInput{"ShortMaterial", "f 1 1 1 1 0 1 0\ns 0 0 0 1", "t.nff:2: expected a finite number (index of refraction), got 's'"},
         BadInput{"BinaryGarbage", std::string("s 0 0 0 1\n\x01\x02\xff", 13), "t.nff:2: expected an entity keyword (v b l f c s p pp), got '\\x01\\x02\\xff'"}),
     [](const auto& info) { return std::string(info.param.label); });
+
+}  // namespace
+}  // namespace tracer
+
+namespace tracer {
+namespace {
+
+// A stream of `text` followed by `blanks` spaces, made as it is read, that
+// counts the bytes handed out: a parser holding the input whole would take
+// them all before the first token.
+class BlankTail : public std::streambuf {
+ public:
+  BlankTail(std::string text, std::uint64_t blanks) : text_(std::move(text)), blanks_(blanks) {}
+  std::uint64_t handed_out() const { return handed_out_; }
+
+ protected:
+  int_type underflow() override {
+    if (gptr() < egptr()) return traits_type::to_int_type(*gptr());
+    std::size_t n = 0;
+    while (n < sizeof chunk_ && at_ < text_.size()) chunk_[n++] = text_[at_++];
+    while (n < sizeof chunk_ && blanks_ > 0) chunk_[n++] = ' ', --blanks_;
+    if (n == 0) return traits_type::eof();
+    handed_out_ += n;
+    setg(chunk_, chunk_, chunk_ + n);
+    return traits_type::to_int_type(chunk_[0]);
+  }
+
+ private:
+  std::string text_;
+  std::size_t at_ = 0;
+  std::uint64_t blanks_;
+  std::uint64_t handed_out_ = 0;
+  char chunk_[4096];
+};
+
+// The scene is parsed as it is read: an error in its first line is found
+// having read little more than a chunk of the gigabyte after it, which is
+// never held in memory.
+TEST(NffStream, AnErrorIsFoundWithoutReadingTheRestOfTheInput) {
+  BlankTail source("s 0 0 0 zero\n", std::uint64_t{1} << 30);
+  std::istream in(&source);
+  try {
+    parse_nff(in, "big.nff");
+    ADD_FAILURE() << "parsed";
+  } catch (const SceneError& e) {
+    EXPECT_EQ(std::string(e.what()), "big.nff:1: expected a finite number (sphere radius), got 'zero'");
+  }
+  EXPECT_LT(source.handed_out(), std::uint64_t{1} << 20);
+}
+
+// Blanks and comments far longer than a chunk, in plain text and across
+// gzip members, cost nothing and keep the line count.
+TEST(NffStream, LongBlanksAndCommentsAcrossChunksAndMembers) {
+  const std::string first = std::string(200000, ' ') + "# " + std::string(150000, 'c') + "\ns 0 0 0 1\n";
+  const std::string second = std::string(100000, '\n') + "s 1 1 1 2\n";
+  EXPECT_EQ(parse_nff(first + second, "t.nff").objects.size(), 2u);
+  EXPECT_EQ(parse_nff(gzip(first) + gzip(second) + std::string(70000, '\0'), "t.nff").objects.size(), 2u);
+  try {
+    parse_nff(gzip(first) + gzip(second + "s 2 2 2 zero\n"), "t.nff");
+    ADD_FAILURE() << "parsed";
+  } catch (const SceneError& e) {
+    EXPECT_EQ(std::string(e.what()), "t.nff:100004: expected a finite number (sphere radius), got 'zero'");
+  }
+}
+
+TEST(NffError, ATokenLongerThan1024BytesNamesItsLine) {
+  try {
+    parse_nff("s 0 0 0 1\ns " + std::string(5000, '1') + " 0 0 1\n", "t.nff");
+    ADD_FAILURE() << "parsed";
+  } catch (const SceneError& e) {
+    EXPECT_EQ(std::string(e.what()).rfind("t.nff:2: expected a token of at most 1024 bytes, got '1111", 0), 0u)
+        << e.what();
+  }
+}
 
 }  // namespace
 }  // namespace tracer
