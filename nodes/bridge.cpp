@@ -13,6 +13,12 @@ enum class Record : std::uint8_t { packet = 1, credit, end, abort };
 
 constexpr std::chrono::microseconds shortest_poll{16};
 constexpr std::size_t poll_levels = 7;  // 16 us .. 1024 us
+// A frame is posted once it holds this much: a message under the eager
+// limit of MPI's shared-memory transport (4 KB in Open MPI) is delivered
+// whole by the send; a larger one waits, after the receiver matches it,
+// for the sender's next MPI call, which on a busy rank comes only after a
+// run of pixels.
+constexpr std::size_t frame_bytes = 3 * 1024;
 constexpr std::chrono::microseconds hot_window{1000};  // since the last activity
 
 void put_link(WireWriter& w, const CutLink& link) {
@@ -173,6 +179,7 @@ bool Bridge::take_outgoing(Outgoing& out) {
     w.put(Record::packet);
     put_link(w, out.link);
     put_packet(w, *packet);
+    if (w.size() >= frame_bytes) post_frame(out.peer);
     ++counters_.packets_sent;
     ++unacknowledged_;
     counters_.bytes_sent += packet->payload.size();
@@ -293,15 +300,17 @@ void Bridge::queue_credits() {
   owing_.clear();
 }
 
+void Bridge::post_frame(int peer) {
+  WireWriter& w = frame(peer);
+  ++counters_.messages_sent;
+  counters_.wire_bytes_sent += w.size();
+  transport_.post(peer, Tag::bridge, w.take());
+  w = WireWriter{};
+}
+
 void Bridge::send_frames() {
-  for (int peer = 0; peer < transport_.size(); ++peer) {
-    WireWriter& w = frame(peer);
-    if (w.size() == 0) continue;
-    ++counters_.messages_sent;
-    counters_.wire_bytes_sent += w.size();
-    transport_.post(peer, Tag::bridge, w.take());
-    w = WireWriter{};
-  }
+  for (int peer = 0; peer < transport_.size(); ++peer)
+    if (frame(peer).size() > 0) post_frame(peer);
 }
 
 void Bridge::stop() {

@@ -111,6 +111,7 @@ class Bridge {
   bool deliver_staged();
   bool take_outgoing(Outgoing& out);
   void queue_credits();
+  void post_frame(int peer);
   void send_frames();
   void stop();
   void drain();
