@@ -915,6 +915,65 @@ TEST(Runtime, ThreadUseCountsTimeWithNothingToRun) {
   EXPECT_LE(use[0].idle_seconds, use[0].seconds - 0.025);
 }
 
+// The three parts of a thread's time are cut at the same clock readings,
+// so they add up to its wall time; thread 0 computes for 30 ms, which shows
+// as running time, while thread 1 waits for it, first spinning, then asleep.
+TEST(Runtime, ThreadUseSplitAddsUpToWallTime) {
+  using Clock = std::chrono::steady_clock;
+  csp::Channel<int> started("started");
+  csp::Channel<int> done("done");
+  csp::Runtime rt(2);
+  rt.spawn("busy", 0, [in = started.reader(), out = done.writer()]() mutable {
+    in.read();
+    const auto until = Clock::now() + 30ms;
+    while (Clock::now() < until) {
+    }
+    out.write(1);
+  });
+  rt.spawn("waiting", 1, [out = started.writer(), in = done.reader()]() mutable {
+    out.write(1);
+    in.read();
+  });
+  rt.run();
+  const auto use = rt.thread_use();
+  ASSERT_EQ(use.size(), 2u);
+  for (const auto& t : use) {
+    EXPECT_NEAR(t.running_seconds + t.spinning_seconds + t.sleeping_seconds, t.seconds, 1e-6);
+    EXPECT_NEAR(t.idle_seconds, t.spinning_seconds + t.sleeping_seconds, 1e-6);
+    EXPECT_GE(t.running_seconds, 0);
+    EXPECT_GE(t.spinning_seconds, 0);
+    EXPECT_GE(t.sleeping_seconds, 0);
+    EXPECT_GT(t.cpu_seconds, 0);
+    EXPECT_LE(t.cpu_seconds, t.seconds + 1e-3);
+    EXPECT_LE(t.sleeps, t.waits);
+  }
+  EXPECT_GE(use[0].running_seconds, 0.03);
+  EXPECT_GE(use[1].waits, 1u);
+  // Thread 1 waits 30 ms at least, far past any spin, so it sleeps.
+  EXPECT_GE(use[1].sleeps, 1u);
+  EXPECT_GE(use[1].spinning_seconds + use[1].sleeping_seconds, 0.025);
+}
+
+// A thread whose processes never wait runs the whole time: no idle wait,
+// all of its time is running time.
+TEST(Runtime, ThreadUseOfAThreadThatNeverWaitsIsAllRunning) {
+  using Clock = std::chrono::steady_clock;
+  csp::Runtime rt(1);
+  rt.spawn("busy", 0, [] {
+    const auto until = Clock::now() + 10ms;
+    while (Clock::now() < until) {
+    }
+  });
+  rt.run();
+  const auto use = rt.thread_use();
+  ASSERT_EQ(use.size(), 1u);
+  EXPECT_EQ(use[0].waits, 0u);
+  EXPECT_EQ(use[0].spinning_seconds, 0);
+  EXPECT_EQ(use[0].sleeping_seconds, 0);
+  EXPECT_NEAR(use[0].running_seconds, use[0].seconds, 1e-6);
+  EXPECT_GE(use[0].running_seconds, 0.01);
+}
+
 // A process woken from another thread runs within a few switches of its
 // thread, even while that thread is never idle: the wake is dispatched at
 // the next switch, not after a round of the ready queue. A busy process on
