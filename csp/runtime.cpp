@@ -566,6 +566,11 @@ void par(std::vector<std::function<void()>> processes) {
 
 void sleep_for(std::chrono::steady_clock::duration d) { boost::this_fiber::sleep_for(d); }
 
+bool yield_requested() {
+  const Scheduler* s = detail::thread_algorithm();
+  return s && s->yield_requested();
+}
+
 void yield() {
   if (detail::thread_scheduler())
     if (auto* props = boost::fibers::context::active()->get_properties())

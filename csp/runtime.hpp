@@ -99,6 +99,14 @@ void sleep_for(std::chrono::steady_clock::duration d);
 // and the ones that yielded before it). Never counted as blocked.
 void yield();
 
+// True if the calling thread has work that should not wait for the caller
+// to finish a long computation: under FifoScheduler, a ready high-priority
+// process, or a process woken from another thread and not yet dispatched
+// (a packet arrived for it). A few loads and no clock, so a computation
+// may ask between small steps and yield() only when told; false outside a
+// Runtime and under schedulers without the rule (virtual time).
+bool yield_requested();
+
 // Name of the calling process ("" outside a Runtime).
 const std::string& current_process_name();
 

@@ -146,4 +146,8 @@ void FifoScheduler::notify() noexcept {
   wakeup_.notify_one();
 }
 
+bool FifoScheduler::yield_requested() const noexcept {
+  return notified_.load(std::memory_order_relaxed) || !ready_.empty();
+}
+
 }  // namespace csp

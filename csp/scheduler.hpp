@@ -11,7 +11,11 @@
 // csp::yield(): a process that waited on a message has little left to do
 // before it waits again, and the ones that yielded are the long computations
 // it would otherwise queue behind (so a process that yielded waits as long
-// as woken ones keep coming). When none is ready the thread first spins
+// as woken ones keep coming). A long computation that asks
+// yield_requested() between small steps is told to yield when a
+// high-priority process is ready or a wake from another thread is pending:
+// it then gives the thread up for one round and goes on, so it is delayed
+// by what is ready, never starved. When none is ready the thread first spins
 // for a few microseconds watching for notify() (a wake from another thread:
 // waking a sleeping thread costs a system call on both sides, several times
 // a message's own cost), then sleeps on a condition variable until notify()
@@ -94,6 +98,10 @@ class Scheduler : public boost::fibers::algo::algorithm_with_properties<ProcessP
   // the fiber's properties (and, in a derived scheduler, room in its ready
   // set), so that Boost's noexcept awakened() need allocate nothing.
   virtual void make_room_for_fiber();
+  // True if the running process should offer the thread now (see
+  // csp::yield_requested()); called on the scheduler's thread. The default
+  // keeps no such rule and says no.
+  virtual bool yield_requested() const noexcept { return false; }
 };
 
 // How one thread's time divides (see "Accounting" above); written by that
@@ -139,6 +147,9 @@ class FifoScheduler final : public Scheduler {
   bool has_ready_fibers() const noexcept override;
   void suspend_until(std::chrono::steady_clock::time_point const& when) noexcept override;
   void notify() noexcept override;
+  // A ready high-priority process, or a wake from another thread not yet
+  // dispatched: a packet arrived here that the caller would delay.
+  bool yield_requested() const noexcept override;
 
  private:
   static constexpr unsigned dispatch_period = 32;
