@@ -1063,13 +1063,17 @@ TEST(Runtime, YieldRequestedByAReadyHighPriorityProcess) {
 
 // A stream of wakes from another thread does not starve a low-priority
 // process that yields whenever asked: each woken process runs until it
-// waits again, then the computation goes on, and the run ends in order
-// when it is done (the sender then poisons the channel, ending the reader).
+// waits again, then the computation goes on. It goes on until it has taken
+// its steps and the reader, on its thread, has had 100 values (the wakes
+// it yielded to), and the run ends in order when it is done (the sender
+// then poisons the channel, ending the reader).
 TEST(Runtime, YieldOnRequestDoesNotStarveTheLowPriorityProcess) {
-  constexpr long steps = 20000;
+  using Clock = std::chrono::steady_clock;
+  constexpr long steps = 20000, wanted_reads = 100;
   csp::Channel<int> c("c");
   std::atomic<bool> done{false};
-  long reads = 0, taken = 0;
+  bool bounded = false;
+  long reads = 0, taken = 0;  // both written on thread 1 only
   csp::Runtime rt(2);
   rt.spawn("sender", 0, [out = c.writer(), &done]() mutable {
     while (!done.load(std::memory_order_relaxed)) out.write(1);
@@ -1084,14 +1088,21 @@ TEST(Runtime, YieldOnRequestDoesNotStarveTheLowPriorityProcess) {
   rt.spawn(
       "computer", 1,
       [&] {
-        for (; taken < steps; ++taken)
+        const auto bound = Clock::now() + 20s;
+        for (; taken < steps || reads < wanted_reads; ++taken) {
+          if (Clock::now() > bound) {
+            bounded = true;
+            break;
+          }
           if (csp::yield_requested()) csp::yield();
+        }
         done = true;
       },
       csp::Priority::low);
   rt.run();
-  EXPECT_EQ(taken, steps);
-  EXPECT_GE(reads, 1);
+  EXPECT_FALSE(bounded) << "reads " << reads << ", steps " << taken;
+  EXPECT_GE(taken, steps);
+  EXPECT_GE(reads, wanted_reads);
 }
 
 // A process woken from another thread runs within a few switches of its
