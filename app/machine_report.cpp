@@ -146,6 +146,24 @@ void json_ranks(std::ostream& out, const nodes::MachineReport& r, const std::str
   out << (r.ranks.empty() ? "" : "\n" + indent) << "]";
 }
 
+// One line per runtime thread: where its time went, as shares of its wall
+// time, and the CPU time the OS gave it (less than running + spinning when
+// other threads had its core).
+void print_thread_use(std::ostream& out, const std::vector<csp::ThreadUse>& threads) {
+  for (std::size_t t = 0; t < threads.size(); ++t) {
+    const csp::ThreadUse& u = threads[t];
+    const double share = u.seconds > 0 ? 100 / u.seconds : 0;
+    std::ostringstream label;
+    label << "thread " << t;
+    out << std::left << std::setw(15) << label.str() << std::right << std::setprecision(3) << u.seconds
+        << " s: " << std::setprecision(1) << "running " << share * u.running_seconds << "%, spinning "
+        << share * u.spinning_seconds << "%, sleeping " << share * u.sleeping_seconds << "%; cpu "
+        << share * u.cpu_seconds << "%; " << u.sleeps << " sleeps in " << u.waits << " idle waits; woke "
+        << u.remote_wakes << " processes of other threads, " << u.sleepers_woken << " of them asleep\n";
+  }
+  out << std::setprecision(3);
+}
+
 }  // namespace
 
 double MachineSummary::parallel_seconds() const {
@@ -190,6 +208,7 @@ void print_machine_report(std::ostream& out, const MachineSummary& m) {
     out << std::setprecision(1) << ", idle " << 100 * r.idle_share() << "% of thread time" << std::setprecision(3);
   else out << "; predicted " << r.predicted_seconds << " s (" << r.cost_model << ")";
   out << "\n";
+  if (r.cost_model.empty()) print_thread_use(out, r.host_threads);
   if (m.serial)
     out << "speedup        " << m.speedup() << " (1 node: " << m.serial->seconds << " s on "
         << count_of(m.serial->threads, "thread") << "; " << count_of(r.nodes, "node") << ": "
@@ -257,7 +276,13 @@ void write_machine_json(std::ostream& out, const MachineSummary& m, const std::s
     out << ", \"host_threads\": [";
     for (std::size_t t = 0; t < r.host_threads.size(); ++t)
       out << (t ? ", " : "") << "{\"seconds\": " << r.host_threads[t].seconds
-          << ", \"idle_seconds\": " << r.host_threads[t].idle_seconds << "}";
+          << ", \"idle_seconds\": " << r.host_threads[t].idle_seconds
+          << ", \"running_seconds\": " << r.host_threads[t].running_seconds
+          << ", \"spinning_seconds\": " << r.host_threads[t].spinning_seconds
+          << ", \"sleeping_seconds\": " << r.host_threads[t].sleeping_seconds
+          << ", \"cpu_seconds\": " << r.host_threads[t].cpu_seconds << ", \"waits\": " << r.host_threads[t].waits
+          << ", \"sleeps\": " << r.host_threads[t].sleeps << ", \"remote_wakes\": " << r.host_threads[t].remote_wakes
+          << ", \"sleepers_woken\": " << r.host_threads[t].sleepers_woken << "}";
     out << "]";
   }
   if (!r.cost_model.empty())

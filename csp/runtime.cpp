@@ -5,6 +5,7 @@
 #include <boost/fiber/operations.hpp>
 #include <algorithm>
 #include <barrier>
+#include <ctime>
 #include <condition_variable>
 #include <exception>
 #include <mutex>
@@ -94,6 +95,15 @@ Ending run_body(const std::function<void()>& body, std::exception_ptr& error) {
     error = std::current_exception();
     return Ending::failed;
   }
+}
+
+double seconds_of(std::chrono::steady_clock::duration d) { return std::chrono::duration<double>(d).count(); }
+
+// The calling thread's CPU time so far (0 where the OS cannot tell).
+double thread_cpu_seconds() {
+  timespec ts{};
+  if (clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts) != 0) return 0;
+  return static_cast<double>(ts.tv_sec) + 1e-9 * static_cast<double>(ts.tv_nsec);
 }
 
 // Binds the calling fiber to its process record (or unbinds it with null).
@@ -203,8 +213,10 @@ struct Worker {
 
 using detail::Failure;
 using detail::Process;
+using detail::seconds_of;
 using detail::Spawn;
 using detail::SpinlockLock;
+using detail::thread_cpu_seconds;
 using detail::Worker;
 
 struct Runtime::Impl {
@@ -216,7 +228,7 @@ struct Runtime::Impl {
       : options(with_thread_count(std::move(o))), tracker(options.threads, [this] { stop_all(); }) {
     for (unsigned i = 0; i < options.threads; ++i) workers.push_back(std::make_unique<Worker>());
     use.resize(options.threads);
-    idle.resize(options.threads);
+    times.resize(options.threads);
   }
 
   static RuntimeOptions with_thread_count(RuntimeOptions o) {
@@ -254,8 +266,9 @@ struct Runtime::Impl {
   RuntimeOptions options;
   std::vector<std::unique_ptr<Worker>> workers;
   std::vector<ThreadUse> use;  // element i written by thread i only, read after the join
-  // Element i gathered by thread i's FifoScheduler, which may outlive worker_main.
-  std::vector<std::chrono::steady_clock::duration> idle;
+  // Element i gathered by thread i's FifoScheduler, which may outlive
+  // worker_main; serve() starts it and copies it into use[i].
+  std::vector<ThreadTimes> times;
   detail::Tracker tracker;
   std::mutex failures_mutex;
   std::vector<Failure> failures;     // guarded by failures_mutex
@@ -275,7 +288,7 @@ void Runtime::Impl::set_up_thread(unsigned index) {
   std::unique_ptr<Scheduler> owned(
       options.scheduler
           ? options.scheduler(index)
-          : new FifoScheduler(&idle[index], idle_spin(options.threads, std::thread::hardware_concurrency())));
+          : new FifoScheduler(&times[index], idle_spin(options.threads, std::thread::hardware_concurrency())));
   Scheduler* algo = owned.get();
   boost::fibers::context* main = boost::fibers::context::active();
   algo->make_room_for_fiber();  // for the dispatcher, which set_algo makes ready
@@ -301,6 +314,10 @@ void Runtime::Impl::worker_main(unsigned index, detail::StartGate& gate, std::ba
 // waits for them to end.
 void Runtime::Impl::serve(unsigned index) {
   const auto started = std::chrono::steady_clock::now();
+  const double cpu_started = thread_cpu_seconds();
+  times[index].start(started);
+  detail::remote_wakes_here = 0;
+  detail::sleepers_woken_here = 0;
   std::vector<boost::fibers::fiber> fibers;
   Worker& w = *workers[index];
   for (bool stop = false; !stop;) {
@@ -318,8 +335,21 @@ void Runtime::Impl::serve(unsigned index) {
     launch_all(batch, fibers);
   }
   for (boost::fibers::fiber& f : fibers) f.join();
-  use[index].seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
-  use[index].idle_seconds = std::chrono::duration<double>(idle[index]).count();
+  const auto ended = std::chrono::steady_clock::now();
+  ThreadUse& u = use[index];
+  u.cpu_seconds = thread_cpu_seconds() - cpu_started;
+  u.seconds = seconds_of(ended - started);
+  u.remote_wakes = detail::remote_wakes_here;
+  u.sleepers_woken = detail::sleepers_woken_here;
+  if (options.scheduler) return;  // another scheduler keeps no accounts
+  ThreadTimes& t = times[index];
+  t.close(ended);
+  u.running_seconds = seconds_of(t.running);
+  u.spinning_seconds = seconds_of(t.spinning);
+  u.sleeping_seconds = seconds_of(t.sleeping);
+  u.idle_seconds = seconds_of(t.spinning + t.sleeping);
+  u.waits = t.waits;
+  u.sleeps = t.sleeps;
 }
 
 // A process that cannot start (no memory for its stack) is recorded and no
@@ -541,6 +571,11 @@ void par(std::vector<std::function<void()>> processes) {
 }
 
 void sleep_for(std::chrono::steady_clock::duration d) { boost::this_fiber::sleep_for(d); }
+
+bool yield_requested() {
+  const Scheduler* s = detail::thread_algorithm();
+  return s && s->yield_requested();
+}
 
 void yield() {
   if (detail::thread_scheduler())

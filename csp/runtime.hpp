@@ -19,6 +19,7 @@
 
 #include <chrono>
 #include <cstddef>
+#include <cstdint>
 #include <functional>
 #include <memory>
 #include <string>
@@ -28,10 +29,25 @@
 
 namespace csp {
 
-// How one runtime thread spent a run.
+// How one runtime thread spent a run. Under the default scheduler, seconds
+// = running + spinning + sleeping (to the clock's resolution): running is
+// the time it ran processes (and switched between them), spinning the time
+// it watched for a wake with nothing to run, sleeping the time it slept in
+// the OS. cpu_seconds is what the OS charged the thread: running plus
+// spinning less the time the OS gave its core to another thread (more
+// threads than cores, or a busy machine). Under other schedulers only
+// seconds and cpu_seconds are kept.
 struct ThreadUse {
   double seconds = 0;       // from its start until its last process ended
-  double idle_seconds = 0;  // waiting with no process ready (default scheduler only; 0 under others)
+  double idle_seconds = 0;  // spinning + sleeping: waiting with no process ready
+  double running_seconds = 0;
+  double spinning_seconds = 0;
+  double sleeping_seconds = 0;
+  double cpu_seconds = 0;   // the thread's CPU time over the same span
+  std::uint64_t waits = 0;  // times it ran out of processes to run
+  std::uint64_t sleeps = 0; // of which it spun in vain and slept in the OS
+  std::uint64_t remote_wakes = 0;    // processes of other threads it woke
+  std::uint64_t sleepers_woken = 0;  // of which found their thread asleep: a system call
 };
 
 struct RuntimeOptions {
@@ -87,6 +103,14 @@ void sleep_for(std::chrono::steady_clock::duration d);
 // lets every ready high-priority process run, every woken low-priority one,
 // and the ones that yielded before it). Never counted as blocked.
 void yield();
+
+// True if the calling thread has work that should not wait for the caller
+// to finish a long computation: under FifoScheduler, a ready high-priority
+// process, or a process woken from another thread and not yet dispatched
+// (a packet arrived for it). A few loads and no clock, so a computation
+// may ask between small steps and yield() only when told; false outside a
+// Runtime and under schedulers without the rule (virtual time).
+bool yield_requested();
 
 // Name of the calling process ("" outside a Runtime).
 const std::string& current_process_name();

@@ -15,6 +15,8 @@ namespace {
 thread_local void* properties_reserve = nullptr;
 }  // namespace
 
+constinit thread_local std::uint64_t detail::sleepers_woken_here = 0;
+
 static_assert(sizeof(ProcessProps) <= ProcessProps::reserve_bytes);
 
 void* ProcessProps::operator new(std::size_t size) {
@@ -77,12 +79,13 @@ bool FifoScheduler::take_notification() noexcept {
   return notified_.load(std::memory_order_relaxed) && notified_.exchange(false, std::memory_order_acq_rel);
 }
 
-// Spins until notified (true), the spin limit or `when`, whichever first;
-// with no spin limit, looks once.
+// Spins, from `start`, until notified (true), the spin limit or `when`,
+// whichever first; with no spin limit, looks once.
 // Reads before it claims, so the spinning thread does not keep taking the
 // flag's cache line from the notifier.
-bool FifoScheduler::spin_until_notified(std::chrono::steady_clock::time_point when) noexcept {
-  const auto end = std::min(when, std::chrono::steady_clock::now() + spin_limit_);
+bool FifoScheduler::spin_until_notified(std::chrono::steady_clock::time_point start,
+                                        std::chrono::steady_clock::time_point when) noexcept {
+  const auto end = std::min(when, start + spin_limit_);
   do {
     for (int i = 0; i < 64; ++i) {
       if (take_notification()) return true;
@@ -92,31 +95,62 @@ bool FifoScheduler::spin_until_notified(std::chrono::steady_clock::time_point wh
   return false;
 }
 
-void FifoScheduler::suspend_until(std::chrono::steady_clock::time_point const& when) noexcept {
-  if (!idle_) return wait_for_notify(when);
-  const auto start = std::chrono::steady_clock::now();
-  wait_for_notify(when);
-  *idle_ += std::chrono::steady_clock::now() - start;
-}
-
-void FifoScheduler::wait_for_notify(std::chrono::steady_clock::time_point when) noexcept {
-  if (spin_until_notified(when)) return;
+// Sleeps until notified or `when`; true if notified. sleeping_ tells
+// notify() that its wake finds the thread asleep (for the accounts).
+bool FifoScheduler::sleep_until_notified(std::chrono::steady_clock::time_point when) noexcept {
   std::unique_lock<std::mutex> lk(mutex_);
-  const auto woken = [this] { return notified_.load(std::memory_order_acquire); };
+  sleeping_.store(true, std::memory_order_seq_cst);
+  const auto woken = [this] { return notified_.load(std::memory_order_seq_cst); };
+  bool notified = true;
   if (when == std::chrono::steady_clock::time_point::max()) {
     wakeup_.wait(lk, woken);
   } else {
-    wakeup_.wait_until(lk, when, woken);
+    notified = wakeup_.wait_until(lk, when, woken);
   }
+  sleeping_.store(false, std::memory_order_relaxed);
   notified_.store(false, std::memory_order_relaxed);
+  return notified;
+}
+
+// The clock readings here are the ones the wait needs (the spin deadline,
+// the end of the spin); the accounts add one at the end of a sleep.
+void FifoScheduler::suspend_until(std::chrono::steady_clock::time_point const& when) noexcept {
+  const auto start = std::chrono::steady_clock::now();
+  if (times_) {
+    times_->close(start);
+    ++times_->waits;
+  }
+  if (spin_until_notified(start, when)) {
+    if (!times_ && !idle_) return;
+    const auto end = std::chrono::steady_clock::now();
+    if (idle_) *idle_ += end - start;
+    if (times_) times_->spinning += end - start, times_->awake_since = end;
+    return;
+  }
+  const auto slept = std::chrono::steady_clock::now();
+  sleep_until_notified(when);
+  if (!times_ && !idle_) return;
+  const auto end = std::chrono::steady_clock::now();
+  if (idle_) *idle_ += end - start;
+  if (times_) {
+    times_->spinning += slept - start;
+    times_->sleeping += end - slept;
+    ++times_->sleeps;
+    times_->awake_since = end;
+  }
 }
 
 void FifoScheduler::notify() noexcept {
+  if (sleeping_.load(std::memory_order_relaxed)) ++detail::sleepers_woken_here;
   {
     std::lock_guard<std::mutex> lk(mutex_);
     notified_.store(true, std::memory_order_release);
   }
   wakeup_.notify_one();
+}
+
+bool FifoScheduler::yield_requested() const noexcept {
+  return notified_.load(std::memory_order_relaxed) || !ready_.empty();
 }
 
 }  // namespace csp

@@ -11,7 +11,11 @@
 // csp::yield(): a process that waited on a message has little left to do
 // before it waits again, and the ones that yielded are the long computations
 // it would otherwise queue behind (so a process that yielded waits as long
-// as woken ones keep coming). When none is ready the thread first spins
+// as woken ones keep coming). A long computation that asks
+// yield_requested() between small steps is told to yield when a
+// high-priority process is ready or a wake from another thread is pending:
+// it then gives the thread up for one round and goes on, so it is delayed
+// by what is ready, never starved. When none is ready the thread first spins
 // for a few microseconds watching for notify() (a wake from another thread:
 // waking a sleeping thread costs a system call on both sides, several times
 // a message's own cost), then sleeps on a condition variable until notify()
@@ -25,12 +29,21 @@
 // woken from another thread waits for one switch, not for a round of the
 // queue, a timer that fell due during a long computation fires when the
 // computation offers the thread, and most switches read no clock.
+//
+// Accounting (ThreadTimes): a thread's time from the start of its accounts
+// is cut at every idle wait into running (processes, and the switches
+// between them), spinning and sleeping, so that the three add up to the
+// time since the start: an awake interval is closed at the clock reading
+// that opens the next wait, and each wait's phases at the readings that
+// end them. These readings are the ones the idle wait makes anyway (its
+// spin deadline, its end), so a busy thread pays no clock for its accounts.
 #pragma once
 
 #include <atomic>
 #include <chrono>
 #include <condition_variable>
 #include <cstddef>
+#include <cstdint>
 #include <functional>
 #include <memory>
 #include <mutex>
@@ -87,6 +100,29 @@ class Scheduler : public boost::fibers::algo::algorithm_with_properties<ProcessP
   // the fiber's properties (and, in a derived scheduler, room in its ready
   // set), so that Boost's noexcept awakened() need allocate nothing.
   virtual void make_room_for_fiber();
+  // True if the running process should offer the thread now (see
+  // csp::yield_requested()); called on the scheduler's thread. The default
+  // keeps no such rule and says no.
+  virtual bool yield_requested() const noexcept { return false; }
+};
+
+// How one thread's time divides (see "Accounting" above); written by that
+// thread only. The clock reads awake_since as the start of the interval
+// now open, which is running time until the next wait.
+struct ThreadTimes {
+  std::chrono::steady_clock::duration running{};   // processes and switches
+  std::chrono::steady_clock::duration spinning{};  // idle, watching for a wake
+  std::chrono::steady_clock::duration sleeping{};  // idle, asleep in the OS
+  std::uint64_t waits = 0;    // idle waits begun
+  std::uint64_t sleeps = 0;   // of which went on to sleep in the OS
+  std::chrono::steady_clock::time_point awake_since{};
+  // Starts the accounts at `now` (all zero).
+  void start(std::chrono::steady_clock::time_point now) { *this = ThreadTimes{}, awake_since = now; }
+  // Closes the open running interval at `now`.
+  void close(std::chrono::steady_clock::time_point now) {
+    running += now - awake_since;
+    awake_since = now;
+  }
 };
 
 // Called once on each runtime thread, with that thread's index.
@@ -104,19 +140,26 @@ class FifoScheduler final : public Scheduler {
   explicit FifoScheduler(std::chrono::steady_clock::duration* idle = nullptr,
                          std::chrono::microseconds spin = idle_spin(1, 1))
       : spin_limit_(spin), idle_(idle) {}
+  // `times`, if given, gathers the thread's running, spinning and sleeping
+  // time (see ThreadTimes); the caller starts it.
+  FifoScheduler(ThreadTimes* times, std::chrono::microseconds spin) : spin_limit_(spin), times_(times) {}
 
   void awakened(boost::fibers::context* ctx, ProcessProps& props) noexcept override;
   boost::fibers::context* pick_next() noexcept override;
   bool has_ready_fibers() const noexcept override;
   void suspend_until(std::chrono::steady_clock::time_point const& when) noexcept override;
   void notify() noexcept override;
+  // A ready high-priority process, or a wake from another thread not yet
+  // dispatched: a packet arrived here that the caller would delay.
+  bool yield_requested() const noexcept override;
 
  private:
   static constexpr unsigned dispatch_period = 32;
 
   bool take_notification() noexcept;
-  bool spin_until_notified(std::chrono::steady_clock::time_point when) noexcept;
-  void wait_for_notify(std::chrono::steady_clock::time_point when) noexcept;
+  bool spin_until_notified(std::chrono::steady_clock::time_point start,
+                           std::chrono::steady_clock::time_point when) noexcept;
+  bool sleep_until_notified(std::chrono::steady_clock::time_point when) noexcept;
 
   boost::fibers::scheduler::ready_queue_type ready_;          // high priority, and fibers of no process
   boost::fibers::scheduler::ready_queue_type ready_low_woken_;  // low priority, woken
@@ -127,8 +170,10 @@ class FifoScheduler final : public Scheduler {
   std::mutex mutex_;  // orders notify() against the check before sleeping
   std::condition_variable wakeup_;
   std::atomic<bool> notified_{false};  // a wake from another thread not yet dispatched
+  std::atomic<bool> sleeping_{false};  // set under mutex_ while the thread sleeps, or is about to
   const std::chrono::microseconds spin_limit_;
-  std::chrono::steady_clock::duration* idle_;
+  std::chrono::steady_clock::duration* idle_ = nullptr;
+  ThreadTimes* times_ = nullptr;
 };
 
 }  // namespace csp

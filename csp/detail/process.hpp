@@ -106,6 +106,12 @@ class Tracker {
   std::function<void()> on_all_ended_;
 };
 
+// Counted on the thread that wakes: processes of other threads it woke
+// (wait.cpp), and of those wakes the ones that found the other thread
+// asleep (scheduler.cpp). Read and reset by the runtime thread itself.
+extern constinit thread_local std::uint64_t remote_wakes_here;
+extern constinit thread_local std::uint64_t sleepers_woken_here;
+
 // The process the calling fiber runs, or null outside a Runtime.
 Process* current_process();
 // The process fiber ctx runs (ctx: the calling fiber's context).

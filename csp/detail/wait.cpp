@@ -167,7 +167,10 @@ void complete(Waiter& w, WaitState outcome, std::size_t fired) {
   }
 }
 
+constinit thread_local std::uint64_t remote_wakes_here = 0;
+
 void issue_deferred_wakes() {
+  remote_wakes_here += deferred_wake_count;
   for (std::size_t i = 0; i < deferred_wake_count; ++i)
     deferred_wakes[i]->get_scheduler()->schedule_from_remote(deferred_wakes[i]);
   deferred_wake_count = 0;

@@ -218,8 +218,15 @@ TEST_F(MachineCli, DefaultMachineWritesImageAndJsonWithMachineFields) {
     EXPECT_LE(t["seconds"].number, m["wall_seconds"].number);
     EXPECT_GE(t["idle_seconds"].number, 0);
     EXPECT_LE(t["idle_seconds"].number, t["seconds"].number);
+    const double parts =
+        t["running_seconds"].number + t["spinning_seconds"].number + t["sleeping_seconds"].number;
+    EXPECT_NEAR(parts, t["seconds"].number, 1e-6 + 1e-6 * t["seconds"].number);
+    EXPECT_GT(t["running_seconds"].number, 0);  // every thread holds nodes that trace
+    EXPECT_GT(t["cpu_seconds"].number, 0);
   }
   EXPECT_NE(r.out.find("% of thread time"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("thread 1"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("running "), std::string::npos) << r.out;
 }
 
 TEST_F(MachineCli, AffinityScheduleIsReportedWithItsSteals) {

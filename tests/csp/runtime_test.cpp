@@ -915,6 +915,196 @@ TEST(Runtime, ThreadUseCountsTimeWithNothingToRun) {
   EXPECT_LE(use[0].idle_seconds, use[0].seconds - 0.025);
 }
 
+// The three parts of a thread's time are cut at the same clock readings,
+// so they add up to its wall time; thread 0 computes for 30 ms, which shows
+// as running time, while thread 1 waits for it, first spinning, then asleep.
+TEST(Runtime, ThreadUseSplitAddsUpToWallTime) {
+  using Clock = std::chrono::steady_clock;
+  csp::Channel<int> started("started");
+  csp::Channel<int> done("done");
+  csp::Runtime rt(2);
+  rt.spawn("busy", 0, [in = started.reader(), out = done.writer()]() mutable {
+    in.read();
+    const auto until = Clock::now() + 30ms;
+    while (Clock::now() < until) {
+    }
+    out.write(1);
+  });
+  rt.spawn("waiting", 1, [out = started.writer(), in = done.reader()]() mutable {
+    out.write(1);
+    in.read();
+  });
+  rt.run();
+  const auto use = rt.thread_use();
+  ASSERT_EQ(use.size(), 2u);
+  for (const auto& t : use) {
+    EXPECT_NEAR(t.running_seconds + t.spinning_seconds + t.sleeping_seconds, t.seconds, 1e-6);
+    EXPECT_NEAR(t.idle_seconds, t.spinning_seconds + t.sleeping_seconds, 1e-6);
+    EXPECT_GE(t.running_seconds, 0);
+    EXPECT_GE(t.spinning_seconds, 0);
+    EXPECT_GE(t.sleeping_seconds, 0);
+    EXPECT_GT(t.cpu_seconds, 0);
+    EXPECT_LE(t.cpu_seconds, t.seconds + 1e-3);
+    EXPECT_LE(t.sleeps, t.waits);
+  }
+  EXPECT_GE(use[0].running_seconds, 0.03);
+  EXPECT_GE(use[1].waits, 1u);
+  // Thread 1 waits 30 ms at least, far past any spin, so it sleeps.
+  EXPECT_GE(use[1].sleeps, 1u);
+  EXPECT_GE(use[1].spinning_seconds + use[1].sleeping_seconds, 0.025);
+}
+
+// A thread whose processes never wait runs the whole time: no idle wait,
+// all of its time is running time.
+TEST(Runtime, ThreadUseOfAThreadThatNeverWaitsIsAllRunning) {
+  using Clock = std::chrono::steady_clock;
+  csp::Runtime rt(1);
+  rt.spawn("busy", 0, [] {
+    const auto until = Clock::now() + 10ms;
+    while (Clock::now() < until) {
+    }
+  });
+  rt.run();
+  const auto use = rt.thread_use();
+  ASSERT_EQ(use.size(), 1u);
+  EXPECT_EQ(use[0].waits, 0u);
+  EXPECT_EQ(use[0].spinning_seconds, 0);
+  EXPECT_EQ(use[0].sleeping_seconds, 0);
+  EXPECT_NEAR(use[0].running_seconds, use[0].seconds, 1e-6);
+  EXPECT_GE(use[0].running_seconds, 0.01);
+}
+
+// yield_requested(): a long low-priority computation that asks between
+// steps lets through a process woken from another thread at the next step.
+// "busy" stops only once "reader" has every value, which it can have only
+// if busy yields when told (with no rule, busy would run to its bound);
+// each write comes from thread 0 while thread 1 runs busy, so none of
+// those wakes finds thread 1 asleep.
+TEST(Runtime, YieldRequestedLetsAProcessWokenFromAnotherThreadThrough) {
+  using Clock = std::chrono::steady_clock;
+  constexpr int values = 200;
+  csp::Channel<int> c("c");
+  std::atomic<int> received{0};
+  std::atomic<bool> bounded{false};
+  long steps = 0, yields = 0;
+  csp::Runtime rt(2);
+  rt.spawn("writer", 0, [out = c.writer()]() mutable {
+    for (int i = 0; i < values; ++i) out.write(i);
+  });
+  rt.spawn("reader", 1, [in = c.reader(), &received]() mutable {
+    for (int i = 0; i < values; ++i) {
+      EXPECT_EQ(in.read(), i);
+      received.store(i + 1, std::memory_order_relaxed);
+    }
+  });
+  rt.spawn(
+      "busy", 1,
+      [&] {
+        const auto bound = Clock::now() + 20s;
+        while (received.load(std::memory_order_relaxed) < values) {
+          if (Clock::now() > bound) {
+            bounded = true;
+            return;
+          }
+          ++steps;
+          if (csp::yield_requested()) {
+            ++yields;
+            csp::yield();
+          }
+        }
+      },
+      csp::Priority::low);
+  rt.run();
+  EXPECT_FALSE(bounded) << "the reader got " << received.load() << " of " << values;
+  EXPECT_EQ(received.load(), values);
+  EXPECT_GE(yields, 1);
+  EXPECT_GE(steps, yields);
+  const auto use = rt.thread_use();
+  EXPECT_GE(use[0].remote_wakes, 1u);
+  // At most the wake that ends the run may find thread 1 asleep: one from
+  // thread 0 if its writer happens to be the last process to end.
+  EXPECT_LE(use[0].sleepers_woken, 1u);
+}
+
+// Nothing else ready, nothing arrived: no yield is requested; outside a
+// Runtime never.
+TEST(Runtime, YieldRequestedIsFalseWithNothingWaiting) {
+  EXPECT_FALSE(csp::yield_requested());
+  bool asked = true;
+  csp::Runtime rt(1);
+  rt.spawn("alone", 0, [&asked] { asked = csp::yield_requested(); }, csp::Priority::low);
+  rt.run();
+  EXPECT_FALSE(asked);
+}
+
+// A ready high-priority process is a request too, and yielding to it keeps
+// the priority order: it runs before the low-priority caller resumes.
+TEST(Runtime, YieldRequestedByAReadyHighPriorityProcess) {
+  std::vector<std::string> order;
+  csp::Channel<int> go("go", 1);
+  csp::Runtime rt(1);
+  rt.spawn(
+      "low", 0,
+      [&order, out = go.writer()]() mutable {
+        out.write(1);  // buffered: wakes "high", which is now ready
+        const bool asked = csp::yield_requested();
+        order.push_back(asked ? "low asked" : "low not asked");
+        if (asked) csp::yield();
+        order.push_back("low resumed");
+      },
+      csp::Priority::low);
+  rt.spawn("high", 0, [&order, in = go.reader()]() mutable {
+    in.read();
+    order.push_back("high");
+  });
+  rt.run();
+  EXPECT_EQ(order, (std::vector<std::string>{"low asked", "high", "low resumed"}));
+}
+
+// A stream of wakes from another thread does not starve a low-priority
+// process that yields whenever asked: each woken process runs until it
+// waits again, then the computation goes on. It goes on until it has taken
+// its steps and the reader, on its thread, has had 100 values (the wakes
+// it yielded to), and the run ends in order when it is done (the sender
+// then poisons the channel, ending the reader).
+TEST(Runtime, YieldOnRequestDoesNotStarveTheLowPriorityProcess) {
+  using Clock = std::chrono::steady_clock;
+  constexpr long steps = 20000, wanted_reads = 100;
+  csp::Channel<int> c("c");
+  std::atomic<bool> done{false};
+  bool bounded = false;
+  long reads = 0, taken = 0;  // both written on thread 1 only
+  csp::Runtime rt(2);
+  rt.spawn("sender", 0, [out = c.writer(), &done]() mutable {
+    while (!done.load(std::memory_order_relaxed)) out.write(1);
+    out.poison();
+  });
+  rt.spawn("reader", 1, [in = c.reader(), &reads]() mutable {
+    try {
+      for (;;) reads += in.read();
+    } catch (const csp::Poisoned&) {
+    }
+  });
+  rt.spawn(
+      "computer", 1,
+      [&] {
+        const auto bound = Clock::now() + 20s;
+        for (; taken < steps || reads < wanted_reads; ++taken) {
+          if (Clock::now() > bound) {
+            bounded = true;
+            break;
+          }
+          if (csp::yield_requested()) csp::yield();
+        }
+        done = true;
+      },
+      csp::Priority::low);
+  rt.run();
+  EXPECT_FALSE(bounded) << "reads " << reads << ", steps " << taken;
+  EXPECT_GE(taken, steps);
+  EXPECT_GE(reads, wanted_reads);
+}
+
 // A process woken from another thread runs within a few switches of its
 // thread, even while that thread is never idle: the wake is dispatched at
 // the next switch, not after a round of the ready queue. A busy process on
