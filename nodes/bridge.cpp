@@ -11,8 +11,8 @@ namespace {
 
 enum class Record : std::uint8_t { packet = 1, credit, end, abort };
 
-constexpr std::chrono::microseconds shortest_poll{16};
-constexpr std::size_t poll_levels = 7;  // 16 us .. 1024 us
+constexpr std::chrono::microseconds shortest_poll{4};
+constexpr std::size_t poll_levels = 9;  // 4 us .. 1024 us
 // A frame is posted once it holds this much: a message under the eager
 // limit of MPI's shared-memory transport (4 KB in Open MPI) is delivered
 // whole by the send; a larger one waits, after the receiver matches it,

@@ -21,7 +21,7 @@
 // the unsplit machine, acyclic by topology::next_hop's buffer classes.
 //
 // Polling: the transport moves and reports messages only when called. The
-// bridge polls it after every wake-up, and every 16 us while an answer is
+// bridge polls it after every wake-up, and every 4 us while an answer is
 // due (a packet it sent has not come back as a credit) or within 1 ms of
 // the last activity: an idle runtime thread watches for that short a
 // timeout without sleeping, so a page request that crosses ranks costs
@@ -138,7 +138,7 @@ class Bridge {
   std::size_t level_ = 0;                    // the timeout guard enabled
   std::uint64_t unacknowledged_ = 0;         // packets sent whose credits have not come back
   std::chrono::steady_clock::time_point last_active_{};
-  std::vector<std::size_t> timeout_guards_;  // 16 us, 32 us, ... 1 ms
+  std::vector<std::size_t> timeout_guards_;  // 4 us, 8 us, ... 1 ms
 };
 
 }  // namespace nodes
