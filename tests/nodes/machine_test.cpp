@@ -14,6 +14,7 @@
 #include <string>
 #include <tuple>
 
+#include "tests/nodes/test_database.hpp"
 #include "tracer/generators.hpp"
 
 namespace {
@@ -22,14 +23,7 @@ using nodes::MachineOptions;
 using nodes::PixelOrder;
 using nodes::Schedule;
 
-tracer::Database make_db(const std::string& spec, std::uint32_t page_size, int size) {
-  tracer::Scene scene = tracer::generate_scene(spec);
-  scene.camera.width = size;
-  scene.camera.height = size;
-  tracer::BuildOptions build;
-  build.page_size = page_size;
-  return tracer::build_database(scene, build);
-}
+using test::make_db;
 
 std::vector<tracer::Color> reference(const std::string& spec, int size, bool spd) {
   const auto db = make_db(spec, 65536, size);

@@ -18,6 +18,7 @@
 
 #include "nodes/machine.hpp"
 #include "topology/spec.hpp"
+#include "tests/nodes/test_database.hpp"
 #include "tracer/generators.hpp"
 
 namespace {
@@ -25,14 +26,7 @@ namespace {
 using nodes::MachineOptions;
 using nodes::Schedule;
 
-tracer::Database make_db(const std::string& spec, std::uint32_t page_size, int size) {
-  tracer::Scene scene = tracer::generate_scene(spec);
-  scene.camera.width = size;
-  scene.camera.height = size;
-  tracer::BuildOptions build;
-  build.page_size = page_size;
-  return tracer::build_database(scene, build);
-}
+using test::make_db;
 
 bool same_bits(const tracer::Image& a, const tracer::Image& b) {
   return a.pixels().size() == b.pixels().size() &&
