@@ -120,6 +120,7 @@ int rank_main(int argc, char** argv, const vmpi::MpiSession& mpi) {
     return 0;
   }
   options.machine.threads = app::threads_per_rank(options.machine.threads, mpi.ranks_on_this_host());
+  options.machine.shared_cores = app::cores_shared(options.machine.threads, mpi.ranks_on_this_host());
   try {
     vmpi::MpiTransport transport;
     if (host) return run(options, &transport);

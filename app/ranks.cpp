@@ -2,7 +2,9 @@
 #include "app/ranks.hpp"
 
 #include <algorithm>
+#include <cstdint>
 #include <optional>
+#include <thread>
 
 #include "app/cpu_count.hpp"
 #include "app/machine_run.hpp"
@@ -23,10 +25,33 @@ void check_rank_options(const Options& o, int ranks) {
                      (nodes == 1 ? " node" : " nodes") + ": every rank needs one; use more --nodes or fewer ranks");
 }
 
+namespace {
+
+// The CPUs this rank may use, and whether the launcher bound it to them
+// alone (a mask smaller than the host's) or left the host's to all ranks.
+struct RankCpus {
+  unsigned cpus;
+  bool bound;
+};
+
+RankCpus rank_cpus() {
+  const unsigned cpus = usable_cpus();
+  return {cpus, cpus < std::max(1u, std::thread::hardware_concurrency())};
+}
+
+}  // namespace
+
 unsigned threads_per_rank(unsigned threads, int ranks_on_this_host) {
   if (threads != 0) return threads;
-  const unsigned cores = usable_cpus();
-  return std::max(1u, cores / static_cast<unsigned>(std::max(ranks_on_this_host, 1)));
+  const RankCpus mine = rank_cpus();
+  if (mine.bound) return mine.cpus;
+  return std::max(1u, mine.cpus / static_cast<unsigned>(std::max(ranks_on_this_host, 1)));
+}
+
+bool cores_shared(unsigned threads, int ranks_on_this_host) {
+  const RankCpus mine = rank_cpus();
+  const std::uint64_t wanted = mine.bound ? threads : std::uint64_t{threads} * std::max(ranks_on_this_host, 1);
+  return wanted > mine.cpus;
 }
 
 void serve_rank(const Options& options, nodes::Transport& transport) {

@@ -14,9 +14,15 @@ namespace app {
 // --single, --compare-serial, --timing virtual, and more ranks than nodes.
 void check_rank_options(const Options& options, int ranks);
 
-// --threads 0 over several ranks: the CPUs this process may use, shared
-// among the ranks that run on this host, at least one each.
+// --threads 0 over several ranks: the CPUs the launcher bound this rank
+// to, or, unbound, the CPUs this process may use shared among the ranks on
+// this host; at least one.
 unsigned threads_per_rank(unsigned threads, int ranks_on_this_host);
+
+// Whether this rank's threads must share their cores with other ranks:
+// more than its bound CPUs, or, unbound, the host's ranks' threads
+// together more than the CPUs.
+bool cores_shared(unsigned threads, int ranks_on_this_host);
 
 // A rank other than 0: its nodes, until the machine ends. Throws
 // nodes::RankFailure when any rank failed (rank 0 reports it).

@@ -285,10 +285,11 @@ struct Runtime::Impl {
 // where std::bad_alloc ends the program, so room for them is first tried.
 void Runtime::Impl::set_up_thread(unsigned index) {
   if (!detail::address_space_free(boost_thread_set_up_bytes)) throw std::bad_alloc();
-  std::unique_ptr<Scheduler> owned(
-      options.scheduler
-          ? options.scheduler(index)
-          : new FifoScheduler(&times[index], idle_spin(options.threads, std::thread::hardware_concurrency())));
+  const std::chrono::microseconds spin = options.shared_cores
+                                              ? std::chrono::microseconds{0}
+                                              : idle_spin(options.threads, std::thread::hardware_concurrency());
+  std::unique_ptr<Scheduler> owned(options.scheduler ? options.scheduler(index)
+                                                     : new FifoScheduler(&times[index], spin));
   Scheduler* algo = owned.get();
   boost::fibers::context* main = boost::fibers::context::active();
   algo->make_room_for_fiber();  // for the dispatcher, which set_algo makes ready
@@ -399,7 +400,7 @@ void Runtime::Impl::run_process(Process& p, const std::function<void()>& body) {
   tracker.remove(p);
 }
 
-Runtime::Runtime(unsigned threads) : Runtime(RuntimeOptions{threads, RuntimeOptions{}.stack_size, {}, {}}) {}
+Runtime::Runtime(unsigned threads) : Runtime(RuntimeOptions{threads, RuntimeOptions{}.stack_size, {}, false, {}}) {}
 Runtime::Runtime(RuntimeOptions options) : impl_(std::make_unique<Impl>(std::move(options))) {}
 Runtime::~Runtime() = default;
 

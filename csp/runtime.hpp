@@ -54,6 +54,10 @@ struct RuntimeOptions {
   unsigned threads = 0;                   // 0: std::thread::hardware_concurrency()
   std::size_t stack_size = 256 * 1024;    // bytes per process fiber, with a guard page below (detail/stack.hpp)
   SchedulerFactory scheduler;             // empty: FifoScheduler on every thread
+  // Other processes of this program share the cores (more of them than
+  // cores): an idle thread of the default scheduler sleeps at once rather
+  // than spin for a wake, which would take the core from one with work.
+  bool shared_cores = false;
   // Called on the failing process's thread, after it ended with an
   // exception other than Poisoned and before run() returns: lets a program
   // whose other processes wait on something outside the runtime (a wire to

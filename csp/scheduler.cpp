@@ -120,7 +120,8 @@ void FifoScheduler::suspend_until(std::chrono::steady_clock::time_point const& w
     times_->close(start);
     ++times_->waits;
   }
-  if (spin_until_notified(start, when)) {
+  // Notified, or the deadline passed while spinning: nothing to sleep for.
+  if (spin_until_notified(start, when) || std::chrono::steady_clock::now() >= when) {
     if (!times_ && !idle_) return;
     const auto end = std::chrono::steady_clock::now();
     if (idle_) *idle_ += end - start;

@@ -326,6 +326,7 @@ Executed execute(const tracer::DatabaseHeader& header, const topology::Topology&
   const std::size_t local_nodes = share.node_count(topology.size());
   csp::RuntimeOptions runtime_options;
   runtime_options.threads = thread_count(options, local_nodes);
+  runtime_options.shared_cores = options.shared_cores;
   if (timing) runtime_options = timing->runtime_options(runtime_options.stack_size);
   std::optional<SplitState> split;
   Network* network = nullptr;

@@ -68,6 +68,7 @@ struct MachineOptions {
   std::string topology = "hypercube";  // a kind, or a full spec such as "hypercube:4"
   std::optional<std::size_t> nodes = 16;  // with a bare kind; must agree with a full spec
   unsigned threads = 0;                // 0: hardware cores; never more than the nodes
+  bool shared_cores = false;           // other processes share the cores (csp::RuntimeOptions::shared_cores)
   std::optional<std::uint32_t> cache_pages;  // remote pages cached per node
   std::optional<std::uint64_t> cache_kb;     // the same in KB; default (neither): default_cache_pages()
   std::uint32_t grain = 16;            // items per tile: balance vs farming traffic
