@@ -8,9 +8,10 @@ packages=(
   libgtest-dev libgmock-dev libbenchmark-dev
   libpng-dev zlib1g-dev
   libopenmpi-dev openmpi-bin
+  nlohmann-json3-dev libcairo2-dev fonts-dejavu-core
 )
-if [[ "${1:-}" == "--dev" ]]; then   # sanitizers' clang runtime and the fuzzer
-  packages+=(clang-14 libclang-rt-14-dev)
+if [[ "${1:-}" == "--dev" ]]; then   # sanitizers' clang runtime, the fuzzer, the browser checks
+  packages+=(clang-14 libclang-rt-14-dev chromium)
 fi
 missing=()
 for p in "${packages[@]}"; do
