@@ -2,6 +2,7 @@
 // priority, then yielded; when idle, a short spin, then a sleep.
 #include "csp/scheduler.hpp"
 
+#include <stdexcept>
 #include <utility>
 
 #include <boost/fiber/detail/cpu_relax.hpp>
@@ -54,7 +55,18 @@ void FifoScheduler::awakened(boost::fibers::context* ctx, ProcessProps& props) n
   }
 }
 
+// Runs the arrivals handler, unless its own process is the one switching
+// away (it takes the work itself before it waits). The handler first, then
+// the clear: the process it wakes runs after this switch, so it takes
+// whatever came before the clear, and whatever comes after marks again.
+void FifoScheduler::take_arrivals() noexcept {
+  if (boost::fibers::context::active() == arrivals_->owner_) return;
+  arrivals_->handler_();
+  arrivals_->marked_.store(false, std::memory_order_seq_cst);
+}
+
 boost::fibers::context* FifoScheduler::pick_next() noexcept {
+  if (arrivals_ && arrivals_->marked_.load(std::memory_order_relaxed)) take_arrivals();
   const bool none_ready = ready_.empty() && ready_low_woken_.empty() && ready_low_.empty();
   if (dispatcher_ && (none_ready || take_notification() || std::exchange(dispatch_soon_, false) ||
                       ++picks_since_dispatch_ >= dispatch_period)) {
@@ -88,7 +100,7 @@ bool FifoScheduler::spin_until_notified(std::chrono::steady_clock::time_point st
   const auto end = std::min(when, start + spin_limit_);
   do {
     for (int i = 0; i < 64; ++i) {
-      if (take_notification()) return true;
+      if (take_notification() || arrival_pending()) return true;
       cpu_relax();  // Boost.Fiber's spin-wait hint for this architecture
     }
   } while (std::chrono::steady_clock::now() < end);
@@ -100,7 +112,7 @@ bool FifoScheduler::spin_until_notified(std::chrono::steady_clock::time_point st
 bool FifoScheduler::sleep_until_notified(std::chrono::steady_clock::time_point when) noexcept {
   std::unique_lock<std::mutex> lk(mutex_);
   sleeping_.store(true, std::memory_order_seq_cst);
-  const auto woken = [this] { return notified_.load(std::memory_order_seq_cst); };
+  const auto woken = [this] { return notified_.load(std::memory_order_seq_cst) || arrival_pending(); };
   bool notified = true;
   if (when == std::chrono::steady_clock::time_point::max()) {
     wakeup_.wait(lk, woken);
@@ -151,7 +163,44 @@ void FifoScheduler::notify() noexcept {
 }
 
 bool FifoScheduler::yield_requested() const noexcept {
-  return notified_.load(std::memory_order_relaxed) || !ready_.empty();
+  return notified_.load(std::memory_order_relaxed) || !ready_.empty() ||
+         (arrivals_ && arrivals_->marked_.load(std::memory_order_relaxed));
+}
+
+// sleeping_ is set (seq_cst) before the sleeper looks at its arrivals for
+// the last time, and signal() marks (seq_cst) before it reads sleeping_:
+// either the sleeper sees the mark or the signaller sees it asleep.
+void FifoScheduler::wake_if_sleeping() noexcept {
+  if (sleeping_.load(std::memory_order_seq_cst)) notify();
+}
+
+Arrivals::~Arrivals() { detach(); }
+
+void Arrivals::signal() noexcept {
+  if (marked_.load(std::memory_order_seq_cst) || marked_.exchange(true, std::memory_order_seq_cst)) return;
+  if (FifoScheduler* s = scheduler_.load(std::memory_order_seq_cst)) s->wake_if_sleeping();
+}
+
+bool Arrivals::attach(std::function<void()> handler) {
+  auto* s = dynamic_cast<FifoScheduler*>(detail::thread_algorithm());
+  detail::Process* p = detail::current_process();
+  if (!s || !p || !p->tracker) return false;
+  if (s->arrivals_) throw std::logic_error("csp: a runtime thread takes one Arrivals at a time");
+  handler_ = std::move(handler);
+  owner_ = boost::fibers::context::active();
+  s->arrivals_ = this;
+  p->tracker->watch(p->thread, this);
+  tracker_ = p->tracker;
+  scheduler_.store(s, std::memory_order_seq_cst);
+  return true;
+}
+
+void Arrivals::detach() noexcept {
+  FifoScheduler* s = scheduler_.exchange(nullptr, std::memory_order_seq_cst);
+  if (!s) return;
+  s->arrivals_ = nullptr;
+  static_cast<detail::Tracker*>(tracker_)->unwatch(this);
+  marked_.store(false, std::memory_order_seq_cst);
 }
 
 }  // namespace csp

@@ -29,6 +29,8 @@
 // woken from another thread waits for one switch, not for a round of the
 // queue, a timer that fell due during a long computation fires when the
 // computation offers the thread, and most switches read no clock.
+// Arrivals (below) hand a thread work outside its channels: the scheduler
+// runs their handler at its next switch, and an idle thread stops waiting.
 //
 // Accounting (ThreadTimes): a thread's time from the start of its accounts
 // is cut at every idle wait into running (processes, and the switches
@@ -133,6 +135,57 @@ using SchedulerFactory = std::function<Scheduler*(unsigned thread)>;
 // taken as enough): 50 us, or none when the threads outnumber the hardware.
 std::chrono::microseconds idle_spin(unsigned threads, unsigned hardware_threads);
 
+class FifoScheduler;
+
+// csp::Arrivals: work handed to one runtime thread outside its channels, by
+// other threads, which the thread notices at its next switch instead of
+// being woken for each piece (nodes' thread relays carry packets between
+// threads this way: a packet costs its sender an enqueue and no wake-up).
+//
+// Contract:
+//  - A producer, on any thread, publishes its work (a release store or
+//    stronger), then calls signal(). The first signal after the handler
+//    last ran costs one atomic exchange, and a system call only if the
+//    owner's thread sleeps; later ones, until the handler runs, cost a load.
+//  - One process of a FifoScheduler thread attaches a handler (attach(),
+//    from that process). The scheduler calls it on that thread at the next
+//    switch after a signal, never while the attaching process runs (it
+//    drains the work itself before it waits), then clears the mark; a
+//    signal that comes after the handler started calls it again. An idle
+//    thread that is signalled stops spinning or sleeping. The handler must
+//    not block: it may only try_write() (typically a token that wakes the
+//    attaching process, which then takes all the work there is).
+//  - The deadlock detector counts a marked Arrivals as a process able to
+//    run (see Tracker in detail/process.hpp), so work in transit between
+//    threads is never mistaken for a deadlock.
+//  - detach() (same process, before it ends) stops the calls; signals after
+//    it are ignored.
+class Arrivals {
+ public:
+  Arrivals() = default;
+  Arrivals(const Arrivals&) = delete;
+  Arrivals& operator=(const Arrivals&) = delete;
+  ~Arrivals();
+
+  void signal() noexcept;
+  // False (nothing attached) if the calling thread's scheduler takes no
+  // arrivals (the virtual-time one), or outside a Runtime.
+  bool attach(std::function<void()> handler);
+  void detach() noexcept;
+  // Attached and signalled since the handler last ran.
+  bool pending() const noexcept {
+    return marked_.load(std::memory_order_seq_cst) && scheduler_.load(std::memory_order_seq_cst) != nullptr;
+  }
+
+ private:
+  friend class FifoScheduler;
+  std::atomic<bool> marked_{false};
+  std::atomic<FifoScheduler*> scheduler_{nullptr};  // set while attached
+  std::function<void()> handler_;
+  boost::fibers::context* owner_ = nullptr;
+  void* tracker_ = nullptr;  // the detail::Tracker it is registered with
+};
+
 class FifoScheduler final : public Scheduler {
  public:
   // `idle`, if given, gathers the time the thread waits with nothing to
@@ -154,7 +207,12 @@ class FifoScheduler final : public Scheduler {
   bool yield_requested() const noexcept override;
 
  private:
+  friend class Arrivals;
   static constexpr unsigned dispatch_period = 32;
+
+  bool arrival_pending() const noexcept { return arrivals_ && arrivals_->marked_.load(std::memory_order_seq_cst); }
+  void take_arrivals() noexcept;
+  void wake_if_sleeping() noexcept;
 
   bool take_notification() noexcept;
   bool spin_until_notified(std::chrono::steady_clock::time_point start,
@@ -174,6 +232,7 @@ class FifoScheduler final : public Scheduler {
   const std::chrono::microseconds spin_limit_;
   std::chrono::steady_clock::duration* idle_ = nullptr;
   ThreadTimes* times_ = nullptr;
+  Arrivals* arrivals_ = nullptr;  // attached on this thread
 };
 
 }  // namespace csp

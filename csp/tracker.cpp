@@ -64,6 +64,15 @@ bool Tracker::block(Process& p, Waiter& w) {
 
 void Tracker::unblock(Process& p) { counts_of(p).fetch_add(one_version - one_blocked); }
 
+void Tracker::watch(unsigned thread, const Arrivals* a) { counts_[thread % threads_].arrivals.store(a); }
+
+void Tracker::unwatch(const Arrivals* a) noexcept {
+  for (unsigned t = 0; t < threads_; ++t) {
+    const Arrivals* expected = a;
+    counts_[t].arrivals.compare_exchange_strong(expected, nullptr);
+  }
+}
+
 std::uint64_t Tracker::alive() const {
   std::uint64_t alive = 0;
   for (unsigned t = 0; t < threads_; ++t) alive += alive_of(counts_[t].word.load());
@@ -86,6 +95,8 @@ Tracker::Run Tracker::survey() const {
       alive += alive_of(word);
       versions += version_of(word);
     }
+    for (unsigned t = 0; t < threads_; ++t)
+      if (const Arrivals* a = counts_[t].arrivals.load(); a && a->pending()) return Run::going;
     std::uint64_t versions_again = 0;
     for (unsigned t = 0; t < threads_; ++t) {
       const std::uint64_t word = counts_[t].word.load();

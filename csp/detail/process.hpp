@@ -9,6 +9,10 @@
 // never counted. A process's own block and end touch only its thread's
 // word, so threads that each wake their own processes never contend for it.
 //
+// Work that threads hand each other outside channels (csp::Arrivals) is
+// seen too: a survey that finds an Arrivals pending between its two reads
+// says the run goes on, since the handler will wake a process for it.
+//
 // `blocked == alive > 0` over the whole run means no process can run and
 // nobody will wake one: the state is stable. Only a process that makes its
 // own thread's word all blocked (by blocking, or by ending) can complete
@@ -64,6 +68,10 @@ class Tracker {
   bool block(Process& p, Waiter& w);
   void unblock(Process& p);
   bool aborting() const { return aborting_.load(std::memory_order_acquire); }
+  // An Arrivals attached on `thread` (one per thread): while it is pending,
+  // the run counts as able to go on. unwatch() before `a` goes.
+  void watch(unsigned thread, const Arrivals* a);
+  void unwatch(const Arrivals* a) noexcept;
   std::uint64_t alive() const;
   std::string deadlock_dump() const;  // what each process waited on; only once aborting()
 
@@ -83,6 +91,7 @@ class Tracker {
 
   struct alignas(64) Counts {
     std::atomic<std::uint64_t> word{0};
+    std::atomic<const Arrivals*> arrivals{nullptr};  // changes only at attach and detach
   };
   enum class Run { going, deadlocked, ended };
 

@@ -1,0 +1,162 @@
+// csp::Arrivals: work signalled from other threads reaches its process
+// (also when its thread sleeps), in order, once; the handler never runs
+// while its own process runs; work in transit is not taken for a deadlock;
+// schedulers without the rule and code outside a Runtime attach nothing.
+#include <gtest/gtest.h>
+
+#include <atomic>
+#include <chrono>
+#include <cstdint>
+#include <deque>
+#include <mutex>
+#include <string>
+#include <vector>
+
+#include "csp/csp.hpp"
+#include "csp/virtual_time.hpp"
+
+namespace {
+
+using namespace std::chrono_literals;
+
+// Work handed from one thread to another: a locked queue, then a signal.
+struct Handoff {
+  std::mutex mutex;
+  std::deque<int> items;
+  csp::Arrivals arrivals;
+
+  void put(int v) {
+    {
+      std::lock_guard lk(mutex);
+      items.push_back(v);
+    }
+    arrivals.signal();
+  }
+  std::deque<int> take() {
+    std::lock_guard lk(mutex);
+    return std::exchange(items, {});
+  }
+};
+
+// The consumer on thread 0 attaches a handler that writes a token, waits on
+// the token, and takes everything there is until it has `n` items.
+std::vector<int> consume(Handoff& h, csp::Channel<char>& token, int n, std::atomic<int>* handler_in_owner = nullptr) {
+  std::vector<int> got;
+  const bool attached = h.arrivals.attach([w = token.writer(), handler_in_owner]() mutable {
+    if (handler_in_owner && csp::current_process_name() == "consumer") ++*handler_in_owner;
+    char t = 't';
+    (void)w.try_write(t);
+  });
+  EXPECT_TRUE(attached);
+  auto r = token.reader();
+  for (;;) {
+    for (int v : h.take()) got.push_back(v);
+    if (static_cast<int>(got.size()) >= n) break;
+    (void)r.read();
+  }
+  h.arrivals.detach();
+  return got;
+}
+
+TEST(Arrivals, ReachTheirProcessInOrderOnceAlsoWhenItsThreadSleeps) {
+  constexpr int n = 2000;
+  Handoff h;
+  csp::Channel<char> token("token", 1);
+  std::vector<int> got;
+  csp::Runtime rt(2);
+  rt.spawn("consumer", 0, [&] { got = consume(h, token, n); });
+  rt.spawn("producer", 1, [&] {
+    for (int i = 0; i < n; ++i) {
+      h.put(i);
+      // Now and then long enough for thread 0 to spin out and sleep.
+      if (i % 200 == 0) csp::sleep_for(2ms);
+    }
+  });
+  rt.run();
+  ASSERT_EQ(got.size(), static_cast<std::size_t>(n));
+  for (int i = 0; i < n; ++i) ASSERT_EQ(got[i], i);
+  EXPECT_FALSE(h.arrivals.pending());
+}
+
+// The producer ends right after its last signal, while the consumer waits
+// on its token: until thread 0's scheduler runs the handler, no process can
+// run, yet the run is going.
+TEST(Arrivals, WorkInTransitIsNotADeadlock) {
+  for (int round = 0; round < 200; ++round) {
+    Handoff h;
+    csp::Channel<char> token("token", 1);
+    std::vector<int> got;
+    csp::Runtime rt(2);
+    rt.spawn("consumer", 0, [&] { got = consume(h, token, 1); });
+    rt.spawn("producer", 1, [&] { h.put(round); });
+    ASSERT_NO_THROW(rt.run()) << "round " << round;
+    ASSERT_EQ(got, std::vector<int>{round});
+  }
+}
+
+// The consumer keeps running (it yields, so its thread switches) while
+// signals come: the scheduler leaves the handler to the switches away from
+// other processes, and the consumer still sees everything.
+TEST(Arrivals, HandlerNeverRunsWhileItsOwnProcessRuns) {
+  constexpr int n = 5000;
+  Handoff h;
+  csp::Channel<char> token("token", 1);
+  std::atomic<int> in_owner{0};
+  std::atomic<bool> done{false};
+  std::vector<int> got;
+  csp::Runtime rt(2);
+  rt.spawn("consumer", 0, [&] {
+    got = consume(h, token, n, &in_owner);
+    done = true;
+  });
+  rt.spawn("neighbour", 0, [&] {
+    while (!done) csp::yield();
+  });
+  rt.spawn("producer", 1, [&] {
+    for (int i = 0; i < n; ++i) h.put(i);
+  });
+  rt.run();
+  EXPECT_EQ(in_owner.load(), 0);
+  ASSERT_EQ(got.size(), static_cast<std::size_t>(n));
+  for (int i = 0; i < n; ++i) ASSERT_EQ(got[i], i);
+}
+
+TEST(Arrivals, NothingAttachesOutsideARuntimeOrUnderVirtualTime) {
+  csp::Arrivals outside;
+  EXPECT_FALSE(outside.attach([] {}));
+  outside.signal();
+  EXPECT_FALSE(outside.pending());
+
+  csp::RuntimeOptions options;
+  options.threads = 1;
+  options.scheduler = csp::virtual_time_scheduler();
+  csp::Runtime rt(options);
+  bool attached = true;
+  rt.spawn("p", 0, [&] {
+    csp::Arrivals a;
+    attached = a.attach([] {});
+  });
+  rt.run();
+  EXPECT_FALSE(attached);
+}
+
+TEST(Arrivals, OneThreadTakesOneAtATime) {
+  csp::Runtime rt(1);
+  std::string error;
+  rt.spawn("p", 0, [&] {
+    csp::Arrivals a, b;
+    ASSERT_TRUE(a.attach([] {}));
+    try {
+      (void)b.attach([] {});
+    } catch (const std::logic_error& e) {
+      error = e.what();
+    }
+    a.detach();
+    EXPECT_TRUE(b.attach([] {}));
+    b.detach();
+  });
+  rt.run();
+  EXPECT_NE(error.find("one Arrivals"), std::string::npos) << error;
+}
+
+}  // namespace
