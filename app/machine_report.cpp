@@ -164,6 +164,22 @@ void print_thread_use(std::ostream& out, const std::vector<csp::ThreadUse>& thre
   out << std::setprecision(3);
 }
 
+// What crossed between threads through the relays: packets, and the wakes
+// and signals they took (packets per wake is the batching).
+void print_relays(std::ostream& out, const nodes::MachineReport& r) {
+  if (r.relays.empty()) return;
+  std::uint64_t packets = 0, wakes = 0, signals = 0;
+  for (const auto& t : r.relays) {
+    packets += t.packets_sent;
+    wakes += t.wakes;
+    signals += t.signals;
+  }
+  out << "between threads " << packets << " packets on " << r.relayed_links << " relayed links, in " << wakes
+      << " relay wakes (" << std::setprecision(2) << (wakes ? static_cast<double>(packets) / wakes : 0.0)
+      << " per wake) and " << signals << " signals\n"
+      << std::setprecision(3);
+}
+
 }  // namespace
 
 double MachineSummary::parallel_seconds() const {
@@ -209,6 +225,7 @@ void print_machine_report(std::ostream& out, const MachineSummary& m) {
   else out << "; predicted " << r.predicted_seconds << " s (" << r.cost_model << ")";
   out << "\n";
   if (r.cost_model.empty()) print_thread_use(out, r.host_threads);
+  print_relays(out, r);
   if (m.serial)
     out << "speedup        " << m.speedup() << " (1 node: " << m.serial->seconds << " s on "
         << count_of(m.serial->threads, "thread") << "; " << count_of(r.nodes, "node") << ": "

@@ -348,6 +348,7 @@ Executed execute(const tracer::DatabaseHeader& header, const topology::Topology&
   net_options.trace_routes = options.trace_routes;
   net_options.trace_kinds = options.trace_kinds;
   if (timing) net_options.link = timing->model().link_model();
+  net_options.relay_between_threads = options.relay_between_threads && !timing;
   if (share.plan) {
     net_options.local = [share](NodeId n) { return share.runs(n); };
     net_options.placement = [first = share.first_node(), local_nodes, threads = runtime.threads()](NodeId n) {
@@ -396,6 +397,9 @@ Executed execute(const tracer::DatabaseHeader& header, const topology::Topology&
   MachineReport& report = result.report;
   report.wall_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
   report.host_threads = runtime.thread_use();
+  report.relayed_links = net.relayed_links();
+  if (report.relayed_links > 0)
+    for (unsigned t = 0; t < runtime.threads(); ++t) report.relays.push_back(net.relay_counters(t));
   if (timing) {
     report.cost_model = timing->model().describe();
     report.predicted_seconds = timing->predicted_seconds();

@@ -68,6 +68,7 @@ struct MachineOptions {
   std::string topology = "hypercube";  // a kind, or a full spec such as "hypercube:4"
   std::optional<std::size_t> nodes = 16;  // with a bare kind; must agree with a full spec
   unsigned threads = 0;                // 0: hardware cores; never more than the nodes
+  bool relay_between_threads = true;   // links between threads through relays (NetworkOptions)
   bool shared_cores = false;           // other processes share the cores (csp::RuntimeOptions::shared_cores)
   std::optional<std::uint32_t> cache_pages;  // remote pages cached per node
   std::optional<std::uint64_t> cache_kb;     // the same in KB; default (neither): default_cache_pages()
@@ -131,6 +132,8 @@ struct MachineReport {
   std::uint64_t items = 0;  // pixels, or SPD corner samples
   double wall_seconds = 0;
   std::vector<csp::ThreadUse> host_threads;  // how each OS thread spent the run
+  std::size_t relayed_links = 0;             // links between threads carried by thread relays
+  std::vector<RelayCounters> relays;         // per thread, what its relay carried (empty without relays)
   std::string cost_model;          // CostModel::describe(), empty without virtual time
   double predicted_seconds = 0;    // virtual time at the end of the run
   double compute_seconds = 0;      // virtual compute time summed over the pixel computers

@@ -32,7 +32,11 @@ Network::Network(csp::Runtime& runtime, topology::Topology topology, NetworkOpti
   if (options_.ports_per_node == 0) throw std::invalid_argument("network: each node needs at least one local port");
   if (options_.local && options_.link.enabled())
     throw std::invalid_argument("network: a link model cannot carry links between processes");
+  if (options_.relay_between_threads && options_.link.enabled())
+    throw std::invalid_argument("network: a link model cannot be relayed between threads");
   for (const std::uint8_t kind : options_.trace_kinds) kinds_to_trace_[kind] = true;
+  if (options_.relay_between_threads && threads_ > 1)
+    relays_ = std::make_unique<ThreadRelays>(threads_, options_.buffer_capacity);
   const std::size_t n = topology_.size();
   link_in_.resize(n);
   ports_.resize(n);
@@ -51,6 +55,7 @@ Network::Network(csp::Runtime& runtime, topology::Topology topology, NetworkOpti
   }
   for (NodeId node = 0; node < n; ++node)
     if (is_local(node)) wire_node(runtime, node);
+  if (relays_) relays_->spawn(runtime);
 }
 
 unsigned Network::thread_of(NodeId node) const {
@@ -74,6 +79,13 @@ void Network::wire_node(csp::Runtime& runtime, NodeId node) {
     const NodeId m = neighbours[p];
     const std::size_t back = topology_.port_to(m, node);
     for (unsigned c = 0; c < classes_; ++c) {
+      if (is_local(m) && relays_ && thread_of(m) != thread_of(node)) {
+        cut_queues_.emplace_back("relayed " + link_name(node, m, c), options_.buffer_capacity);
+        relays_->add(CutLink{node, m, c}, thread_of(node), thread_of(m), cut_queues_.back().reader(),
+                     link_in_[m][back * classes_ + c].writer());
+        ends.outputs.push_back(cut_queues_.back().writer());
+        continue;
+      }
       if (is_local(m)) {
         ends.outputs.push_back(output_queue(runtime, node, link_in_[m][back * classes_ + c]));
         continue;
@@ -115,6 +127,7 @@ csp::In<Packet> Network::port(NodeId node, unsigned port) const {
 
 void Network::shutdown() {
   shut_down_.store(true, std::memory_order_release);
+  if (relays_) relays_->poison();
   for (auto& ch : cut_queues_) ch.poison();
   for (auto& ch : injections_) ch.poison();
   for (auto& ch : wires_) ch.poison();

@@ -27,6 +27,12 @@
 // returns with no fiber left blocked. Packets still in the network at
 // shutdown are dropped. stats() is valid after run().
 //
+// With relay_between_threads, a link whose routers run on different
+// threads is a pair of channels, each used by one thread only: the output
+// queue of the sending router, read by its thread's relay, and the input of
+// the receiving router, written by its own thread's relay; the relays carry
+// the packets between the threads (thread_relay.hpp).
+//
 // A machine split over OS processes (rank_plan.hpp) builds, on each rank, a
 // Network whose `local` nodes are that rank's: only their routers and ports
 // exist, and each link between a local and a remote node becomes, per
@@ -46,6 +52,7 @@
 #include "nodes/link.hpp"
 #include "nodes/packet.hpp"
 #include "nodes/router.hpp"
+#include "nodes/thread_relay.hpp"
 #include "topology/topology.hpp"
 
 namespace nodes {
@@ -58,6 +65,10 @@ struct NetworkOptions {
   LinkModel link;                   // optional per-hop latency and bandwidth
   std::function<unsigned(NodeId)> placement;  // thread of node n; default block
   std::function<bool(NodeId)> local;          // nodes this process runs; default all
+  // Links between routers on different threads go through the threads'
+  // relays (thread_relay.hpp) instead of channels shared by two threads.
+  // Real time only (the relays need FifoScheduler); not with a link model.
+  bool relay_between_threads = false;
 };
 
 // One direction and buffer class of a link whose ends run in different processes.
@@ -113,6 +124,13 @@ class Network {
   // Counters of one router (zero for a node this process does not run).
   const RouterCounters& router_counters(NodeId node) const { return *router_counters_.at(node); }
 
+  // Links carried by thread relays (0 without them), and what each
+  // thread's relay carried (after run()).
+  std::size_t relayed_links() const { return relays_ ? relays_->links() : 0; }
+  RelayCounters relay_counters(unsigned thread) const {
+    return relays_ ? relays_->counters(thread) : RelayCounters{};
+  }
+
   // Contiguous ranges of nodes per thread: node * threads / nodes.
   static unsigned block_placement(NodeId node, std::size_t nodes, unsigned threads);
 
@@ -132,6 +150,7 @@ class Network {
   std::vector<csp::Channel<Packet>> wires_;  // link model only: router -> link process
   std::vector<csp::Channel<Packet>> cut_queues_;  // local router -> bridge, toward remote nodes
   CutEnds cut_;
+  std::unique_ptr<ThreadRelays> relays_;  // with relay_between_threads and several threads
   std::atomic<bool> shut_down_{false};
   // Counters live here so they outlive the processes; each is written by
   // exactly one process and read only after run().

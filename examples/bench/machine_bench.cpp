@@ -166,6 +166,8 @@ int main(int argc, char** argv) {
   };
   const std::vector<Line> variants{
       {"  as above (affinity, hilbert, grain 16)", {}},
+      {"  packets between threads on channels, no relays",
+       [](nodes::MachineOptions& o, const tracer::DatabaseHeader&) { o.relay_between_threads = false; }},
       {"  BVH nodes in depth-first layout", {}, {.bvh_layout = tracer::BvhLayout::depth_first}},
       {"  prefetch 0 (ask when idle)",
        [](nodes::MachineOptions& o, const tracer::DatabaseHeader&) { o.prefetch = 0; }},

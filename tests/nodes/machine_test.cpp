@@ -137,6 +137,48 @@ TEST(Machine, ImageIsBitIdenticalOnTwoThreads) {
   }
 }
 
+// Every packet on a link between two threads goes through the relays once:
+// what the relays put in rings, they take out, and it is what the routers
+// sent on those links. Without relays the machine computes the same.
+TEST(Machine, RelaysCarryEveryPacketBetweenThreadsOnce) {
+  const Case c{"hypercube", 16, 2, 256, 4, Schedule::dynamic, 1, 2};
+  const auto relayed = run_case(c);
+  const auto& r = relayed.report;
+  ASSERT_EQ(r.relays.size(), 2u);
+  std::uint64_t expected = 0, crossing = 0;
+  for (const auto& l : r.network.links)
+    if (nodes::Network::block_placement(l.from, 16, 2) != nodes::Network::block_placement(l.to, 16, 2)) {
+      expected += l.packets;
+      ++crossing;
+    }
+  EXPECT_GT(expected, 0u);
+  EXPECT_EQ(crossing, 16u);  // a 4-cube halved: the links of one dimension, both ways
+  EXPECT_EQ(r.relayed_links % crossing, 0u);  // per direction, one per buffer class
+  std::uint64_t sent = 0, received = 0;
+  for (const auto& t : r.relays) {
+    sent += t.packets_sent;
+    received += t.packets_received;
+    EXPECT_GT(t.wakes, 0u);
+    EXPECT_LE(t.signals, t.packets_sent + t.packets_received);  // batches, never more than one per packet
+  }
+  EXPECT_EQ(sent, expected);
+  EXPECT_EQ(received, expected);
+
+  MachineOptions options;
+  options.topology = c.topology;
+  options.nodes = c.nodes;
+  options.threads = 2;
+  options.relay_between_threads = false;
+  auto db = make_db(c.scene, c.page_size, c.size);
+  options.cache_pages = c.cache_pages;
+  options.grain = c.grain;
+  const auto plain = nodes::run_machine(std::move(db), options);
+  EXPECT_TRUE(plain.report.relays.empty());
+  EXPECT_EQ(plain.report.relayed_links, 0u);
+  EXPECT_TRUE(same_bits(plain.image.pixels(), relayed.image.pixels()));
+  EXPECT_TRUE(same_bits(relayed.image.pixels(), cached_reference(c.scene, c.size)));
+}
+
 TEST(Machine, ImageIsBitIdenticalOn256Nodes) {
   const Case c{"hypercube", 256, 2, 256, 1, Schedule::dynamic, 1, 1, "teapot:2", 16};
   EXPECT_TRUE(same_bits(run_case(c).image.pixels(), cached_reference(c.scene, c.size)));
