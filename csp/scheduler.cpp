@@ -3,6 +3,7 @@
 #include "csp/scheduler.hpp"
 
 #include <stdexcept>
+#include <thread>
 #include <utility>
 
 #include <boost/fiber/detail/cpu_relax.hpp>
@@ -97,6 +98,13 @@ bool FifoScheduler::take_notification() noexcept {
 // flag's cache line from the notifier.
 bool FifoScheduler::spin_until_notified(std::chrono::steady_clock::time_point start,
                                         std::chrono::steady_clock::time_point when) noexcept {
+  if (spin_limit_.count() == 0) {
+    for (int i = 0; i < os_yields_before_sleep; ++i) {
+      if (take_notification() || arrival_pending()) return true;
+      std::this_thread::yield();
+    }
+    return take_notification() || arrival_pending();
+  }
   const auto end = std::min(when, start + spin_limit_);
   do {
     for (int i = 0; i < 64; ++i) {

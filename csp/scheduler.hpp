@@ -209,6 +209,7 @@ class FifoScheduler final : public Scheduler {
  private:
   friend class Arrivals;
   static constexpr unsigned dispatch_period = 32;
+  static constexpr int os_yields_before_sleep = 16;
 
   bool arrival_pending() const noexcept { return arrivals_ && arrivals_->marked_.load(std::memory_order_seq_cst); }
   void take_arrivals() noexcept;

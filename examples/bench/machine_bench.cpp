@@ -3,6 +3,8 @@
 // renderer over one shared in-memory database with plain std::threads
 // pulling rows, measured side by side on the same threads; and the speedup
 // of T threads over 1.
+// Each machine line on T threads is also run with packets between threads
+// on plain channels rather than through the thread relays.
 // Then where the machine's time goes, on 16 nodes and T threads: the same
 // run with the BVH's nodes in depth-first layout rather than in treelets,
 // with the paper's ask-when-idle protocol (prefetch 0), with every cache
@@ -143,18 +145,25 @@ int main(int argc, char** argv) {
               shared_t.median(), shared_t.fastest(), shared1.median() / shared_t.median());
 
   for (int nodes : {16, 64}) {
-    MachineRun one, many;
+    MachineRun one, many, plain;
+    const Variant no_relays = [](nodes::MachineOptions& o, const tracer::DatabaseHeader&) {
+      o.relay_between_threads = false;
+    };
     for (int r = 0; r < repeats; ++r) {
       run_machine_once(one, spec, size, nodes, 1, image);
       run_machine_once(many, spec, size, nodes, threads, image);
+      run_machine_once(plain, spec, size, nodes, threads, image, no_relays);
     }
     const std::string l1 = "machine hypercube " + std::to_string(nodes) + ", 1 thread";
     const std::string lt = "machine hypercube " + std::to_string(nodes) + ", " + std::to_string(threads) + " threads";
     print_run(l1.c_str(), one, shared1.median());
     print_run(lt.c_str(), many, shared_t.median());
+    const std::string lp = lt + ", no relays";
+    print_run(lp.c_str(), plain, shared_t.median());
     if (one.ok() && many.ok())
-      std::printf("  speedup of %u threads over 1: %.2fx (fastest runs %.2fx)\n", threads,
-                  one.times.median() / many.times.median(), one.times.fastest() / many.times.fastest());
+      std::printf("  speedup of %u threads over 1: %.2fx (fastest runs %.2fx); without relays %.2fx\n", threads,
+                  one.times.median() / many.times.median(), one.times.fastest() / many.times.fastest(),
+                  plain.ok() ? one.times.median() / plain.times.median() : 0.0);
   }
 
   std::printf("where the time goes: hypercube 16, %u threads, against shared memory on %u threads\n", threads,
@@ -166,8 +175,6 @@ int main(int argc, char** argv) {
   };
   const std::vector<Line> variants{
       {"  as above (affinity, hilbert, grain 16)", {}},
-      {"  packets between threads on channels, no relays",
-       [](nodes::MachineOptions& o, const tracer::DatabaseHeader&) { o.relay_between_threads = false; }},
       {"  BVH nodes in depth-first layout", {}, {.bvh_layout = tracer::BvhLayout::depth_first}},
       {"  prefetch 0 (ask when idle)",
        [](nodes::MachineOptions& o, const tracer::DatabaseHeader&) { o.prefetch = 0; }},
