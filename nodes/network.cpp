@@ -81,7 +81,7 @@ void Network::wire_node(csp::Runtime& runtime, NodeId node) {
     for (unsigned c = 0; c < classes_; ++c) {
       if (is_local(m) && relays_ && thread_of(m) != thread_of(node)) {
         cut_queues_.emplace_back("relayed " + link_name(node, m, c), options_.buffer_capacity);
-        relays_->add(CutLink{node, m, c}, thread_of(node), thread_of(m), cut_queues_.back().reader(),
+        relays_->add(thread_of(node), thread_of(m), cut_queues_.back().reader(),
                      link_in_[m][back * classes_ + c].writer());
         ends.outputs.push_back(cut_queues_.back().writer());
         continue;

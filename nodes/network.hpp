@@ -148,7 +148,7 @@ class Network {
   std::vector<csp::Channel<Packet>> injections_;  // per node
   std::vector<std::vector<csp::Channel<Packet>>> ports_;
   std::vector<csp::Channel<Packet>> wires_;  // link model only: router -> link process
-  std::vector<csp::Channel<Packet>> cut_queues_;  // local router -> bridge, toward remote nodes
+  std::vector<csp::Channel<Packet>> cut_queues_;  // local router -> bridge (toward remote nodes) or relay (other thread)
   CutEnds cut_;
   std::unique_ptr<ThreadRelays> relays_;  // with relay_between_threads and several threads
   std::atomic<bool> shut_down_{false};

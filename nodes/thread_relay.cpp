@@ -8,12 +8,9 @@
 #include <string>
 #include <utility>
 
-#include "nodes/network.hpp"
-
 namespace nodes {
 
 struct ThreadRelays::Link {
-  CutLink link;
   unsigned from_thread = 0;
   unsigned to_thread = 0;
   csp::In<Packet> queue;
@@ -245,11 +242,10 @@ ThreadRelays::~ThreadRelays() = default;
 
 std::size_t ThreadRelays::links() const { return links_.size(); }
 
-void ThreadRelays::add(const CutLink& link, unsigned from_thread, unsigned to_thread, csp::In<Packet> queue,
-                       csp::Out<Packet> into) {
+void ThreadRelays::add(unsigned from_thread, unsigned to_thread, csp::In<Packet> queue, csp::Out<Packet> into) {
   if (from_thread == to_thread || from_thread >= threads_ || to_thread >= threads_)
     throw std::invalid_argument("thread relay: a relayed link joins two different threads of the runtime");
-  links_.push_back(Link{link, from_thread, to_thread, std::move(queue), std::move(into)});
+  links_.push_back(Link{from_thread, to_thread, std::move(queue), std::move(into)});
 }
 
 // A ring from a to b carries the packets of links a→b (at most K each, by

@@ -44,8 +44,6 @@
 
 namespace nodes {
 
-struct CutLink;
-
 // What one thread's relay carried; read after the run.
 struct RelayCounters {
   std::uint64_t packets_sent = 0;      // packets this thread's relay put in rings
@@ -61,11 +59,10 @@ class ThreadRelays {
   ThreadRelays(const ThreadRelays&) = delete;
   ThreadRelays& operator=(const ThreadRelays&) = delete;
 
-  // Before spawn(): the link's output queue at its `from` router (read by
-  // the relay of from_thread) and its input at its `to` router (written by
-  // the relay of to_thread); the threads differ.
-  void add(const CutLink& link, unsigned from_thread, unsigned to_thread, csp::In<Packet> queue,
-           csp::Out<Packet> into);
+  // Before spawn(): a link's output queue at its sending router (read by
+  // the relay of from_thread) and its input at its receiving router
+  // (written by the relay of to_thread); the threads differ.
+  void add(unsigned from_thread, unsigned to_thread, csp::In<Packet> queue, csp::Out<Packet> into);
   std::size_t links() const;
   // One relay process per thread that has links; under a FifoScheduler only.
   void spawn(csp::Runtime& runtime);
