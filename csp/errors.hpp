@@ -1,13 +1,26 @@
-// Exceptions of the CSP runtime.
+// Exceptions of the CSP runtime, and message_of for a stored one.
 // Poisoned ends a process normally (it is how a network shuts down); Deadlock,
 // ProcessesFailed, ProcessNotStarted and ThreadNotStarted are what
 // Runtime::run() reports when a run goes wrong.
 #pragma once
 
+#include <exception>
 #include <stdexcept>
 #include <string>
 
 namespace csp {
+
+// The message of a stored exception: what() of a std::exception, else
+// "unknown exception". For reporting a process's failure in one line.
+inline std::string message_of(const std::exception_ptr& error) {
+  try {
+    std::rethrow_exception(error);
+  } catch (const std::exception& e) {
+    return e.what();
+  } catch (...) {
+    return "unknown exception";
+  }
+}
 
 // Thrown by every blocking or try operation on a poisoned channel.
 struct Poisoned : std::runtime_error {

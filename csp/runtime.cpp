@@ -29,15 +29,6 @@ struct Failure {
   std::exception_ptr error;
 };
 
-std::string message_of(const std::exception_ptr& e) {
-  try {
-    std::rethrow_exception(e);
-  } catch (const std::exception& x) {
-    return x.what();
-  } catch (...) {
-    return "unknown exception";
-  }
-}
 
 // One failure: rethrown as is; several: ProcessesFailed naming the first
 // few and counting the rest.
@@ -433,7 +424,7 @@ void Runtime::run() {
     for (std::thread& t : threads) t.join();
     impl_->finished = true;
     throw ThreadNotStarted("csp: could not " + what + " runtime thread " + std::to_string(thread + 1) + " of " +
-                             std::to_string(count) + ", so no process ran: " + detail::message_of(why));
+                             std::to_string(count) + ", so no process ran: " + message_of(why));
   };
   try {
     threads.reserve(count);

@@ -12,6 +12,7 @@
 
 #include <sys/resource.h>
 
+#include "csp/errors.hpp"
 #include "nodes/mailbox.hpp"
 #include "nodes/report_wire.hpp"
 #include "topology/spec.hpp"
@@ -263,15 +264,6 @@ struct SplitState {
   BridgeCounters bridge;
 };
 
-std::string message_of(const std::exception_ptr& error) {
-  try {
-    std::rethrow_exception(error);
-  } catch (const std::exception& e) {
-    return e.what();
-  } catch (...) {
-    return "unknown exception";
-  }
-}
 
 double cpu_seconds() {
   rusage use{};
@@ -337,7 +329,7 @@ Executed execute(const tracer::DatabaseHeader& header, const topology::Topology&
     // the network down, so the bridge tells the other ranks and ends.
     runtime_options.on_failure = [&split, &network, rank = share.rank](const std::string& process,
                                                                         std::exception_ptr error) {
-      split->local_failure.set(rank, "process '" + process + "' failed: " + message_of(error));
+      split->local_failure.set(rank, "process '" + process + "' failed: " + csp::message_of(error));
       if (network) network->shutdown();
     };
   }
