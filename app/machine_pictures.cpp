@@ -9,6 +9,7 @@
 #include "app/experiments.hpp"
 #include "app/output_files.hpp"
 #include "app/viz/ownership.hpp"
+#include "nodes/messages.hpp"
 #include "topology/spec.hpp"
 
 namespace app {
@@ -99,6 +100,7 @@ viz::KeyValueTable machine_statistics(const nodes::MachineReport& r) {
             {"miss ratio", fixed(100 * svm.miss_ratio(), 3) + "%"},
             {"pages served", std::to_string(r.served().pages_served)},
             {"mean hops per message", fixed(r.network.hops.mean(), 2)},
+            {"links cut between ranks", std::to_string(r.cut_links)},
             {"pixel imbalance (max/mean)", fixed(r.item_imbalance(), 3)},
             {"wall time", fixed(r.wall_seconds, 2) + " s"}};
   if (!r.cost_model.empty()) {
@@ -106,6 +108,43 @@ viz::KeyValueTable machine_statistics(const nodes::MachineReport& r) {
     t.rows.push_back({"predicted synthesis time", paper_duration(r.predicted_seconds)});
   }
   return t;
+}
+
+std::vector<viz::Table> machine_tables(const nodes::MachineReport& r) {
+  std::vector<viz::Table> tables;
+  viz::Table per_node{.caption = "Per node",
+                      .header = {"node", "pixels", "tiles", "rays", "page accesses", "misses", "miss ratio",
+                                 "pages served", "cache pages", "evictions"}};
+  for (std::size_t n = 0; n < r.per_node.size(); ++n) {
+    const nodes::NodeReport& x = r.per_node[n];
+    per_node.rows.push_back({std::to_string(n), std::to_string(x.work.items), std::to_string(x.work.tiles),
+                             std::to_string(x.work.rays.rays()), std::to_string(x.svm.accesses()),
+                             std::to_string(x.svm.misses), fixed(100 * x.svm.miss_ratio(), 3) + "%",
+                             std::to_string(x.served.pages_served), std::to_string(x.cache_capacity),
+                             std::to_string(x.evictions)});
+  }
+  tables.push_back(std::move(per_node));
+  viz::Table hops{.caption = "Hops by packet kind", .header = {"kind", "packets", "mean hops", "most hops"}};
+  for (const auto& [kind, h] : r.network.hops_by_kind)
+    hops.rows.push_back({std::string(nodes::message_kind_name(kind)), std::to_string(h.packets), fixed(h.mean(), 2),
+                         std::to_string(h.max_hops)});
+  hops.rows.push_back({"all", std::to_string(r.network.hops.packets), fixed(r.network.hops.mean(), 2),
+                       std::to_string(r.network.hops.max_hops)});
+  tables.push_back(std::move(hops));
+  if (!r.ranks.empty()) {
+    viz::Table ranks{.caption = "Per MPI rank (" + std::to_string(r.cut_links) + " links cut)",
+                     .header = {"rank", "nodes", "threads", "packets sent", "bytes sent", "packets received",
+                                "bytes received", "MPI messages", "scene bytes at peak", "cpu (s)", "wall (s)"}};
+    for (const nodes::RankReport& k : r.ranks)
+      ranks.rows.push_back({std::to_string(k.rank),
+                            std::to_string(k.first_node) + "-" + std::to_string(k.first_node + k.node_count - 1),
+                            std::to_string(k.threads), std::to_string(k.bridge.packets_sent),
+                            std::to_string(k.bridge.bytes_sent), std::to_string(k.bridge.packets_received),
+                            std::to_string(k.bridge.bytes_received), std::to_string(k.bridge.messages_sent),
+                            std::to_string(k.peak_scene_bytes), fixed(k.cpu_seconds, 3), fixed(k.wall_seconds, 3)});
+    tables.push_back(std::move(ranks));
+  }
+  return tables;
 }
 
 std::vector<std::pair<std::string, std::filesystem::path>> picture_outputs(const PictureFiles& files) {
@@ -151,6 +190,7 @@ std::vector<std::filesystem::path> write_machine_pictures(const PictureFiles& fi
     viz::Section run{.heading = "The run on " + report.topology};
     run.blocks.push_back(viz::ImageFigure{.caption = "rendered image", .image = std::move(image)});
     run.blocks.push_back(machine_statistics(report));
+    for (viz::Table& t : machine_tables(report)) run.blocks.push_back(std::move(t));
     run.blocks.push_back(viz::SvgFigure{.caption = "the machine after the run", .svg = machine});
     run.blocks.push_back(viz::ImageFigure{.caption = "which processor computed each pixel (key: processor numbers)",
                                           .image = std::move(ownership),

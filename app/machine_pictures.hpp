@@ -31,6 +31,11 @@ viz::Timeline timeline(const nodes::MachineReport& report);
 // The statistics of a run as rows for the HTML page.
 viz::KeyValueTable machine_statistics(const nodes::MachineReport& report);
 
+// The page's tables: one row per node (work, cache, pages served), one per
+// packet kind (packets and hops), and, for a run over several MPI ranks,
+// one per rank (its nodes, threads and what crossed the wire).
+std::vector<viz::Table> machine_tables(const nodes::MachineReport& report);
+
 struct PictureFiles {
   std::filesystem::path machine_svg;    // empty: not written
   std::filesystem::path ownership_png;  // empty: not written

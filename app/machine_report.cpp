@@ -146,6 +146,16 @@ void json_ranks(std::ostream& out, const nodes::MachineReport& r, const std::str
   out << (r.ranks.empty() ? "" : "\n" + indent) << "]";
 }
 
+// The relays' counters per thread, as print_relays sums them.
+void json_relays(std::ostream& out, const nodes::MachineReport& r) {
+  out << ", \"relayed_links\": " << r.relayed_links << ", \"relays\": [";
+  for (std::size_t t = 0; t < r.relays.size(); ++t)
+    out << (t ? ", " : "") << "{\"packets_sent\": " << r.relays[t].packets_sent
+        << ", \"packets_received\": " << r.relays[t].packets_received << ", \"wakes\": " << r.relays[t].wakes
+        << ", \"signals\": " << r.relays[t].signals << "}";
+  out << "]";
+}
+
 // One line per runtime thread: where its time went, as shares of its wall
 // time, and the CPU time the OS gave it (less than running + spinning when
 // other threads had its core).
@@ -301,6 +311,7 @@ void write_machine_json(std::ostream& out, const MachineSummary& m, const std::s
           << ", \"sleeps\": " << r.host_threads[t].sleeps << ", \"remote_wakes\": " << r.host_threads[t].remote_wakes
           << ", \"sleepers_woken\": " << r.host_threads[t].sleepers_woken << "}";
     out << "]";
+    json_relays(out, r);
   }
   if (!r.cost_model.empty())
     out << ", \"cost_model\": " << json_string(r.cost_model) << ", \"predicted_seconds\": "

@@ -224,6 +224,19 @@ TEST_F(MachineCli, DefaultMachineWritesImageAndJsonWithMachineFields) {
     EXPECT_GT(t["running_seconds"].number, 0);  // every thread holds nodes that trace
     EXPECT_GT(t["cpu_seconds"].number, 0);
   }
+  // The links between the two threads' subcubes go through the relays:
+  // every packet one relay put in a ring, the other took out.
+  EXPECT_GT(m["relayed_links"].number, 0);
+  ASSERT_EQ(m["relays"].items.size(), 2u);
+  double relay_sent = 0, relay_received = 0;
+  for (const Json& t : m["relays"].items) {
+    relay_sent += t["packets_sent"].number;
+    relay_received += t["packets_received"].number;
+    EXPECT_GE(t["wakes"].number, 0);
+  }
+  EXPECT_GT(relay_sent, 0);
+  EXPECT_EQ(relay_sent, relay_received);
+  EXPECT_NE(r.out.find("between threads "), std::string::npos) << r.out;
   EXPECT_NE(r.out.find("% of thread time"), std::string::npos) << r.out;
   EXPECT_NE(r.out.find("thread 1"), std::string::npos) << r.out;
   EXPECT_NE(r.out.find("running "), std::string::npos) << r.out;

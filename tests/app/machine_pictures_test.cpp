@@ -90,6 +90,9 @@ TEST(MachinePictures, WritesWellFormedSvgAndAPageLinkingOnlyItsFiles) {
   EXPECT_GE(links, 2);  // the image and the ownership picture
   for (const auto& entry : fs::directory_iterator(dir)) EXPECT_TRUE(names.count(entry.path().filename().string()));
   EXPECT_NE(html.find("when each processor traced each tile"), std::string::npos);
+  EXPECT_NE(html.find("<caption>Per node</caption>"), std::string::npos);
+  EXPECT_NE(html.find("<caption>Hops by packet kind</caption>"), std::string::npos);
+  EXPECT_EQ(html.find("Per MPI rank"), std::string::npos);  // one process: no ranks' table
   // The ownership picture's key: one swatch per processor, in its colour.
   for (int n = 0; n < 4; ++n)
     EXPECT_NE(html.find("<li style=\"background:" + viz::hex(viz::node_colour(n))), std::string::npos) << n;
@@ -128,6 +131,37 @@ TEST(MachinePictures, TimelineNeedsARunThatRecordedItsTiles) {
   files.timeline_svg = dir / "tiles.svg";
   EXPECT_THROW(app::write_machine_pictures(files, "teapot", run.image, run.report), std::invalid_argument);
   EXPECT_FALSE(fs::exists(files.timeline_svg));
+}
+
+TEST(MachinePictures, TablesHaveARowPerNodeAndPerKindThatAddUpToTheRun) {
+  const auto run = small_run(false);
+  auto report = run.report;
+  auto tables = app::machine_tables(report);
+  ASSERT_EQ(tables.size(), 2u);
+  ASSERT_EQ(tables[0].rows.size(), 4u);
+  std::uint64_t pixels = 0;
+  for (const auto& row : tables[0].rows) {
+    ASSERT_EQ(row.size(), tables[0].header.size());
+    pixels += std::stoull(row[1]);
+  }
+  EXPECT_EQ(pixels, 120u);
+  ASSERT_EQ(tables[1].rows.size(), report.network.hops_by_kind.size() + 1);
+  std::uint64_t packets = 0;
+  for (std::size_t i = 0; i + 1 < tables[1].rows.size(); ++i) packets += std::stoull(tables[1].rows[i][1]);
+  EXPECT_EQ(tables[1].rows.back()[0], "all");
+  EXPECT_EQ(std::to_string(packets), tables[1].rows.back()[1]);
+  // A split run adds the ranks' table, a row per rank.
+  report.ranks.resize(2);
+  report.ranks[0].node_count = 2;
+  report.ranks[1].rank = 1;
+  report.ranks[1].first_node = 2;
+  report.ranks[1].node_count = 2;
+  report.cut_links = 2;
+  tables = app::machine_tables(report);
+  ASSERT_EQ(tables.size(), 3u);
+  EXPECT_EQ(tables[2].caption, "Per MPI rank (2 links cut)");
+  ASSERT_EQ(tables[2].rows.size(), 2u);
+  EXPECT_EQ(tables[2].rows[1][1], "2-3");
 }
 
 }  // namespace
