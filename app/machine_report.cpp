@@ -50,10 +50,9 @@ void print_per_node(std::ostream& out, const nodes::MachineReport& r, const char
   print_node_row(out, static_cast<std::size_t>(most - nodes.begin()), *most);
 }
 
-void json_svm(std::ostream& out, const nodes::SvmStats& s) {
-  out << "{\"accesses\": " << s.accesses() << ", \"local_hits\": " << s.own_hits
-      << ", \"cache_hits\": " << s.cache_hits << ", \"misses\": " << s.misses
-      << ", \"coalesced\": " << s.coalesced << ", \"miss_ratio\": " << s.miss_ratio() << "}";
+Json json_svm(const nodes::SvmStats& s) {
+  return {{"accesses", s.accesses()}, {"local_hits", s.own_hits}, {"cache_hits", s.cache_hits},
+          {"misses", s.misses},       {"coalesced", s.coalesced}, {"miss_ratio", s.miss_ratio()}};
 }
 
 // The cache a node actually has: what was asked for, capped at the pages it
@@ -64,50 +63,45 @@ std::uint32_t largest_cache(const nodes::MachineReport& r) {
   return largest;
 }
 
-void json_per_node(std::ostream& out, const nodes::MachineReport& r, const std::string& indent) {
-  out << "[";
+Json json_per_node(const nodes::MachineReport& r) {
+  Json nodes = Json::array();
   for (std::size_t n = 0; n < r.per_node.size(); ++n) {
     const nodes::NodeReport& x = r.per_node[n];
-    out << (n ? "," : "") << "\n" << indent << "  {\"node\": " << n << ", \"pixels\": " << x.work.items
-        << ", \"tiles\": " << x.work.tiles << ", \"rays\": " << x.work.rays.rays() << ", \"svm\": ";
-    json_svm(out, x.svm);
-    out << ", \"pages_served\": " << x.served.pages_served << ", \"bytes_served\": "
-        << x.served.bytes_served << ", \"own_bytes\": " << x.own_bytes << ", \"cache_pages\": "
-        << x.cache_capacity << ", \"evictions\": " << x.evictions << ", \"peak_resident_bytes\": "
-        << x.peak_resident_bytes << "}";
+    nodes.push_back({{"node", n},
+                     {"pixels", x.work.items},
+                     {"tiles", x.work.tiles},
+                     {"rays", x.work.rays.rays()},
+                     {"svm", json_svm(x.svm)},
+                     {"pages_served", x.served.pages_served},
+                     {"bytes_served", x.served.bytes_served},
+                     {"own_bytes", x.own_bytes},
+                     {"cache_pages", x.cache_capacity},
+                     {"evictions", x.evictions},
+                     {"peak_resident_bytes", x.peak_resident_bytes}});
   }
-  out << "\n" << indent << "]";
+  return nodes;
 }
 
-void json_network(std::ostream& out, const nodes::NetworkStats& s) {
-  out << "{\"packets\": " << s.hops.packets << ", \"mean_hops\": " << s.hops.mean()
-      << ", \"max_hops\": " << s.hops.max_hops << ", \"by_kind\": {";
-  bool first = true;
-  for (const auto& [kind, h] : s.hops_by_kind) {
-    out << (first ? "" : ", ") << json_string(kind_name(kind)) << ": {\"packets\": " << h.packets
-        << ", \"mean_hops\": " << h.mean() << ", \"max_hops\": " << h.max_hops << "}";
-    first = false;
-  }
-  out << "}, \"busiest_link\": ";
-  const nodes::LinkStats* busiest = nodes::busiest_link(s);
-  if (!busiest) out << "null";
-  else
-    out << "{\"from\": " << busiest->from << ", \"to\": " << busiest->to << ", \"packets\": "
-        << busiest->packets << ", \"bytes\": " << busiest->bytes << "}";
-  out << "}";
+Json json_network(const nodes::NetworkStats& s) {
+  Json by_kind = Json::object();
+  for (const auto& [kind, h] : s.hops_by_kind)
+    by_kind[kind_name(kind)] = {{"packets", h.packets}, {"mean_hops", h.mean()}, {"max_hops", h.max_hops}};
+  Json busiest = nullptr;
+  if (const nodes::LinkStats* b = nodes::busiest_link(s))
+    busiest = {{"from", b->from}, {"to", b->to}, {"packets", b->packets}, {"bytes", b->bytes}};
+  return {{"packets", s.hops.packets},
+          {"mean_hops", s.hops.mean()},
+          {"max_hops", s.hops.max_hops},
+          {"by_kind", std::move(by_kind)},
+          {"busiest_link", std::move(busiest)}};
 }
 
 // [{"id": 17, "kind": "page_request", "nodes": [5, 4, 6]}, ...]
-void json_routes(std::ostream& out, const nodes::NetworkStats& s) {
-  out << "[";
-  for (std::size_t i = 0; i < s.routes.size(); ++i) {
-    const nodes::RouteRecord& r = s.routes[i];
-    out << (i ? ", " : "") << "{\"id\": " << r.id << ", \"kind\": " << json_string(kind_name(r.kind))
-        << ", \"nodes\": [";
-    for (std::size_t k = 0; k < r.route.size(); ++k) out << (k ? ", " : "") << r.route[k];
-    out << "]}";
-  }
-  out << "]";
+Json json_routes(const nodes::NetworkStats& s) {
+  Json routes = Json::array();
+  for (const nodes::RouteRecord& r : s.routes)
+    routes.push_back({{"id", r.id}, {"kind", kind_name(r.kind)}, {"nodes", r.route}});
+  return routes;
 }
 
 // Which ranks ran which nodes, and what crossed between them.
@@ -130,30 +124,51 @@ void print_ranks(std::ostream& out, const nodes::MachineReport& r) {
   }
 }
 
-void json_ranks(std::ostream& out, const nodes::MachineReport& r, const std::string& indent) {
-  out << "[";
-  for (std::size_t i = 0; i < r.ranks.size(); ++i) {
-    const nodes::RankReport& k = r.ranks[i];
-    out << (i ? "," : "") << "\n" << indent << "  {\"rank\": " << k.rank << ", \"first_node\": " << k.first_node
-        << ", \"nodes\": " << k.node_count << ", \"threads\": " << k.threads
-        << ", \"packets_sent\": " << k.bridge.packets_sent << ", \"bytes_sent\": " << k.bridge.bytes_sent
-        << ", \"packets_received\": " << k.bridge.packets_received
-        << ", \"bytes_received\": " << k.bridge.bytes_received << ", \"messages_sent\": " << k.bridge.messages_sent
-        << ", \"wire_bytes_sent\": " << k.bridge.wire_bytes_sent << ", \"polls\": " << k.bridge.polls
-        << ", \"peak_scene_bytes\": " << k.peak_scene_bytes << ", \"cpu_seconds\": " << k.cpu_seconds
-        << ", \"wall_seconds\": " << k.wall_seconds << "}";
-  }
-  out << (r.ranks.empty() ? "" : "\n" + indent) << "]";
+Json json_ranks(const nodes::MachineReport& r) {
+  Json ranks = Json::array();
+  for (const nodes::RankReport& k : r.ranks)
+    ranks.push_back({{"rank", k.rank},
+                     {"first_node", k.first_node},
+                     {"nodes", k.node_count},
+                     {"threads", k.threads},
+                     {"packets_sent", k.bridge.packets_sent},
+                     {"bytes_sent", k.bridge.bytes_sent},
+                     {"packets_received", k.bridge.packets_received},
+                     {"bytes_received", k.bridge.bytes_received},
+                     {"messages_sent", k.bridge.messages_sent},
+                     {"wire_bytes_sent", k.bridge.wire_bytes_sent},
+                     {"polls", k.bridge.polls},
+                     {"peak_scene_bytes", k.peak_scene_bytes},
+                     {"cpu_seconds", k.cpu_seconds},
+                     {"wall_seconds", k.wall_seconds}});
+  return ranks;
 }
 
 // The relays' counters per thread, as print_relays sums them.
-void json_relays(std::ostream& out, const nodes::MachineReport& r) {
-  out << ", \"relayed_links\": " << r.relayed_links << ", \"relays\": [";
-  for (std::size_t t = 0; t < r.relays.size(); ++t)
-    out << (t ? ", " : "") << "{\"packets_sent\": " << r.relays[t].packets_sent
-        << ", \"packets_received\": " << r.relays[t].packets_received << ", \"wakes\": " << r.relays[t].wakes
-        << ", \"signals\": " << r.relays[t].signals << "}";
-  out << "]";
+Json json_relays(const nodes::MachineReport& r) {
+  Json relays = Json::array();
+  for (const nodes::RelayCounters& t : r.relays)
+    relays.push_back({{"packets_sent", t.packets_sent},
+                      {"packets_received", t.packets_received},
+                      {"wakes", t.wakes},
+                      {"signals", t.signals}});
+  return relays;
+}
+
+Json json_host_threads(const std::vector<csp::ThreadUse>& threads) {
+  Json out = Json::array();
+  for (const csp::ThreadUse& t : threads)
+    out.push_back({{"seconds", t.seconds},
+                   {"idle_seconds", t.idle_seconds},
+                   {"running_seconds", t.running_seconds},
+                   {"spinning_seconds", t.spinning_seconds},
+                   {"sleeping_seconds", t.sleeping_seconds},
+                   {"cpu_seconds", t.cpu_seconds},
+                   {"waits", t.waits},
+                   {"sleeps", t.sleeps},
+                   {"remote_wakes", t.remote_wakes},
+                   {"sleepers_woken", t.sleepers_woken}});
+  return out;
 }
 
 // One line per runtime thread: where its time went, as shares of its wall
@@ -269,60 +284,50 @@ std::vector<std::uint8_t> parse_trace_kinds(const std::string& names) {
   return kinds;
 }
 
-void write_machine_json(std::ostream& out, const MachineSummary& m, const std::string& indent) {
+Json machine_json(const MachineSummary& m) {
   const nodes::MachineReport& r = m.report;
   const nodes::ServerCounters served = r.served();
-  const std::string in = indent + "  ";
-  out << "{\n"
-      << in << "\"topology\": " << json_string(r.topology) << ", \"nodes\": " << r.nodes
-      << ", \"threads\": " << r.threads << ", \"workers_per_node\": " << r.workers_per_node
-      << ", \"prefetch\": " << r.prefetch << ", \"schedule\": " << json_string(nodes::schedule_name(r.schedule))
-      << ", \"pixel_order\": " << json_string(nodes::pixel_order_name(r.pixel_order)) << ", \"grain\": " << r.grain
-      << ", \"steals\": " << r.farmer.steals << ",\n"
-      << in << "\"cache_pages\": " << r.cache_pages << ", \"cache_kb\": "
-      << double(r.cache_pages) * r.page_size / 1024.0 << ", \"cache_pages_largest_in_use\": " << largest_cache(r)
-      << ", \"database_pages\": " << r.page_count
-      << ", \"database_kb\": " << double(r.page_count) * r.page_size / 1024.0 << ",\n"
-      << in << "\"svm\": ";
-  json_svm(out, r.svm());
-  out << ",\n"
-      << in << "\"page_communications\": " << served.pages_served << ", \"page_bytes\": "
-      << served.bytes_served << ", \"pages_per_pixel\": " << r.rays().pages_per_sample() << ",\n"
-      << in << "\"imbalance\": {\"pixels\": " << r.item_imbalance() << ", \"rays\": "
-      << r.ray_imbalance() << "},\n"
-      << in << "\"per_node\": ";
-  json_per_node(out, r, in);
-  out << ",\n" << in << "\"network\": ";
-  json_network(out, r.network);
-  out << ",\n" << in << "\"routes\": ";
-  json_routes(out, r.network);
-  out << ",\n" << in << "\"cut_links\": " << r.cut_links << ", \"ranks\": ";
-  json_ranks(out, r, in);
-  out << ",\n" << in << "\"wall_seconds\": " << r.wall_seconds;
+  Json j = {{"topology", r.topology},
+            {"nodes", r.nodes},
+            {"threads", r.threads},
+            {"workers_per_node", r.workers_per_node},
+            {"prefetch", r.prefetch},
+            {"schedule", std::string(nodes::schedule_name(r.schedule))},
+            {"pixel_order", std::string(nodes::pixel_order_name(r.pixel_order))},
+            {"grain", r.grain},
+            {"steals", r.farmer.steals},
+            {"cache_pages", r.cache_pages},
+            {"cache_kb", double(r.cache_pages) * r.page_size / 1024.0},
+            {"cache_pages_largest_in_use", largest_cache(r)},
+            {"database_pages", r.page_count},
+            {"database_kb", double(r.page_count) * r.page_size / 1024.0},
+            {"svm", json_svm(r.svm())},
+            {"page_communications", served.pages_served},
+            {"page_bytes", served.bytes_served},
+            {"pages_per_pixel", r.rays().pages_per_sample()},
+            {"imbalance", {{"pixels", r.item_imbalance()}, {"rays", r.ray_imbalance()}}},
+            {"per_node", json_per_node(r)},
+            {"network", json_network(r.network)},
+            {"routes", json_routes(r.network)},
+            {"cut_links", r.cut_links},
+            {"ranks", json_ranks(r)},
+            {"wall_seconds", r.wall_seconds}};
   if (r.cost_model.empty()) {
-    out << ", \"host_threads\": [";
-    for (std::size_t t = 0; t < r.host_threads.size(); ++t)
-      out << (t ? ", " : "") << "{\"seconds\": " << r.host_threads[t].seconds
-          << ", \"idle_seconds\": " << r.host_threads[t].idle_seconds
-          << ", \"running_seconds\": " << r.host_threads[t].running_seconds
-          << ", \"spinning_seconds\": " << r.host_threads[t].spinning_seconds
-          << ", \"sleeping_seconds\": " << r.host_threads[t].sleeping_seconds
-          << ", \"cpu_seconds\": " << r.host_threads[t].cpu_seconds << ", \"waits\": " << r.host_threads[t].waits
-          << ", \"sleeps\": " << r.host_threads[t].sleeps << ", \"remote_wakes\": " << r.host_threads[t].remote_wakes
-          << ", \"sleepers_woken\": " << r.host_threads[t].sleepers_woken << "}";
-    out << "]";
-    json_relays(out, r);
+    j["host_threads"] = json_host_threads(r.host_threads);
+    j["relayed_links"] = r.relayed_links;
+    j["relays"] = json_relays(r);
+  } else {
+    j["cost_model"] = r.cost_model;
+    j["predicted_seconds"] = r.predicted_seconds;
   }
-  if (!r.cost_model.empty())
-    out << ", \"cost_model\": " << json_string(r.cost_model) << ", \"predicted_seconds\": "
-        << r.predicted_seconds;
-  out << ",\n" << in << "\"serial\": ";
+  j["serial"] = nullptr;
   if (m.serial)
-    out << "{\"seconds\": " << m.serial->seconds << ", \"threads\": " << m.serial->threads
-        << ", \"parallel_seconds\": " << m.parallel_seconds()
-        << ", \"speedup\": " << m.speedup() << ", \"efficiency\": " << m.efficiency() << "}";
-  else out << "null";
-  out << "\n" << indent << "}";
+    j["serial"] = {{"seconds", m.serial->seconds},
+                   {"threads", m.serial->threads},
+                   {"parallel_seconds", m.parallel_seconds()},
+                   {"speedup", m.speedup()},
+                   {"efficiency", m.efficiency()}};
+  return j;
 }
 
 std::string tiles_csv(const nodes::MachineReport& report) {

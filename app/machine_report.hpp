@@ -6,15 +6,19 @@
 // the tiles, when recorded, as a CSV timeline.
 #pragma once
 
+#include <cstdint>
+#include <nlohmann/json.hpp>
 #include <optional>
 #include <ostream>
-#include <cstdint>
 #include <string>
 #include <vector>
 
 #include "nodes/machine.hpp"
 
 namespace app {
+
+// Objects keep their keys in the order written, as people read them.
+using Json = nlohmann::ordered_json;
 
 // The 1-node machine on the same scene, for speedup T1/TN and efficiency T1/(N*TN).
 // seconds: wall time, or the predicted (virtual) time when the run has a cost model.
@@ -49,7 +53,7 @@ std::vector<std::uint8_t> parse_trace_kinds(const std::string& names);
 // first_item, items, start_s, end_s, page_requests, rays. Items are numbered
 // in the run's pixel order.
 std::string tiles_csv(const nodes::MachineReport& report);
-// One JSON object, no trailing newline; nested lines start with indent.
-void write_machine_json(std::ostream& out, const MachineSummary& m, const std::string& indent);
+// The machine's part of the --stats document, the same fields as the summary.
+Json machine_json(const MachineSummary& m);
 
 }  // namespace app

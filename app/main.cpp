@@ -61,7 +61,7 @@ void check_distinct_outputs(const app::Options& o) {
 }
 
 // The whole run in this process, or rank 0's part over `ranks`.
-int run(const app::Options& o, nodes::Transport* ranks = nullptr) {
+int run(const app::Options& o, const std::vector<std::string>& command_line, nodes::Transport* ranks = nullptr) {
   tracer::Scene scene;
   double load_seconds = 0;
   try {
@@ -77,6 +77,8 @@ int run(const app::Options& o, nodes::Transport* ranks = nullptr) {
   }
   app::RenderResult result = o.single ? app::render_single(o, scene) : app::render_machine(o, scene, ranks);
   result.report.load_seconds = load_seconds;
+  result.report.version = VMPRAY_VERSION;
+  result.report.command_line = command_line;
   app::OutputPhase phase;
   app::OutputFiles& outputs = phase.files();  // removed again if a later step fails
   outputs.write(o.output, [&](const auto& path) { result.image.write_image(path.string()); });
@@ -123,7 +125,7 @@ int rank_main(int argc, char** argv, const vmpi::MpiSession& mpi) {
   options.machine.shared_cores = app::cores_shared(options.machine.threads, mpi.ranks_on_this_host());
   try {
     vmpi::MpiTransport transport;
-    if (host) return run(options, &transport);
+    if (host) return run(options, std::vector<std::string>(argv, argv + argc), &transport);
     app::serve_rank(options, transport);
     return 0;
   } catch (const nodes::RankFailure& e) {  // every rank knows: rank 0 says it
@@ -162,7 +164,7 @@ int one_process(int argc, char** argv) {
     return 0;
   }
   try {
-    return run(options);
+    return run(options, std::vector<std::string>(argv, argv + argc));
   } catch (const app::UsageError& e) {  // an image too large: no help to see
     std::cerr << "vmpray: " << e.what() << "\n";
     return 2;

@@ -7,6 +7,7 @@
 #include <optional>
 #include <ostream>
 #include <string>
+#include <vector>
 
 #include "app/machine_report.hpp"
 #include "tracer/database.hpp"
@@ -14,7 +15,12 @@
 
 namespace app {
 
+// The --stats document's layout: raised when a field changes meaning or goes.
+inline constexpr int stats_schema_version = 2;
+
 struct RunReport {
+  std::string version;                    // of vmpray
+  std::vector<std::string> command_line;  // as typed: the program, then its arguments
   std::string scene;
   std::string output;
   int width = 0, height = 0;
@@ -42,6 +48,8 @@ struct RunReport {
 void print_report(std::ostream& out, const RunReport& r);
 // s as a JSON string literal, quotes included.
 std::string json_string(const std::string& s);
+// j as JSON text (indent < 0: one line); bytes that are not UTF-8 become U+FFFD.
+std::string dump_json(const Json& j, int indent = -1);
 // The report as the JSON document --stats writes.
 std::string stats_json(const RunReport& r);
 

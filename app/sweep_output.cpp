@@ -27,9 +27,6 @@ std::string number(double v) {
   return out.str();
 }
 
-// As the render's report quotes: valid UTF-8 whatever the scene's file name.
-std::string quoted(const std::string& s) { return json_string(s); }
-
 const char* const csv_header =
     "scene,topology,nodes,cache_pages,predicted_seconds,predicted_hms,speedup,efficiency,miss_ratio,"
     "page_requests,page_accesses,pages_per_pixel,mean_hops,messages,rays,wall_seconds";
@@ -116,25 +113,34 @@ std::string sweep_csv(const SweepTable& t) {
 }
 
 std::string sweep_json(const SweepTable& t) {
-  std::ostringstream out;
-  out << "{\n  \"sweep\": " << quoted(kind_name(t.kind)) << ",\n  \"scene\": " << quoted(t.scene)
-      << ",\n  \"width\": " << t.width << ",\n  \"height\": " << t.height << ",\n  \"pages\": " << t.page_count
-      << ",\n  \"tracing\": " << quoted(t.tracing) << ",\n  \"farming\": " << quoted(t.farming)
-      << ",\n  \"cost_model\": " << quoted(t.model.describe())
-      << ",\n  \"serial_seconds\": "
-      << number(t.serial_seconds) << ",\n  \"points\": [";
-  for (std::size_t i = 0; i < t.points.size(); ++i) {
-    const ExperimentPoint& p = t.points[i];
-    out << (i ? "," : "") << "\n    {\"topology\": " << quoted(p.topology) << ", \"nodes\": " << p.nodes
-        << ", \"cache_pages\": " << p.cache_pages << ", \"predicted_seconds\": " << number(p.predicted_seconds)
-        << ", \"speedup\": " << number(p.speedup()) << ", \"efficiency\": " << number(p.efficiency())
-        << ", \"miss_ratio\": " << number(p.miss_ratio) << ", \"page_requests\": " << p.misses
-        << ", \"page_accesses\": " << p.page_accesses << ", \"pages_per_pixel\": " << number(p.pages_per_pixel)
-        << ", \"mean_hops\": " << number(p.mean_hops) << ", \"messages\": " << p.messages << ", \"rays\": " << p.rays
-        << ", \"wall_seconds\": " << number(p.wall_seconds) << "}";
-  }
-  out << "\n  ]\n}\n";
-  return out.str();
+  Json points = Json::array();
+  for (const ExperimentPoint& p : t.points)
+    points.push_back({{"topology", p.topology},
+                      {"nodes", p.nodes},
+                      {"cache_pages", p.cache_pages},
+                      {"predicted_seconds", p.predicted_seconds},
+                      {"speedup", p.speedup()},
+                      {"efficiency", p.efficiency()},
+                      {"miss_ratio", p.miss_ratio},
+                      {"page_requests", p.misses},
+                      {"page_accesses", p.page_accesses},
+                      {"pages_per_pixel", p.pages_per_pixel},
+                      {"mean_hops", p.mean_hops},
+                      {"messages", p.messages},
+                      {"rays", p.rays},
+                      {"wall_seconds", p.wall_seconds}});
+  // A number that is not finite is written as null.
+  const Json j = {{"sweep", kind_name(t.kind)},
+                  {"scene", t.scene},
+                  {"width", t.width},
+                  {"height", t.height},
+                  {"pages", t.page_count},
+                  {"tracing", t.tracing},
+                  {"farming", t.farming},
+                  {"cost_model", t.model.describe()},
+                  {"serial_seconds", t.serial_seconds},
+                  {"points", std::move(points)}};
+  return dump_json(j, 2) + "\n";
 }
 
 std::vector<std::filesystem::path> write_sweep(const SweepTable& t, const std::filesystem::path& dir,

@@ -290,12 +290,13 @@ bool valid_utf8(const std::string& s) {
 }
 
 TEST(JsonString, KeepsUtf8AndReplacesWhatIsNot) {
+  const std::string fffd = "\xef\xbf\xbd";  // U+FFFD, the replacement character
   EXPECT_EQ(app::json_string("caf\xc3\xa9 \xe2\x82\xac"), "\"caf\xc3\xa9 \xe2\x82\xac\"");
-  EXPECT_EQ(app::json_string("lat\xe9.nff"), "\"lat\\ufffd.nff\"");
-  EXPECT_EQ(app::json_string("\xc0\xaf"), "\"\\ufffd\\ufffd\"") << "an overlong '/'";
-  EXPECT_EQ(app::json_string("\xed\xa0\x80"), "\"\\ufffd\\ufffd\\ufffd\"") << "a surrogate";
-  EXPECT_EQ(app::json_string("\xe2\x82"), "\"\\ufffd\\ufffd\"") << "cut short";
-  EXPECT_EQ(app::json_string("a\"b\\\n"), "\"a\\\"b\\\\\\u000a\"");
+  EXPECT_EQ(app::json_string("lat\xe9.nff"), "\"lat" + fffd + ".nff\"");
+  EXPECT_EQ(app::json_string("\xc0\xaf"), "\"" + fffd + fffd + "\"") << "an overlong '/'";
+  EXPECT_EQ(app::json_string("\xed\xa0\x80"), "\"" + fffd + fffd + fffd + "\"") << "a surrogate";
+  EXPECT_EQ(app::json_string("\xe2\x82"), "\"" + fffd + "\"") << "cut short";
+  EXPECT_EQ(app::json_string("a\"b\\\n\x01"), "\"a\\\"b\\\\\\n\\u0001\"");
 }
 
 // A scene whose file name is not UTF-8 (Latin-1 here) still gives a valid
@@ -307,7 +308,7 @@ TEST_F(Checks, StatsJsonIsUtf8WhateverTheFileName) {
   ASSERT_EQ(r.exit_code, 0) << r.err;
   const std::string json = test::read_file(dir_ / "s.json");
   EXPECT_TRUE(valid_utf8(json));
-  EXPECT_NE(json.find("\"scene\": \"lat\\ufffd.nff\""), std::string::npos) << json;
+  EXPECT_NE(json.find("\"scene\": \"lat\xef\xbf\xbd.nff\""), std::string::npos) << json;
 }
 
 }  // namespace

@@ -184,7 +184,7 @@ TEST(Sweep, NodesSweepWritesWellFormedTablesAndPlots) {
   const std::string json = read(dir / "nodes.json");
   EXPECT_EQ(std::count(json.begin(), json.end(), '{'), std::count(json.begin(), json.end(), '}'));
   EXPECT_EQ(std::count(json.begin(), json.end(), '['), std::count(json.begin(), json.end(), ']'));
-  EXPECT_NE(json.find("\"efficiency\": 1,"), std::string::npos);
+  EXPECT_NE(json.find("\"efficiency\": 1.0,"), std::string::npos);
   EXPECT_NE(json.find("\"tracing\": \"bvh, treelet layout, shadow rays facing\""), std::string::npos);
   EXPECT_NE(json.find("\"farming\": \"dynamic schedule, grain 4, prefetch 0, scanline order\""), std::string::npos);
   EXPECT_EQ(json.find("nan"), std::string::npos);

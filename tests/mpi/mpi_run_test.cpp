@@ -124,7 +124,7 @@ TEST_F(Mpirun, OnlyRankZeroWritesAndTheReportNamesTheRanks) {
   EXPECT_NE(r.out.find("10-15"), std::string::npos) << r.out;
   const std::string json = read_file(dir_ / "s.json");
   EXPECT_NE(json.find("\"cut_links\": 10"), std::string::npos);
-  for (const char* rank : {"{\"rank\": 0,", "{\"rank\": 1,", "{\"rank\": 2,"})
+  for (const char* rank : {"\"rank\": 0,", "\"rank\": 1,", "\"rank\": 2,"})
     EXPECT_NE(json.find(rank), std::string::npos) << rank;
   EXPECT_EQ(r.err, "");
 }
