@@ -284,6 +284,20 @@ std::vector<std::uint8_t> parse_trace_kinds(const std::string& names) {
   return kinds;
 }
 
+Json cost_model_json(const nodes::CostModel& model) {
+  return {{"name", model.name},
+          {"unit", model.unit},
+          {"box", model.box},
+          {"prim", model.prim},
+          {"shade", model.shade},
+          {"page", model.page},
+          {"serve", model.serve},
+          {"msg", model.msg},
+          {"hop", model.hop},
+          {"bandwidth", model.bandwidth},
+          {"description", model.describe()}};
+}
+
 Json machine_json(const MachineSummary& m) {
   const nodes::MachineReport& r = m.report;
   const nodes::ServerCounters served = r.served();
@@ -317,7 +331,7 @@ Json machine_json(const MachineSummary& m) {
     j["relayed_links"] = r.relayed_links;
     j["relays"] = json_relays(r);
   } else {
-    j["cost_model"] = r.cost_model;
+    j["cost_model"] = r.model ? cost_model_json(*r.model) : Json(r.cost_model);
     j["predicted_seconds"] = r.predicted_seconds;
   }
   j["serial"] = nullptr;

@@ -137,7 +137,7 @@ std::string sweep_json(const SweepTable& t) {
                   {"pages", t.page_count},
                   {"tracing", t.tracing},
                   {"farming", t.farming},
-                  {"cost_model", t.model.describe()},
+                  {"cost_model", cost_model_json(t.model)},
                   {"serial_seconds", t.serial_seconds},
                   {"points", std::move(points)}};
   return dump_json(j, 2) + "\n";

@@ -131,6 +131,23 @@ TEST_F(MachineCli, DefaultMachineWritesImageAndJsonWithMachineFields) {
   EXPECT_NE(r.out.find("running "), std::string::npos) << r.out;
 }
 
+// In virtual time the cost model is an object with every constant, the
+// iPSC/2's as the paper gives them, and no host-thread accounting.
+TEST_F(MachineCli, VirtualTimeStatsCarryTheCostModelAsAnObject) {
+  const Outcome r = run(std::string(kSmall) + " --timing virtual -q -o out.png --stats s.json");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const Json m = Json::parse(read_file(dir_ / "s.json")).at("machine");
+  const Json& model = m.at("cost_model");
+  ASSERT_TRUE(model.is_object()) << model;
+  EXPECT_EQ(model.at("name").get<std::string>(), "ipsc2");
+  EXPECT_DOUBLE_EQ(model.at("msg").get<double>(), 175e-6);
+  for (const char* constant : {"unit", "box", "prim", "shade", "page", "serve", "hop", "bandwidth"})
+    EXPECT_GE(model.at(constant).get<double>(), 0) << constant;
+  EXPECT_NE(model.at("description").get<std::string>().find("ipsc2"), std::string::npos);
+  EXPECT_GT(m.at("predicted_seconds").get<double>(), 0);
+  EXPECT_FALSE(m.contains("host_threads"));
+}
+
 TEST_F(MachineCli, AffinityScheduleIsReportedWithItsSteals) {
   const Outcome r = run(std::string(kSmall) + " --schedule affinity --grain 4 -o out.png --stats s.json");
   ASSERT_EQ(r.exit_code, 0) << r.err;
