@@ -1,9 +1,7 @@
 // Human-readable and JSON forms of RunReport.
 #include "app/report.hpp"
 
-#include <cstdio>
 #include <iomanip>
-#include <sstream>
 
 #include "app/options.hpp"
 #include "app/wording.hpp"
@@ -12,8 +10,6 @@ namespace app {
 
 // JSON text is UTF-8 (RFC 8259): a byte that is not part of a well-formed
 // sequence, as in a file name in Latin-1, becomes U+FFFD.
-std::string json_string(const std::string& s) { return dump_json(Json(s)); }
-
 std::string dump_json(const Json& j, int indent) { return j.dump(indent, ' ', false, Json::error_handler_t::replace); }
 
 void print_report(std::ostream& out, const RunReport& r) {

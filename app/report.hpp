@@ -46,8 +46,6 @@ struct RunReport {
 };
 
 void print_report(std::ostream& out, const RunReport& r);
-// s as a JSON string literal, quotes included.
-std::string json_string(const std::string& s);
 // j as JSON text (indent < 0: one line); bytes that are not UTF-8 become U+FFFD.
 std::string dump_json(const Json& j, int indent = -1);
 // The report as the JSON document --stats writes.

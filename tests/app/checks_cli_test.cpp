@@ -289,14 +289,15 @@ bool valid_utf8(const std::string& s) {
   return true;
 }
 
-TEST(JsonString, KeepsUtf8AndReplacesWhatIsNot) {
+TEST(JsonText, KeepsUtf8AndReplacesWhatIsNot) {
+  const auto json_string = [](const std::string& s) { return app::dump_json(app::Json(s)); };
   const std::string fffd = "\xef\xbf\xbd";  // U+FFFD, the replacement character
-  EXPECT_EQ(app::json_string("caf\xc3\xa9 \xe2\x82\xac"), "\"caf\xc3\xa9 \xe2\x82\xac\"");
-  EXPECT_EQ(app::json_string("lat\xe9.nff"), "\"lat" + fffd + ".nff\"");
-  EXPECT_EQ(app::json_string("\xc0\xaf"), "\"" + fffd + fffd + "\"") << "an overlong '/'";
-  EXPECT_EQ(app::json_string("\xed\xa0\x80"), "\"" + fffd + fffd + fffd + "\"") << "a surrogate";
-  EXPECT_EQ(app::json_string("\xe2\x82"), "\"" + fffd + "\"") << "cut short";
-  EXPECT_EQ(app::json_string("a\"b\\\n\x01"), "\"a\\\"b\\\\\\n\\u0001\"");
+  EXPECT_EQ(json_string("caf\xc3\xa9 \xe2\x82\xac"), "\"caf\xc3\xa9 \xe2\x82\xac\"");
+  EXPECT_EQ(json_string("lat\xe9.nff"), "\"lat" + fffd + ".nff\"");
+  EXPECT_EQ(json_string("\xc0\xaf"), "\"" + fffd + fffd + "\"") << "an overlong '/'";
+  EXPECT_EQ(json_string("\xed\xa0\x80"), "\"" + fffd + fffd + fffd + "\"") << "a surrogate";
+  EXPECT_EQ(json_string("\xe2\x82"), "\"" + fffd + "\"") << "cut short";
+  EXPECT_EQ(json_string("a\"b\\\n\x01"), "\"a\\\"b\\\\\\n\\u0001\"");
 }
 
 // A scene whose file name is not UTF-8 (Latin-1 here) still gives a valid
