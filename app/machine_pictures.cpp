@@ -16,9 +16,6 @@ namespace app {
 
 namespace {
 
-// The page's images: the rendered image and the ownership picture.
-constexpr int kReportImages = 2;
-
 viz::MachineKind drawing_kind(topology::Kind kind) {
   switch (kind) {
     case topology::Kind::hypercube: return viz::MachineKind::hypercube;
@@ -152,17 +149,12 @@ std::vector<std::pair<std::string, std::filesystem::path>> picture_outputs(const
   if (!files.machine_svg.empty()) out.emplace_back("--machine-svg", files.machine_svg);
   if (!files.ownership_png.empty()) out.emplace_back("--ownership", files.ownership_png);
   if (!files.timeline_svg.empty()) out.emplace_back("--timeline", files.timeline_svg);
-  if (!files.report_html.empty()) {
-    for (int image = 1; image <= kReportImages; ++image)
-      out.emplace_back("--report's image", viz::report_image_path(files.report_html, image));
-    out.emplace_back("--report", files.report_html);
-  }
+  if (!files.report_html.empty()) out.emplace_back("--report", files.report_html);
   return out;
 }
 
-std::vector<std::filesystem::path> write_machine_pictures(const PictureFiles& files, const std::string& title,
-                                                          tracer::Image image,
-                                                          const nodes::MachineReport& report) {
+std::vector<std::filesystem::path> write_machine_pictures(const PictureFiles& files, viz::Report page,
+                                                          tracer::Image image, const nodes::MachineReport& report) {
   std::vector<std::filesystem::path> written;
   if (files.machine_svg.empty() && files.ownership_png.empty() && files.report_html.empty() &&
       files.timeline_svg.empty())
@@ -196,9 +188,8 @@ std::vector<std::filesystem::path> write_machine_pictures(const PictureFiles& fi
                                           .image = std::move(ownership),
                                           .key = ownership_key(static_cast<int>(report.nodes))});
     run.blocks.push_back(viz::SvgFigure{.caption = "when each processor traced each tile", .svg = tiles});
-    viz::Report page{.title = title};
-    page.sections.push_back(std::move(run));  // a braced list of sections would copy it
-    for (const auto& f : viz::write_html_report(files.report_html, page, outputs.tracker())) written.push_back(f);
+    page.sections.push_back(std::move(run));
+    written.push_back(outputs.write_text(files.report_html, viz::html_report(page)));
   }
   outputs.keep();
   return written;

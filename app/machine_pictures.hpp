@@ -44,16 +44,17 @@ struct PictureFiles {
 };
 
 // Every file write_machine_pictures writes for `files`, in order, each with
-// the option that asks for it ("--report's image" for the page's images).
+// the option that asks for it.
 std::vector<std::pair<std::string, std::filesystem::path>> picture_outputs(const PictureFiles& files);
 
-// Writes the pictures asked for (none: nothing to do); returns every file written. The
+// Writes the pictures asked for (none: nothing to do); returns every file written.
+// `page` gives the HTML page its title, version and command line; the run's
+// section is added to its sections. The
 // timeline, alone or in the page, needs a run that recorded its tiles
 // (std::invalid_argument otherwise). Throws std::runtime_error naming the path if one
 // cannot be written, after removing those it had written. The rendered image is
 // taken by value for the page to keep without a copy: a caller done with it moves it in.
-std::vector<std::filesystem::path> write_machine_pictures(const PictureFiles& files, const std::string& title,
-                                                          tracer::Image image,
-                                                          const nodes::MachineReport& report);
+std::vector<std::filesystem::path> write_machine_pictures(const PictureFiles& files, viz::Report page,
+                                                          tracer::Image image, const nodes::MachineReport& report);
 
 }  // namespace app

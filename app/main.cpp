@@ -92,8 +92,10 @@ int run(const app::Options& o, const std::vector<std::string>& command_line, nod
   if (result.report.machine && !o.tiles_csv.empty())
     outputs.write_text(o.tiles_csv, app::tiles_csv(result.report.machine->report));
   if (result.report.machine)  // removes what it wrote if it fails; the image is written and not needed again
-    for (const auto& path : app::write_machine_pictures(picture_files(o), result.report.scene, std::move(result.image),
-                                                        result.report.machine->report))
+    for (const auto& path : app::write_machine_pictures(
+             picture_files(o),
+             {.title = result.report.scene, .version = "vmpray " VMPRAY_VERSION, .command_line = command_line},
+             std::move(result.image), result.report.machine->report))
       outputs.add(path);
   return phase.finish(std::cout, "report");
 }

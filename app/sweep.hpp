@@ -47,6 +47,9 @@ struct SweepOptions {
   bool quiet = false;
 };
 
+// Of the sweep JSON: raised whenever a field changes meaning or goes away.
+inline constexpr int sweep_schema_version = 1;
+
 struct SweepTable {
   SweepOptions::Kind kind = SweepOptions::Kind::nodes;
   std::string scene;
@@ -57,6 +60,7 @@ struct SweepTable {
   nodes::CostModel model;
   double serial_seconds = 0;  // T1
   std::vector<ExperimentPoint> points;
+  std::vector<std::string> command_line;  // as typed: "vmpray", "sweep", then the options; empty: not known
 };
 
 // argv[0] is "sweep". Throws UsageError (options.hpp) for a bad command line.

@@ -130,7 +130,10 @@ std::string sweep_json(const SweepTable& t) {
                       {"rays", p.rays},
                       {"wall_seconds", p.wall_seconds}});
   // A number that is not finite is written as null.
-  const Json j = {{"sweep", kind_name(t.kind)},
+  const Json j = {{"schema_version", sweep_schema_version},
+                  {"vmpray_version", VMPRAY_VERSION},
+                  {"command_line", t.command_line},
+                  {"sweep", kind_name(t.kind)},
                   {"scene", t.scene},
                   {"width", t.width},
                   {"height", t.height},
@@ -158,7 +161,9 @@ std::vector<std::filesystem::path> write_sweep(const SweepTable& t, const std::f
   for (std::size_t i = 0; i < plots.size(); ++i)
     files.push_back(outputs.write(dir / (stem + "-" + std::to_string(i + 1) + "-plot.png"),
                                   [&](const auto& path) { viz::plot_image(plots[i]).write_image(path.string()); }));
-  viz::Report report{.title = "vmpray sweep " + stem + ": " + t.scene};
+  viz::Report report{.title = "vmpray sweep " + stem + ": " + t.scene,
+                     .version = "vmpray " VMPRAY_VERSION,
+                     .command_line = t.command_line};
   viz::Section section{.heading = t.scene + " at " + std::to_string(t.width) + "x" + std::to_string(t.height) +
                                   ", " + std::to_string(t.page_count) + " pages, " + t.tracing + "; " + t.farming};
   section.blocks.push_back(viz::Paragraph{"T1 (one node, same model) = " + paper_duration(t.serial_seconds) +
@@ -166,7 +171,7 @@ std::vector<std::filesystem::path> write_sweep(const SweepTable& t, const std::f
   section.blocks.push_back(html_table(t));
   section.blocks.push_back(viz::SvgFigure{.caption = stem + " sweep", .svg = viz::plots_svg(plots, 1)});
   report.sections.push_back(section);
-  for (const auto& f : viz::write_html_report(dir / (stem + ".html"), report, outputs.tracker())) files.push_back(f);
+  files.push_back(outputs.write_text(dir / (stem + ".html"), viz::html_report(report)));
   return files;
 }
 
@@ -183,7 +188,9 @@ int sweep_main(int argc, const char* const argv[]) {
     return 2;
   }
   try {
-    const SweepTable table = run_sweep(options, options.quiet ? nullptr : &std::cerr);
+    SweepTable table = run_sweep(options, options.quiet ? nullptr : &std::cerr);
+    table.command_line.assign(argv, argv + argc);
+    table.command_line.insert(table.command_line.begin(), "vmpray");
     OutputPhase phase;
     const auto files = write_sweep(table, options.out_dir, phase.files());
     if (!options.quiet) {

@@ -92,6 +92,30 @@ void Image::write_png(const std::string& path) const {
   });
 }
 
+std::vector<std::uint8_t> Image::png_bytes() const {
+  Rgb8Image bytes = to_rgb8();
+  png_image png{};
+  png.version = PNG_IMAGE_VERSION;
+  png.width = static_cast<png_uint_32>(width_);
+  png.height = static_cast<png_uint_32>(height_);
+  png.format = PNG_FORMAT_RGB;
+  // libpng's two-call protocol: the first call (no buffer) sizes, the second writes.
+  png_alloc_size_t size = 0;
+  std::vector<std::uint8_t> out;
+  bool ok = png_image_write_to_memory(&png, nullptr, &size, 0, bytes.rgb.data(), 0, nullptr) != 0;
+  if (ok) {
+    out.resize(size);
+    ok = png_image_write_to_memory(&png, out.data(), &size, 0, bytes.rgb.data(), 0, nullptr) != 0;
+    out.resize(size);
+  }
+  const std::string message = png.message;
+  png_image_free(&png);
+  if (!ok)
+    throw std::runtime_error("cannot encode a " + std::to_string(width_) + "x" + std::to_string(height_) +
+                             " PNG: " + message);
+  return out;
+}
+
 void Image::write_ppm(const std::string& path) const {
   Rgb8Image bytes = to_rgb8();
   write_atomically(path, [&](std::FILE* file) {

@@ -36,6 +36,10 @@ class Image {
 
   Rgb8Image to_rgb8() const;
 
+  // The PNG file's bytes, for embedding (e.g. a data: URL); std::runtime_error
+  // if libpng cannot encode the image.
+  std::vector<std::uint8_t> png_bytes() const;
+
   // Throw std::runtime_error naming the path on any I/O failure.
   void write_png(const std::string& path) const;
   void write_ppm(const std::string& path) const;

@@ -1,17 +1,15 @@
-// HTML report writer; see report.hpp for what the page may reference.
+// HTML report writer; see report.hpp for why the page references nothing outside it.
 #include "app/viz/report.hpp"
 
 #include <algorithm>
 #include <cctype>
+#include <cstdint>
 #include <stdexcept>
 
 #include "app/viz/svg.hpp"
-#include "tracer/atomic_file.hpp"
 
 namespace viz {
 namespace {
-
-namespace fs = std::filesystem;
 
 constexpr const char* style = R"(body { font-family: sans-serif; margin: 2em auto; max-width: 1200px; color: #222; }
 h1 { border-bottom: 2px solid #444; }
@@ -23,6 +21,8 @@ th { background: #f0f0f0; text-align: left; }
 td.num { text-align: right; font-variant-numeric: tabular-nums; }
 figure { margin: 1em 0; overflow-x: auto; }
 figcaption { color: #555; font-size: 0.9em; }
+p.made { color: #555; }
+p.made code { background: #f4f4f4; padding: 0.1em 0.3em; overflow-wrap: anywhere; }
 img { image-rendering: pixelated; max-width: 100%; height: auto; }
 .keyed { display: flex; flex-wrap: wrap; gap: 1em; align-items: flex-start; }
 ol.key { list-style: none; margin: 0; padding: 0; display: grid; grid-template-columns: repeat(16, 2.6em);
@@ -30,17 +30,19 @@ ol.key { list-style: none; margin: 0; padding: 0; display: grid; grid-template-c
 ol.key li { text-align: center; border-radius: 2px; }
 )";
 
-// A file name as a relative URL: anything but unreserved characters is %-encoded.
-std::string url_of(const std::string& name) {
+// RFC 4648 base64 with padding, for data: URLs. Written here rather than
+// taken from a library: Debian's Boost keeps its encoder in a detail
+// namespace, and these dozen lines are the whole of it.
+std::string base64(const std::vector<std::uint8_t>& bytes) {
+  static constexpr char digits[] = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
   std::string out;
-  for (unsigned char c : name) {
-    if (std::isalnum(c) || c == '-' || c == '.' || c == '_' || c == '~') {
-      out += static_cast<char>(c);
-    } else {
-      char buf[4];
-      std::snprintf(buf, sizeof buf, "%%%02X", c);
-      out += buf;
-    }
+  out.reserve((bytes.size() + 2) / 3 * 4);
+  for (std::size_t i = 0; i < bytes.size(); i += 3) {
+    const std::size_t n = std::min<std::size_t>(3, bytes.size() - i);
+    std::uint32_t v = std::uint32_t(bytes[i]) << 16;
+    if (n > 1) v |= std::uint32_t(bytes[i + 1]) << 8;
+    if (n > 2) v |= bytes[i + 2];
+    for (std::size_t k = 0; k < 4; ++k) out += k <= n ? digits[(v >> (18 - 6 * k)) & 63] : '=';
   }
   return out;
 }
@@ -71,8 +73,6 @@ void caption(std::string& out, const std::string& text) {
 
 class PageWriter {
  public:
-  PageWriter(const fs::path& html, const FileTracker& track) : html_(html), track_(track) {}
-
   void operator()(const Paragraph& p) { out += "<p>" + escape_xml(p.text) + "</p>\n"; }
 
   void operator()(const KeyValueTable& t) {
@@ -106,12 +106,8 @@ class PageWriter {
   }
 
   void operator()(const ImageFigure& f) {
-    const fs::path png = report_image_path(html_, ++images_);
-    const std::string name = png.filename().string();
-    f.image.write_png(png.string());  // whole or not at all
-    track_(png);
     const int factor = display_factor(f.image.width());
-    const std::string img = "<img src=\"" + escape_xml(url_of(name)) + "\" width=\"" +
+    const std::string img = "<img src=\"data:image/png;base64," + base64(f.image.png_bytes()) + "\" width=\"" +
                             std::to_string(factor * f.image.width()) + "\" height=\"" +
                             std::to_string(factor * f.image.height()) + "\" alt=\"" + escape_xml(f.caption) + "\"/>\n";
     out += "<figure>\n";
@@ -136,42 +132,48 @@ class PageWriter {
   static std::string figcaption(const std::string& text) {
     return text.empty() ? std::string{} : "<figcaption>" + escape_xml(text) + "</figcaption>\n";
   }
-
-  const fs::path& html_;
-  const FileTracker& track_;
-  int images_ = 0;
 };
 
-// Writes the PNGs and then the page, each tracked once it is in place.
-void write_page(const fs::path& html_path, const Report& report, const FileTracker& track) {
-  PageWriter page(html_path, track);
+}  // namespace
+
+std::string html_report(const Report& report) {
+  PageWriter page;
   page.out = "<!DOCTYPE html>\n<html lang=\"en\">\n<head>\n<meta charset=\"utf-8\"/>\n<title>" +
              escape_xml(report.title) + "</title>\n<style>\n" + style + "</style>\n</head>\n<body>\n<h1>" +
              escape_xml(report.title) + "</h1>\n";
+  if (!report.version.empty() || !report.command_line.empty()) {
+    page.out += "<p class=\"made\">";
+    if (!report.version.empty()) page.out += "Made by " + escape_xml(report.version);
+    if (!report.command_line.empty())
+      page.out += std::string(report.version.empty() ? "Made" : "") + " with <code>" +
+                  escape_xml(shell_quoted(report.command_line)) + "</code>";
+    page.out += "</p>\n";
+  }
   for (const Section& s : report.sections) {
     page.out += "<section>\n<h2>" + escape_xml(s.heading) + "</h2>\n";
     for (const Block& b : s.blocks) std::visit(page, b);
     page.out += "</section>\n";
   }
   page.out += "</body>\n</html>\n";
-  tracer::write_text_atomically(html_path.string(), page.out);
-  track(html_path);
+  return std::move(page.out);
 }
 
-}  // namespace
-
-fs::path report_image_path(const fs::path& html_path, int n) {
-  return html_path.parent_path() / (html_path.stem().string() + "-" + std::to_string(n) + ".png");
-}
-
-std::vector<fs::path> write_html_report(const fs::path& html_path, const Report& report, const FileTracker& track) {
-  // What was tracked is what was written, once the page is in place.
-  std::vector<fs::path> written;
-  write_page(html_path, report, [&](const fs::path& p) {
-    track(p);
-    written.push_back(p);
-  });
-  return written;
+std::string shell_quoted(const std::vector<std::string>& words) {
+  std::string out;
+  for (const std::string& w : words) {
+    if (!out.empty()) out += ' ';
+    const bool plain = !w.empty() && std::all_of(w.begin(), w.end(), [](unsigned char c) {
+      return std::isalnum(c) || std::string_view("-_./=:,+@%").find(char(c)) != std::string_view::npos;
+    });
+    if (plain) {
+      out += w;
+      continue;
+    }
+    out += '\'';
+    for (char c : w) out += c == '\'' ? std::string("'\\''") : std::string(1, c);
+    out += '\'';
+  }
+  return out;
 }
 
 }  // namespace viz

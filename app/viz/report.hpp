@@ -1,16 +1,13 @@
-// The HTML report of a render: one self-contained page (no network: no
-// external CSS, scripts or fonts) with statistics tables, inline SVG
-// pictures and the images.
-// Images are written as PNG files beside the HTML, named "<stem>-<n>.png"
-// (n = 1, 2, ... in document order) and linked by file name, so the page
-// references only files it wrote itself. All text is escaped; SVG figures
-// are inserted as they are and must come from this library's *_svg functions.
-// An image narrower than 256 px is shown enlarged by a whole factor, its
-// pixels kept sharp; its PNG keeps the image's own size.
+// The HTML report of a render or a sweep: one page that stands alone, with
+// no reference to anything outside it (no network, no other file: styles
+// inline, SVG figures inline, images as PNG data: URLs), so it can be mailed,
+// archived or opened from anywhere.
+// Invariants: all text is escaped; SVG figures are inserted as they are and
+// must come from this library's *_svg functions; an image narrower than
+// 256 px is shown enlarged by a whole factor, its pixels kept sharp, and is
+// embedded at its own size.
 #pragma once
 
-#include <filesystem>
-#include <functional>
 #include <string>
 #include <utility>
 #include <variant>
@@ -62,22 +59,17 @@ struct Section {
 
 struct Report {
   std::string title{};
+  std::string version{};                    // of the program that made the page; empty: not shown
+  std::vector<std::string> command_line{};  // as typed, shown shell-quoted; empty: not shown
   std::vector<Section> sections{};
 };
 
-// Called with each file the writer has put in place, whole: the PNGs, then
-// the page. A caller that must leave nothing after a failure removes what
-// it was given (app::OutputFiles).
-using FileTracker = std::function<void(const std::filesystem::path&)>;
+// The page. Throws std::invalid_argument if an SvgFigure does not hold an
+// <svg> document, std::runtime_error if an image cannot be encoded.
+std::string html_report(const Report& report);
 
-// Writes the page to html_path (through a temporary file renamed into
-// place) and its PNGs beside it. Returns every file written, the HTML last.
-// Throws std::invalid_argument if an SvgFigure does not hold an <svg>
-// document, std::runtime_error naming the path on an I/O failure.
-// Where the page at html_path puts its n-th image (n from 1), beside it.
-std::filesystem::path report_image_path(const std::filesystem::path& html_path, int n);
-
-std::vector<std::filesystem::path> write_html_report(const std::filesystem::path& html_path, const Report& report,
-                                                     const FileTracker& track);
+// Words as a POSIX shell would need them typed: each word that holds
+// anything but letters, digits and -_./=:,+@% in single quotes.
+std::string shell_quoted(const std::vector<std::string>& words);
 
 }  // namespace viz

@@ -12,6 +12,7 @@
 #include <memory>
 #include <nlohmann/json.hpp>
 #include <regex>
+#include <set>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -263,13 +264,12 @@ TEST_F(MachineCli, AReportThatCannotBePrintedFailsTheRun) {
   }
 }
 
-// Two outputs at one path would overwrite each other; the page's own images
-// count too. Refused before the render, leaving nothing.
+// Two outputs at one path would overwrite each other. Refused before the
+// render, leaving nothing.
 TEST_F(MachineCli, TwoOutputsAtOnePathAreAnError) {
   const std::vector<std::pair<std::string, std::string>> cases{
       {"-o x.png --ownership x.png", "--output and --ownership would both write 'x.png'"},
       {"--stats t.json --tiles ./t.json", "--stats and --tiles would both write './t.json'"},
-      {"-o r-2.png --report r.html", "--output and --report's image would both write 'r-2.png'"},
   };
   for (const auto& [args, message] : cases) {
     const Outcome r = run(std::string(kSmall) + " -q " + args);
@@ -440,6 +440,21 @@ TEST_F(MachineCli, ReportShowsMissRatioPageTrafficAndPerNodeTable) {
   for (const char* field : {"miss ratio", "page communications", "distinct pages per pixel",
                             "imbalance", "busiest link", "wall time"})
     EXPECT_NE(r.out.find(field), std::string::npos) << field;
+}
+
+// The page is one file that holds its images and says what made it.
+TEST_F(MachineCli, ReportIsOnePageThatSaysWhatMadeIt) {
+  const Outcome r = run(std::string(kSmall) + " --topology ring:4 -q -o out.png --report run.html");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  std::set<std::string> written;
+  for (const auto& entry : fs::directory_iterator(dir_))
+    if (!entry.path().filename().string().starts_with("std")) written.insert(entry.path().filename().string());
+  EXPECT_EQ(written, (std::set<std::string>{"out.png", "run.html"}));
+  const std::string html = test::read_file(dir_ / "run.html");
+  EXPECT_NE(html.find("Made by vmpray " VMPRAY_VERSION " with <code>"), std::string::npos);
+  EXPECT_NE(html.find(std::string(kSmall) + " --topology ring:4 -q -o out.png --report run.html</code>"),
+            std::string::npos);
+  EXPECT_NE(html.find("<img src=\"data:image/png;base64,"), std::string::npos);
 }
 
 using test::parse;

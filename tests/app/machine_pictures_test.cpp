@@ -61,7 +61,7 @@ TEST(MachinePictures, WritesWellFormedSvgAndAPageLinkingOnlyItsFiles) {
   fs::create_directories(dir);
   const auto run = small_run(false);
   const app::PictureFiles files{dir / "machine.svg", dir / "owners.png", dir / "run.html", dir / "tiles.svg"};
-  const auto written = app::write_machine_pictures(files, "teapot on a 2x2 mesh", run.image, run.report);
+  const auto written = app::write_machine_pictures(files, {.title = "teapot on a 2x2 mesh"}, run.image, run.report);
   // What the command line checks for clashes before the render is what is written.
   std::vector<fs::path> announced;
   for (const auto& [option, path] : app::picture_outputs(files)) announced.push_back(path);
@@ -76,19 +76,21 @@ TEST(MachinePictures, WritesWellFormedSvgAndAPageLinkingOnlyItsFiles) {
   EXPECT_EQ(viz::test::count_class(tiles, "row"), 4u);
   EXPECT_EQ(viz::test::count_class(tiles, "tile"), run.report.farmer.tiles);  // few tiles: none narrower than a pixel
 
-  std::set<std::string> names;
-  for (const auto& f : written) names.insert(f.filename().string());
   const std::string html = read(files.report_html);
   EXPECT_NE(html.find("predicted synthesis time"), std::string::npos);
   // The page is titled by the scene; its section says what it shows.
   EXPECT_NE(html.find("<h1>teapot on a 2x2 mesh</h1>"), std::string::npos);
   EXPECT_NE(html.find("<h2>The run on mesh:2x2</h2>"), std::string::npos);
-  const std::regex link(R"((?:src|href)=\"([^\"]*)\")");
-  int links = 0;
-  for (auto it = std::sregex_iterator(html.begin(), html.end(), link); it != std::sregex_iterator(); ++it, ++links)
-    EXPECT_TRUE(names.count((*it)[1].str())) << (*it)[1].str();
-  EXPECT_GE(links, 2);  // the image and the ownership picture
-  for (const auto& entry : fs::directory_iterator(dir)) EXPECT_TRUE(names.count(entry.path().filename().string()));
+  // It stands alone: the image and the ownership picture are in it, and it
+  // references no file, so the directory holds only what was asked for.
+  const std::regex link(R"((?:src|href)=\"([^\"#][^\"]*)\")");
+  int images = 0;
+  for (auto it = std::sregex_iterator(html.begin(), html.end(), link); it != std::sregex_iterator(); ++it, ++images)
+    EXPECT_TRUE((*it)[1].str().starts_with("data:image/png;base64,")) << (*it)[1].str().substr(0, 60);
+  EXPECT_EQ(images, 2);
+  std::set<fs::path> on_disk;
+  for (const auto& entry : fs::directory_iterator(dir)) on_disk.insert(entry.path());
+  EXPECT_EQ(on_disk, std::set<fs::path>(written.begin(), written.end()));
   EXPECT_NE(html.find("when each processor traced each tile"), std::string::npos);
   EXPECT_NE(html.find("<caption>Per node</caption>"), std::string::npos);
   EXPECT_NE(html.find("<caption>Hops by packet kind</caption>"), std::string::npos);
@@ -104,19 +106,19 @@ TEST(MachinePictures, APictureThatCannotBeWrittenTakesTheOthersWithIt) {
   fs::create_directories(dir);
   const auto run = small_run(false);
   const app::PictureFiles files{dir / "machine.svg", dir / "owners.png", {}, dir / "missing" / "tiles.svg"};
-  EXPECT_THROW(app::write_machine_pictures(files, "teapot", run.image, run.report), std::runtime_error);
+  EXPECT_THROW(app::write_machine_pictures(files, {.title = "teapot"}, run.image, run.report), std::runtime_error);
   EXPECT_TRUE(fs::is_empty(dir));
 }
 
-// The page goes last, after the images it shows; when it cannot be put in
-// place (a directory stands at its path) those images go too.
-TEST(MachinePictures, AReportThatCannotBeWrittenTakesItsImagesWithIt) {
+// The page goes last; when it cannot be put in place (a directory stands
+// at its path) the pictures written before it go too.
+TEST(MachinePictures, AReportThatCannotBeWrittenTakesThePicturesWithIt) {
   const fs::path dir = fs::path(::testing::TempDir()) / "vmpray_machine_report_failed";
   fs::remove_all(dir);
   fs::create_directories(dir / "r.html");
   const auto run = small_run(false);
   const app::PictureFiles files{dir / "machine.svg", {}, dir / "r.html", {}};
-  EXPECT_THROW(app::write_machine_pictures(files, "teapot", run.image, run.report), std::runtime_error);
+  EXPECT_THROW(app::write_machine_pictures(files, {.title = "teapot"}, run.image, run.report), std::runtime_error);
   std::vector<std::string> left;
   for (const auto& entry : fs::directory_iterator(dir)) left.push_back(entry.path().filename().string());
   EXPECT_EQ(left, std::vector<std::string>{"r.html"});
@@ -129,7 +131,7 @@ TEST(MachinePictures, TimelineNeedsARunThatRecordedItsTiles) {
   const auto run = small_run(false, false);
   app::PictureFiles files;
   files.timeline_svg = dir / "tiles.svg";
-  EXPECT_THROW(app::write_machine_pictures(files, "teapot", run.image, run.report), std::invalid_argument);
+  EXPECT_THROW(app::write_machine_pictures(files, {.title = "teapot"}, run.image, run.report), std::invalid_argument);
   EXPECT_FALSE(fs::exists(files.timeline_svg));
 }
 

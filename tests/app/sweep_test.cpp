@@ -3,11 +3,14 @@
 // giving the same predictions twice and on any number of jobs, which
 // failure a sweep of points run side by side reports, and a machine too
 // large for the memory refused before any run.
+#include "app/sweep.hpp"
+
 #include <gtest/gtest.h>
 
 #include <filesystem>
 #include <fstream>
 #include <initializer_list>
+#include <nlohmann/json.hpp>
 #include <regex>
 #include <set>
 #include <sstream>
@@ -16,10 +19,9 @@
 
 #include "app/experiments.hpp"
 #include "app/options.hpp"
-#include "app/sweep.hpp"
-#include "tracer/generators.hpp"
 #include "tests/support/scratch.hpp"
 #include "tests/viz/xml_check.hpp"
+#include "tracer/generators.hpp"
 
 namespace {
 
@@ -168,7 +170,8 @@ TEST(SweepOptions, CacheSweepDefaultsToSixteenNodes) {
 TEST(Sweep, NodesSweepWritesWellFormedTablesAndPlots) {
   const fs::path dir = fresh_dir("vmpray_sweep_nodes");
   auto o = parse({"nodes", "teapot:2", "--size", "12", "--nodes", "1,2,4", "--topology", "hypercube,ring"});
-  const app::SweepTable table = app::run_sweep(o, nullptr);
+  app::SweepTable table = app::run_sweep(o, nullptr);
+  table.command_line = {"vmpray", "sweep", "nodes", "teapot:2"};
   app::OutputFiles outputs;
   const auto files = app::write_sweep(table, dir, outputs);
   outputs.keep();
@@ -188,6 +191,16 @@ TEST(Sweep, NodesSweepWritesWellFormedTablesAndPlots) {
   EXPECT_NE(json.find("\"tracing\": \"bvh, treelet layout, shadow rays facing\""), std::string::npos);
   EXPECT_NE(json.find("\"farming\": \"dynamic schedule, grain 4, prefetch 0, scanline order\""), std::string::npos);
   EXPECT_EQ(json.find("nan"), std::string::npos);
+  const nlohmann::json doc = nlohmann::json::parse(json);
+  EXPECT_EQ(doc.at("schema_version"), app::sweep_schema_version);
+  EXPECT_EQ(doc.at("vmpray_version"), VMPRAY_VERSION);
+  EXPECT_EQ(doc.at("command_line"), nlohmann::json(table.command_line));
+  EXPECT_EQ(doc.at("points").size(), 6u);
+  // The page stands alone and says what made it.
+  const std::string html = read(dir / "nodes.html");
+  EXPECT_NE(html.find("Made by vmpray " VMPRAY_VERSION " with <code>vmpray sweep nodes teapot:2</code>"),
+            std::string::npos);
+  EXPECT_EQ(html.find("src=\"nodes-"), std::string::npos);
 
   const std::string svg_text = read(dir / "nodes.svg");
   const auto svg = viz::test::check_xml(svg_text);

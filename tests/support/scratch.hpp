@@ -3,7 +3,8 @@
 // binary in that directory with its output captured.
 //
 // Invariants: every test gets a fresh, empty directory named after the suite
-// prefix and the test, removed again when the test ends; run_vmpray() never
+// prefix, the test and the process (so two builds' suites can run at once),
+// removed again when the test ends; run_vmpray() never
 // reads standard input and reports stderr without ASan's expected fiber-stack
 // warning (sanitizer_noise below), so assertions about one-line errors hold
 // under the sanitizer build too.
@@ -11,6 +12,7 @@
 
 #include <gtest/gtest.h>
 #include <sys/wait.h>
+#include <unistd.h>
 
 #include <cstdlib>
 #include <filesystem>
@@ -55,8 +57,8 @@ struct Outcome {
 class ScratchTest : public ::testing::Test {
  protected:
   explicit ScratchTest(const std::string& prefix)
-      : dir_(fs::temp_directory_path() /
-             (prefix + ::testing::UnitTest::GetInstance()->current_test_info()->name())) {}
+      : dir_(fs::temp_directory_path() / (prefix + ::testing::UnitTest::GetInstance()->current_test_info()->name() +
+                                          "-" + std::to_string(::getpid()))) {}
   void SetUp() override {
     fs::remove_all(dir_);
     fs::create_directories(dir_);

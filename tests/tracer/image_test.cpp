@@ -6,6 +6,8 @@
 
 #include <cmath>
 #include <filesystem>
+#include <fstream>
+#include <iterator>
 #include <limits>
 #include <utility>
 #include <vector>
@@ -73,6 +75,18 @@ TEST(Image, PngRoundTripIsBitExact) {
   EXPECT_EQ(back.width, 37);
   EXPECT_EQ(back.height, 21);
   EXPECT_EQ(back.rgb, img.to_rgb8().rgb);
+}
+
+TEST(Image, PngBytesAreTheFileWritePngWrites) {
+  fs::path file = scratch_dir("png_bytes") / "g.png";
+  Image img = gradient(19, 7);
+  img.write_png(file.string());
+  std::ifstream in(file, std::ios::binary);
+  const std::vector<std::uint8_t> on_disk{std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+  const std::vector<std::uint8_t> bytes = img.png_bytes();
+  ASSERT_GT(bytes.size(), 8u);
+  EXPECT_EQ(bytes[1], 'P');
+  EXPECT_EQ(bytes, on_disk);
 }
 
 TEST(Image, PpmRoundTripIsBitExact) {

@@ -1,6 +1,6 @@
-// HTML report: well-formed, escapes text, links only files it wrote (which
-// exist), needs no network, and names every file it may leave behind when
-// it fails, so that the caller can remove them.
+// HTML report: well-formed, escapes text, stands alone (its images embedded
+// as PNG data: URLs that decode to the images, nothing referenced outside
+// the page), says what made it, and refuses a figure that is not SVG.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -25,11 +25,30 @@ namespace fs = std::filesystem;
 class ReportTest : public ::test::ScratchTest {
  protected:
   ReportTest() : ScratchTest("viz-report-") {}
-  static std::string read(const fs::path& p) { return ::test::read_file(p); }
-  std::vector<fs::path> write(const fs::path& html, const Report& report) {
-    return write_html_report(html, report, [this](const fs::path& p) { tracked_.push_back(p); });
+  // The PNG a data: URL holds, decoded through a file (the reader reads files).
+  tracer::Rgb8Image decode_png(const std::string& url) {
+    const std::string prefix = "data:image/png;base64,";
+    EXPECT_EQ(url.rfind(prefix, 0), 0u) << url.substr(0, 40);
+    static const std::string digits = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
+    std::string bytes;
+    std::uint32_t bits = 0;
+    int held = 0;
+    for (char c : url.substr(prefix.size())) {
+      if (c == '=') break;
+      const std::size_t v = digits.find(c);
+      EXPECT_NE(v, std::string::npos) << "not base64: " << c;
+      bits = (bits << 6) | std::uint32_t(v);
+      held += 6;
+      if (held >= 8) {
+        held -= 8;
+        bytes += static_cast<char>((bits >> held) & 0xff);
+      }
+    }
+    const fs::path png = dir_ / ("decoded-" + std::to_string(decoded_++) + ".png");
+    std::ofstream(png, std::ios::binary) << bytes;
+    return tracer::read_png(png.string());
   }
-  std::vector<fs::path> tracked_;  // what the writer said it may leave behind
+  int decoded_ = 0;
 };
 
 Report sample_report() {
@@ -51,9 +70,7 @@ Report sample_report() {
 }
 
 TEST_F(ReportTest, IsWellFormedAndEscapesText) {
-  const fs::path html = dir_ / "report.html";
-  write(html, sample_report());
-  const std::string text = read(html);
+  const std::string text = html_report(sample_report());
   const test::XmlCheck doc = test::check_xml(text);
   ASSERT_TRUE(doc.ok) << doc.error;
   EXPECT_NE(text.find("<title>Render &lt;teapot&gt; &amp; &quot;friends&quot;</title>"), std::string::npos);
@@ -62,39 +79,46 @@ TEST_F(ReportTest, IsWellFormedAndEscapesText) {
   EXPECT_NE(text.find("1 &lt; 2 &amp;&amp; 3 &gt; 2"), std::string::npos);
 }
 
-TEST_F(ReportTest, LinksOnlyFilesItWrote) {
-  const fs::path html = dir_ / "run 1#a.html";  // a name that needs URL encoding
-  const std::vector<fs::path> written = write(html, sample_report());
-  ASSERT_EQ(written.size(), 3u);
-  EXPECT_EQ(written.back(), html);
-  const test::XmlCheck doc = test::check_xml(read(html));
+// Every reference is an embedded image or a place in the page itself.
+TEST_F(ReportTest, EmbedsItsImagesAndReferencesNothingOutside) {
+  const test::XmlCheck doc = test::check_xml(html_report(sample_report()));
   ASSERT_TRUE(doc.ok) << doc.error;
-  std::size_t references = 0;
+  std::vector<tracer::Rgb8Image> images;
   for (const auto& e : doc.elements)
     for (const char* attr : {"src", "href", "xlink:href"}) {
       if (!e.attrs.count(attr)) continue;
-      ++references;
       const std::string url = e.attrs.at(attr);
-      EXPECT_EQ(url.find(':'), std::string::npos) << "not a relative file: " << url;
-      EXPECT_EQ(url.find('/'), std::string::npos) << url;
-      // Undo the %-encoding of the file name.
-      std::string name;
-      for (std::size_t i = 0; i < url.size(); ++i) {
-        if (url[i] == '%') {
-          name += static_cast<char>(std::stoi(url.substr(i + 1, 2), nullptr, 16));
-          i += 2;
-        } else {
-          name += url[i];
-        }
-      }
-      const fs::path target = dir_ / name;
-      EXPECT_TRUE(fs::exists(target)) << target;
-      EXPECT_NE(std::find(written.begin(), written.end(), target), written.end()) << target;
+      if (url.starts_with("#")) continue;
+      images.push_back(decode_png(url));
     }
-  EXPECT_EQ(references, 2u);
-  const tracer::Rgb8Image png = tracer::read_png(written[0].string());
-  EXPECT_EQ(png.width, 4);
-  EXPECT_EQ(png.rgb[(1 * 4 + 1) * 3], 255);
+  ASSERT_EQ(images.size(), 2u);
+  EXPECT_EQ(images[0].width, 4);
+  EXPECT_EQ(images[0].height, 3);
+  tracer::Image render(4, 3);
+  render.at(1, 1) = {1, 0.5f, 0};
+  EXPECT_EQ(images[0].rgb, render.to_rgb8().rgb);
+  EXPECT_EQ(images[1].rgb, ownership_image(4, 3, std::vector<std::uint16_t>(12, 1)).to_rgb8().rgb);
+}
+
+// The page names the program and the command that made it, quoted as a shell needs it.
+TEST_F(ReportTest, SaysWhatMadeIt) {
+  Report r = sample_report();
+  r.version = "vmpray 9.9";
+  r.command_line = {"vmpray", "teapot", "--report", "my run.html", "it's"};
+  const std::string text = html_report(r);
+  ASSERT_TRUE(test::check_xml(text).ok);
+  EXPECT_NE(text.find("Made by vmpray 9.9 with <code>vmpray teapot --report &#39;my run.html&#39; "
+                      "&#39;it&#39;\\&#39;&#39;s&#39;</code>"),
+            std::string::npos)
+      << text.substr(0, 2000);
+  EXPECT_EQ(html_report(sample_report()).find("Made by"), std::string::npos);  // not known: not said
+}
+
+TEST(ShellQuoted, QuotesOnlyWhatAShellWouldSplitOrExpand) {
+  EXPECT_EQ(shell_quoted({"vmpray", "teapot", "--topology", "mesh:4x4", "-o", "a/b.png"}),
+            "vmpray teapot --topology mesh:4x4 -o a/b.png");
+  EXPECT_EQ(shell_quoted({"a b", "", "$x", "*"}), "'a b' '' '$x' '*'");
+  EXPECT_EQ(shell_quoted({"it's"}), "'it'\\''s'");
 }
 
 // A key lists its entries beside the image, in order, each on its colour.
@@ -102,9 +126,7 @@ TEST_F(ReportTest, KeyedImageShowsEachEntryOnItsColour) {
   Report r;
   const std::vector<KeyEntry> key{{"0", {255, 255, 0}}, {"1", {0, 0, 128}}, {"<2>", {10, 200, 30}}};
   r.sections.push_back({"owners", {ImageFigure{"owners", tracer::Image(4, 3), key}}});
-  const fs::path html = dir_ / "r.html";
-  write(html, r);
-  const test::XmlCheck doc = test::check_xml(read(html));
+  const test::XmlCheck doc = test::check_xml(html_report(r));
   ASSERT_TRUE(doc.ok) << doc.error;
   ASSERT_EQ(test::count_class(doc, "key"), 1u);
   std::vector<test::XmlElement> items;
@@ -122,9 +144,8 @@ TEST_F(ReportTest, KeyedImageShowsEachEntryOnItsColour) {
 // Small images are shown enlarged by a whole factor, to at least 256 px;
 // the PNG keeps the image's size.
 TEST_F(ReportTest, SmallImagesAreShownEnlarged) {
-  const fs::path html = dir_ / "r.html";
-  const std::vector<fs::path> written = write(html, sample_report());
-  const test::XmlCheck doc = test::check_xml(read(html));
+  const std::string text = html_report(sample_report());
+  const test::XmlCheck doc = test::check_xml(text);
   ASSERT_TRUE(doc.ok) << doc.error;
   std::size_t images = 0;
   for (const auto& e : doc.elements) {
@@ -132,16 +153,14 @@ TEST_F(ReportTest, SmallImagesAreShownEnlarged) {
     ++images;
     EXPECT_EQ(e.attrs.at("width"), "256");  // 4 x 3 pixels, 64 times
     EXPECT_EQ(e.attrs.at("height"), "192");
+    EXPECT_EQ(decode_png(e.attrs.at("src")).width, 4);
   }
   EXPECT_EQ(images, 2u);
-  EXPECT_EQ(tracer::read_png(written[0].string()).width, 4);
-  EXPECT_NE(read(html).find("image-rendering: pixelated"), std::string::npos);
+  EXPECT_NE(text.find("image-rendering: pixelated"), std::string::npos);
 }
 
 TEST_F(ReportTest, NeedsNoNetwork) {
-  const fs::path html = dir_ / "r.html";
-  write(html, sample_report());
-  const std::string text = read(html);
+  const std::string text = html_report(sample_report());
   EXPECT_EQ(text.find("<script"), std::string::npos);
   EXPECT_EQ(text.find("<link"), std::string::npos);
   EXPECT_EQ(text.find("@import"), std::string::npos);
@@ -151,32 +170,7 @@ TEST_F(ReportTest, NeedsNoNetwork) {
 TEST_F(ReportTest, RejectsFigureThatIsNotSvg) {
   Report r;
   r.sections.push_back({"bad", {SvgFigure{"x", "<script>alert(1)</script>"}}});
-  EXPECT_THROW(write(dir_ / "r.html", r), std::invalid_argument);
-}
-
-TEST_F(ReportTest, UnwritableDirectoryIsAnError) {
-  EXPECT_THROW(write(dir_ / "missing" / "r.html", sample_report()), std::runtime_error);
-}
-
-// The PNGs go out before the page; when the page cannot be put in place
-// (here a directory stands at its path) the writer has named each PNG it
-// wrote, and not the directory that stood in the way.
-TEST_F(ReportTest, APageThatCannotBeWrittenNamesTheImagesItLeft) {
-  fs::create_directory(dir_ / "r.html");
-  EXPECT_THROW(write(dir_ / "r.html", sample_report()), std::runtime_error);
-  std::vector<fs::path> left;
-  for (const auto& entry : fs::directory_iterator(dir_))
-    if (entry.path().filename() != "r.html") left.push_back(entry.path());
-  std::sort(left.begin(), left.end());
-  EXPECT_EQ(left, (std::vector<fs::path>{dir_ / "r-1.png", dir_ / "r-2.png"}));
-  EXPECT_EQ(tracked_, left);
-}
-
-// Everything written was tracked, the page last.
-TEST_F(ReportTest, TracksEveryFileItWrites) {
-  const std::vector<fs::path> written = write(dir_ / "r.html", sample_report());
-  EXPECT_EQ(tracked_, written);
-  EXPECT_EQ(tracked_.back(), dir_ / "r.html");
+  EXPECT_THROW(html_report(r), std::invalid_argument);
 }
 
 }  // namespace
