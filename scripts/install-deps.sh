@@ -11,7 +11,7 @@ packages=(
   nlohmann-json3-dev libcairo2-dev fonts-dejavu-core
 )
 if [[ "${1:-}" == "--dev" ]]; then   # sanitizers' clang runtime, the fuzzer, the browser checks
-  packages+=(clang-14 libclang-rt-14-dev chromium)
+  packages+=(clang-14 libclang-rt-14-dev chromium python3)
 fi
 missing=()
 for p in "${packages[@]}"; do

@@ -1,0 +1,73 @@
+#!/usr/bin/env bash
+# Opens the HTML pages vmpray writes (a render's --report page and a sweep's
+# page) in headless Chromium with the network cut off, and fails unless each
+# page loads, fetches nothing (no resource but data: URLs), shows every image
+# decoded and not blank, has its tables and SVG figures, raises no script
+# error, and screenshots to something that is not blank.
+#
+# The page is opened inside a checking page (scripts/browser-check.html)
+# whose script inspects it once it has loaded and writes one line, PASS or
+# FAIL, that --dump-dom prints.
+#
+# usage: scripts/browser-check.sh [BUILD_DIR]   (default build/release)
+set -euo pipefail
+here=$(cd "$(dirname "$0")" && pwd)
+build=$(cd "${1:-build/release}" && pwd)
+vmpray=$build/app/vmpray
+browser=$(command -v chromium || command -v chromium-browser || true)
+[[ -x "$vmpray" ]] || { echo "browser-check: no $vmpray; build first" >&2; exit 1; }
+[[ -n "$browser" ]] || { echo "browser-check: chromium is not installed (scripts/install-deps.sh --dev)" >&2; exit 1; }
+work=$(mktemp -d)
+trap 'rm -rf "$work"' EXIT
+
+# Chromium as root needs --no-sandbox; the resolver and proxy rules leave it
+# no way to reach a network, so a page that needed one would fail to load.
+run_browser() {
+  timeout 120 "$browser" --headless=new --no-sandbox --disable-gpu --no-first-run --disable-extensions \
+    --host-resolver-rules='MAP * ~NOTFOUND' --proxy-server='127.0.0.1:9' --allow-file-access-from-files \
+    --enable-logging=stderr --v=0 --user-data-dir="$work/profile" "$@"
+}
+
+# check PAGE IMAGES SVGS TABLES: the page and the least it must hold.
+check() {
+  local page=$1 images=$2 svgs=$3 tables=$4 name
+  name=$(basename "$page" .html)
+  local query="page=$(basename "$page")&images=$images&svgs=$svgs&tables=$tables"
+  cp "$here/browser-check.html" "$(dirname "$page")/check-$name.html"
+  run_browser --virtual-time-budget=10000 --dump-dom "file://$(dirname "$page")/check-$name.html?$query" \
+    >"$work/$name.dom" 2>"$work/$name.log" || true
+  local verdict
+  verdict=$(grep -o 'id="verdict">BROWSER-CHECK [^<]*' "$work/$name.dom" | sed 's/^id="verdict">//' ||
+    echo "BROWSER-CHECK FAIL no verdict: the checking page did not run")
+  if grep -q 'Uncaught' "$work/$name.log"; then
+    verdict="BROWSER-CHECK FAIL script error: $(grep -m1 'Uncaught' "$work/$name.log")"
+  fi
+  run_browser --screenshot="$work/$name.png" --window-size=1280,1600 "file://$page" >/dev/null 2>&1 || true
+  if ! python3 "$here/png-not-blank.py" "$work/$name.png"; then
+    verdict="BROWSER-CHECK FAIL the screenshot of $name is blank or missing"
+  fi
+  echo "$name: ${verdict#BROWSER-CHECK }"
+  [[ "$verdict" == "BROWSER-CHECK PASS"* ]]
+}
+
+cd "$work"
+"$vmpray" teapot --width 128 --height 128 --topology mesh:4x4 -q -o teapot.png --report "$work/run.html"
+"$vmpray" sweep nodes --scene teapot:2 --size 16 --nodes 1,2,4 --topology hypercube,ring -q --out "$work/sweep"
+
+status=0
+check "$work/run.html" 2 2 3 || status=1
+check "$work/sweep/nodes.html" 0 1 1 || status=1
+
+# The check itself must catch what it is for: each of these pages fails it.
+mkdir "$work/bad"
+sed 's|<img src="[^"]*"|<img src="http://example.invalid/x.png"|' "$work/run.html" >"$work/bad/fetches.html"
+sed 's|</body>|<script>undefined_function();</script></body>|' "$work/run.html" >"$work/bad/throws.html"
+printf '<!DOCTYPE html><html><head><title>x</title></head><body><p> </p></body></html>\n' >"$work/bad/blank.html"
+for bad in fetches throws blank; do
+  if check "$work/bad/$bad.html" 2 2 3 2>/dev/null; then
+    echo "browser-check: the page that $bad passed the check" >&2
+    status=1
+  fi
+done
+((status == 0)) && echo "browser-check: the check fails a page that fetches, throws or is blank"
+exit $status
