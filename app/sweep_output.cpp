@@ -4,12 +4,14 @@
 #include <iomanip>
 #include <iostream>
 #include <map>
+#include <optional>
 #include <sstream>
 #include <stdexcept>
 #include <system_error>
 
-#include "app/output_files.hpp"
 #include "app/options.hpp"
+#include "app/output_files.hpp"
+#include "app/paper_figures.hpp"
 #include "app/report.hpp"
 #include "app/sweep.hpp"
 #include "app/viz/plot.hpp"
@@ -29,9 +31,29 @@ std::string number(double v) {
 
 const char* const csv_header =
     "scene,topology,nodes,cache_pages,predicted_seconds,predicted_hms,speedup,efficiency,miss_ratio,"
-    "page_requests,page_accesses,pages_per_pixel,mean_hops,messages,rays,wall_seconds";
+    "page_requests,page_accesses,pages_per_pixel,mean_hops,messages,rays,wall_seconds,paper_seconds,deviation";
 
 std::string kind_name(SweepOptions::Kind kind) { return kind == SweepOptions::Kind::nodes ? "nodes" : "cache"; }
+
+// The paper's Table 2 time for a point of a nodes sweep, where it printed one.
+// A cache sweep has none: Table 2 was measured with the whole memory as cache.
+std::optional<double> paper_seconds(const SweepTable& t, const ExperimentPoint& p) {
+  if (t.kind != SweepOptions::Kind::nodes) return std::nullopt;
+  return paper_synthesis_seconds(t.scene, t.width, t.height, p.nodes);
+}
+
+bool has_paper_figures(const SweepTable& t) {
+  for (const ExperimentPoint& p : t.points)
+    if (paper_seconds(t, p)) return true;
+  return false;
+}
+
+// "+4.4%"
+std::string signed_percent(double fraction) {
+  std::ostringstream out;
+  out << std::showpos << std::fixed << std::setprecision(1) << 100 * fraction << "%";
+  return out.str();
+}
 
 // One series per kind of topology ("hypercube:3" and "hypercube:4" are one
 // line): y(point) against the sweep's axis.
@@ -52,6 +74,11 @@ std::vector<viz::LinePlot> nodes_plots(const SweepTable& t) {
   viz::LinePlot time{.title = t.scene + ": predicted synthesis time", .x_label = "processors",
                      .y_label = "seconds", .x_scale = viz::AxisScale::log2, .y_scale = viz::AxisScale::log10};
   time.series = series_of(t, [](const ExperimentPoint& p) { return p.predicted_seconds; });
+  viz::Series paper{.name = "paper (iPSC/2)", .style = viz::LineStyle::dashed};
+  for (const ExperimentPoint& p : t.points)
+    if (const auto s = paper_seconds(t, p); s && (paper.points.empty() || paper.points.back().x < p.nodes))
+      paper.points.push_back({double(p.nodes), *s});
+  if (!paper.points.empty()) time.series.push_back(paper);
   viz::LinePlot eff{.title = t.scene + ": efficiency", .x_label = "processors", .y_label = "efficiency (%)",
                     .x_scale = viz::AxisScale::log2, .y_min = 0.0, .y_max = 105.0};
   eff.series = series_of(t, [](const ExperimentPoint& p) { return 100 * p.efficiency(); });
@@ -83,6 +110,8 @@ viz::Table html_table(const SweepTable& t) {
   viz::Table table{.caption = "Virtual-time runs (" + t.model.describe() + ")",
                    .header = {"topology", "N", "cache", "predicted", "speedup", "efficiency", "miss ratio",
                               "page requests", "mean hops", "wall s"}};
+  const bool paper = has_paper_figures(t);
+  if (paper) table.header.insert(table.header.begin() + 4, {"paper", "vs paper"});
   for (const ExperimentPoint& p : t.points) {
     std::ostringstream eff, miss, hops, speed, wall;
     eff << std::fixed << std::setprecision(1) << 100 * p.efficiency() << "%";
@@ -90,9 +119,22 @@ viz::Table html_table(const SweepTable& t) {
     hops << std::fixed << std::setprecision(2) << p.mean_hops;
     speed << std::fixed << std::setprecision(2) << p.speedup();
     wall << std::fixed << std::setprecision(1) << p.wall_seconds;
-    table.rows.push_back({p.topology, std::to_string(p.nodes), std::to_string(p.cache_pages),
-                          paper_duration(p.predicted_seconds), speed.str(), eff.str(), miss.str(),
-                          std::to_string(p.misses), hops.str(), wall.str()});
+    std::vector<std::string> row{p.topology,
+                                 std::to_string(p.nodes),
+                                 std::to_string(p.cache_pages),
+                                 paper_duration(p.predicted_seconds),
+                                 speed.str(),
+                                 eff.str(),
+                                 miss.str(),
+                                 std::to_string(p.misses),
+                                 hops.str(),
+                                 wall.str()};
+    if (paper) {
+      const auto s = paper_seconds(t, p);
+      row.insert(row.begin() + 4,
+                 {s ? paper_duration(*s) : "", s ? signed_percent(deviation_from(p.predicted_seconds, *s)) : ""});
+    }
+    table.rows.push_back(std::move(row));
   }
   return table;
 }
@@ -105,16 +147,21 @@ std::string sweep_csv(const SweepTable& t) {
   for (const ExperimentPoint& p : t.points) {
     out << t.scene << "," << p.topology << "," << p.nodes << "," << p.cache_pages << "," << number(p.predicted_seconds)
         << "," << paper_duration(p.predicted_seconds) << "," << number(p.speedup()) << "," << number(p.efficiency())
-        << "," << number(p.miss_ratio) << "," << p.misses << "," << p.page_accesses << ","
-        << number(p.pages_per_pixel) << "," << number(p.mean_hops) << "," << p.messages << "," << p.rays << ","
-        << number(p.wall_seconds) << "\n";
+        << "," << number(p.miss_ratio) << "," << p.misses << "," << p.page_accesses << "," << number(p.pages_per_pixel)
+        << "," << number(p.mean_hops) << "," << p.messages << "," << p.rays << "," << number(p.wall_seconds) << ",";
+    if (const auto paper = paper_seconds(t, p))
+      out << number(*paper) << "," << number(deviation_from(p.predicted_seconds, *paper));
+    else
+      out << ",";
+    out << "\n";
   }
   return out.str();
 }
 
 std::string sweep_json(const SweepTable& t) {
   Json points = Json::array();
-  for (const ExperimentPoint& p : t.points)
+  for (const ExperimentPoint& p : t.points) {
+    const auto paper = paper_seconds(t, p);
     points.push_back({{"topology", p.topology},
                       {"nodes", p.nodes},
                       {"cache_pages", p.cache_pages},
@@ -128,7 +175,10 @@ std::string sweep_json(const SweepTable& t) {
                       {"mean_hops", p.mean_hops},
                       {"messages", p.messages},
                       {"rays", p.rays},
-                      {"wall_seconds", p.wall_seconds}});
+                      {"wall_seconds", p.wall_seconds},
+                      {"paper_seconds", paper ? Json(*paper) : Json()},
+                      {"deviation", paper ? Json(deviation_from(p.predicted_seconds, *paper)) : Json()}});
+  }
   // A number that is not finite is written as null.
   const Json j = {{"schema_version", sweep_schema_version},
                   {"vmpray_version", VMPRAY_VERSION},
@@ -168,6 +218,14 @@ std::vector<std::filesystem::path> write_sweep(const SweepTable& t, const std::f
                                   ", " + std::to_string(t.page_count) + " pages, " + t.tracing + "; " + t.farming};
   section.blocks.push_back(viz::Paragraph{"T1 (one node, same model) = " + paper_duration(t.serial_seconds) +
                                           "; efficiency = T1 / (N * TN)."});
+  if (has_paper_figures(t))
+    section.blocks.push_back(viz::Paragraph{
+        "The paper's Table 2 (a 64-node iPSC/2 hypercube, the whole memory as cache) beside each point it has a "
+        "time for; \"vs paper\" is predicted / paper - 1."});
+  else if (t.kind == SweepOptions::Kind::cache)
+    section.blocks.push_back(viz::Paragraph{
+        "The paper gives Figure 8 as curves, with no figures to set beside these; it draws the 50% efficiency "
+        "threshold shown here, and reports its network saturated on Rings4 below 204 pages of cache."});
   section.blocks.push_back(html_table(t));
   section.blocks.push_back(viz::SvgFigure{.caption = stem + " sweep", .svg = viz::plots_svg(plots, 1)});
   report.sections.push_back(section);
