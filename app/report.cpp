@@ -15,24 +15,24 @@ std::string dump_json(const Json& j, int indent) { return j.dump(indent, ' ', fa
 void print_report(std::ostream& out, const RunReport& r) {
   const auto& s = r.rays;
   out << std::fixed << std::setprecision(2);
-  out << "scene          " << r.scene << ": " << r.polygons << " polygons, " << r.objects
-      << " objects, " << r.primitives << " primitives\n"
+  out << "scene          " << r.scene << ": " << r.polygons << " polygons, " << r.objects << " objects, "
+      << r.primitives << " primitives\n"
       << "image          " << r.output << " (" << r.width << "x" << r.height
       << (r.spd_procedure ? ", SPD procedure" : "") << ")\n"
-      << "database       " << r.pages << " pages of " << r.page_size << " bytes = "
-      << size_text(double(r.database_bytes)) << " (" << accel_description(r.accel, r.bvh_layout) << ", built in "
-      << r.build.accel_seconds << " s)\n"
-      << "rays           " << s.rays() << ": primary " << s.primary << " (hit " << s.primary_hits
-      << "), shadow " << s.shadow << ", reflected " << s.reflected << ", refracted "
-      << s.refracted << (r.shadow_rays_all ? " (shadow rays to every light)" : "") << "\n"
-      << "tests          " << s.box_tests << (r.accel == tracer::Accel::bvh ? " box" : " cell")
-      << ", " << s.prim_tests << " primitive\n"
-      << "page accesses  " << s.record_reads << " record reads, " << s.page_calls
-      << " page calls, " << s.pages_per_sample() << " distinct pages per "
-      << (r.spd_procedure ? "sample" : "pixel") << "\n"
+      << "database       " << r.pages << " pages of " << r.page_size
+      << " bytes = " << size_text(double(r.database_bytes)) << " (" << accel_description(r.accel, r.bvh_layout)
+      << ", built in " << r.build.accel_seconds << " s)\n"
+      << "rays           " << s.rays() << ": primary " << s.primary << " (hit " << s.primary_hits << "), shadow "
+      << s.shadow << ", reflected " << s.reflected << ", refracted " << s.refracted
+      << (r.shadow_rays_all ? " (shadow rays to every light)" : "") << "\n"
+      << "tests          " << s.box_tests << (r.accel == tracer::Accel::bvh ? " box" : " cell") << ", " << s.prim_tests
+      << " primitive\n"
+      << "page accesses  " << s.record_reads << " record reads, " << s.page_calls << " page calls, "
+      << s.pages_per_sample() << " distinct pages per " << (r.spd_procedure ? "sample" : "pixel") << "\n"
       << "time           load " << r.load_seconds << " s, build "
-      << r.build.triangulate_seconds + r.build.accel_seconds + r.build.pack_seconds
-      << " s, render " << r.render_seconds << " s, " << r.mrays_per_second() << " Mrays/s\n";
+      << r.build.triangulate_seconds + r.build.accel_seconds + r.build.pack_seconds << " s, render " << r.render_seconds
+      << " s" << (r.render_threads > 1 ? " on " + std::to_string(r.render_threads) + " threads" : std::string()) << ", "
+      << r.mrays_per_second() << " Mrays/s\n";
   if (r.machine) print_machine_report(out, *r.machine);
 }
 
@@ -80,6 +80,7 @@ std::string stats_json(const RunReport& r) {
               {"pack", r.build.pack_seconds},
               {"render", r.render_seconds}}},
             {"mrays_per_second", r.mrays_per_second()}};
+  if (r.render_threads > 0) j["render_threads"] = r.render_threads;
   if (r.machine) j["machine"] = machine_json(*r.machine);
   return dump_json(j, 2) + "\n";
 }

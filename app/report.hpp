@@ -37,6 +37,7 @@ struct RunReport {
   tracer::BuildStats build;
   double load_seconds = 0;
   double render_seconds = 0;
+  unsigned render_threads = 0;  // the single-process renderer's threads; 0 for a machine (its summary has them)
   tracer::RayStats rays;
   std::optional<MachineSummary> machine;  // none for the single-process renderer
 

@@ -1,10 +1,12 @@
 // Single-process rendering; see single.hpp.
 #include "app/single.hpp"
 
+#include <algorithm>
 #include <chrono>
 #include <utility>
 #include <vector>
 
+#include "app/cpu_count.hpp"
 #include "app/progress.hpp"
 #include "tracer/render.hpp"
 
@@ -35,15 +37,18 @@ RenderResult render_single(const Options& o, const tracer::Scene& scene) {
   const tracer::Database db = in_phase("building the database", !o.quiet && stderr_is_terminal(),
                                        [&] { return build_database(scene, build_options(o)); });
   RunReport report = describe_run(o, db);
-  tracer::InMemoryPageSource pages(db);
   const tracer::TraceOptions trace{.max_depth = o.max_depth,
                                    .spd_procedure = o.spd_procedure,
                                    .shadow_rays_to_all_lights = o.shadow_rays_all};
   const int w = scene.camera.width, h = scene.camera.height;
   ProgressBar bar(std::uint64_t(w) * h, "pixels", !o.quiet && stderr_is_terminal());
   const auto t0 = std::chrono::steady_clock::now();
-  std::vector<tracer::Color> pixels = tracer::render_frame(db.header, pages, trace, report.rays,
-                                                           [&](int rows) { bar.update(std::uint64_t(rows) * w); });
+  // Rows are what the threads share out: more threads than rows would only wait.
+  const unsigned threads =
+      std::min<unsigned>(o.machine.threads == 0 ? usable_cpus() : o.machine.threads, unsigned(scene.camera.height));
+  report.render_threads = threads;
+  std::vector<tracer::Color> pixels =
+      tracer::render_frame(db, trace, report.rays, threads, [&](int rows) { bar.update(std::uint64_t(rows) * w); });
   report.render_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   bar.finish();
   // The frame becomes the image: one image-sized buffer, not a second to copy it into.

@@ -3,11 +3,16 @@
 #include "tracer/render.hpp"
 
 #include <algorithm>
+#include <atomic>
 #include <bit>
 #include <cmath>
 #include <cstddef>
 #include <cstring>
+#include <exception>
 #include <limits>
+#include <memory>
+#include <mutex>
+#include <thread>
 
 namespace tracer {
 
@@ -490,6 +495,99 @@ std::vector<Color> render_frame(const DatabaseHeader& header, PageSource& pages,
     std::swap(above, below);
     if (progress) progress(y + 1);
   }
+  return out;
+}
+
+namespace {
+
+// One thread's share of a parallel frame: its tracer, over its own page
+// source (InMemoryPageSource holds a page table; a Tracer holds its stamps).
+struct Lane {
+  explicit Lane(const Database& db, const TraceOptions& options) : pages(db), tracer(db.header, pages, options) {}
+  InMemoryPageSource pages;
+  Tracer tracer;
+  RayStats stats;
+};
+
+// Runs row(lane, y) for y in [first, last) on every lane, lane 0 on this
+// thread, rows taken in order from a shared counter; after each row this
+// thread does, after_own_row(rows finished so far). The first exception
+// thrown stops the others at their next row and is rethrown here.
+template <class Row, class AfterOwnRow>
+void parallel_rows(std::vector<std::unique_ptr<Lane>>& lanes, int first, int last, const Row& row,
+                   const AfterOwnRow& after_own_row) {
+  std::atomic<int> next{first}, finished{0};
+  std::atomic<bool> failed{false};
+  std::exception_ptr error;
+  std::mutex error_mutex;
+  const auto work = [&](Lane& lane, bool own) {
+    try {
+      for (int y = next++; y < last && !failed.load(std::memory_order_relaxed); y = next++) {
+        row(lane, y);
+        const int done = finished.fetch_add(1, std::memory_order_relaxed) + 1;
+        if (own) after_own_row(done);
+      }
+    } catch (...) {
+      std::lock_guard lock(error_mutex);
+      if (!error) error = std::current_exception();
+      failed = true;
+    }
+  };
+  std::vector<std::thread> helpers;
+  helpers.reserve(lanes.size() - 1);
+  for (std::size_t i = 1; i < lanes.size(); ++i) helpers.emplace_back(work, std::ref(*lanes[i]), false);
+  work(*lanes[0], true);
+  for (std::thread& t : helpers) t.join();
+  if (error) std::rethrow_exception(error);
+}
+
+// Rows of SPD corner samples traced together: a band's samples are kept
+// until its pixels are averaged, so this many rows of W+1 samples is the
+// extra memory (16 KB a band at 512 pixels a row).
+constexpr int kSampleBand = 32;
+
+}  // namespace
+
+std::vector<Color> render_frame(const Database& db, const TraceOptions& options, RayStats& stats, unsigned threads,
+                                const std::function<void(int)>& progress) {
+  const int w = db.header.camera.width, h = db.header.camera.height;
+  std::vector<std::unique_ptr<Lane>> lanes;
+  for (unsigned i = 0; i < std::max(1u, threads); ++i) lanes.push_back(std::make_unique<Lane>(db, options));
+  std::vector<Color> out(std::size_t(w) * h);
+  const auto report = [&](int rows) {
+    if (progress) progress(rows);
+  };
+  if (!options.spd_procedure) {
+    parallel_rows(
+        lanes, 0, h,
+        [&](Lane& lane, int y) {
+          for (int x = 0; x < w; ++x) out[std::size_t(y) * w + x] = lane.tracer.trace_pixel(x, y, lane.stats);
+        },
+        report);
+  } else {
+    // Sample row r of the band starting at pixel row y0 is corner row y0 + r;
+    // row 0 is the last row of the band before (or corner row 0, traced first).
+    std::vector<Color> band(std::size_t(kSampleBand + 1) * (w + 1));
+    const auto trace_row = [&](Lane& lane, int y0, int sy) {
+      Color* samples = &band[std::size_t(sy - y0) * (w + 1)];
+      for (int sx = 0; sx <= w; ++sx) samples[sx] = lane.tracer.trace_sample(sx, sy, lane.stats);
+    };
+    trace_row(*lanes[0], 0, 0);
+    for (int y0 = 0; y0 < h; y0 += kSampleBand) {
+      const int rows = std::min(kSampleBand, h - y0);
+      parallel_rows(
+          lanes, y0 + 1, y0 + rows + 1, [&](Lane& lane, int sy) { trace_row(lane, y0, sy); }, [](int) {});
+      for (int y = y0; y < y0 + rows; ++y) {
+        const Color* above = &band[std::size_t(y - y0) * (w + 1)];
+        const Color* below = above + (w + 1);
+        for (int x = 0; x < w; ++x)
+          out[std::size_t(y) * w + x] = Tracer::average_corners(above[x], above[x + 1], below[x], below[x + 1]);
+      }
+      std::copy_n(&band[std::size_t(rows) * (w + 1)], w + 1, band.begin());  // the next band's first row
+      report(y0 + rows);
+    }
+  }
+  for (const auto& lane : lanes) stats += lane->stats;
   return out;
 }
 

@@ -115,4 +115,16 @@ std::vector<Color> render_frame(const DatabaseHeader& header, PageSource& pages,
                                 const TraceOptions& options, RayStats& stats,
                                 const std::function<void(int)>& progress = {});
 
+// The same frame on `threads` OS threads (0 and 1: the calling thread only),
+// each with its own Tracer over db's pages in memory, taking rows in order
+// from a shared counter. The pixels and the stats are render_frame's for
+// any thread count: a pixel depends only on (x, y), and the stats are sums
+// of per-sample counts (a Tracer forgets its last page at every sample).
+// In SPD mode each corner sample is traced once, as there: bands of rows of
+// samples are traced in parallel, then averaged. `progress(rows_done)` is
+// called on the calling thread only, with counts that never decrease. An
+// exception on any thread is rethrown here once all have stopped.
+std::vector<Color> render_frame(const Database& db, const TraceOptions& options, RayStats& stats, unsigned threads,
+                                const std::function<void(int)>& progress = {});
+
 }  // namespace tracer

@@ -1,8 +1,8 @@
 // machine_bench: wall time of the VM_pRAY machine (shared virtual memory,
 // farming with the machine's defaults, hypercube network) against the same
 // renderer over one shared in-memory database with plain std::threads
-// pulling rows, measured side by side on the same threads; and the speedup
-// of T threads over 1.
+// pulling rows (the single-process renderer, vmpray --single), measured side
+// by side on the same threads; and the speedup of T threads over 1.
 // Each machine line on T threads is also run with packets between threads
 // on plain channels rather than through the thread relays.
 // Then where the machine's time goes, on 16 nodes and T threads: the same
@@ -18,18 +18,17 @@
 //
 // usage: machine_bench [SCENE [SIZE [THREADS [REPEATS]]]]   default: teapot 512 2 5
 #include <algorithm>
-#include <atomic>
 #include <chrono>
 #include <cstdio>
 #include <cstring>
 #include <exception>
 #include <functional>
 #include <string>
-#include <thread>
 #include <vector>
 
 #include "nodes/machine.hpp"
 #include "tracer/generators.hpp"
+#include "tracer/render.hpp"
 
 namespace {
 
@@ -42,23 +41,13 @@ tracer::Database make_db(const std::string& spec, int size, const tracer::BuildO
   return tracer::build_database(scene, build);
 }
 
-// Rows pulled from a shared counter by plain threads over one database. The
+// The single-process renderer (vmpray --single --threads T): rows pulled
+// from a shared counter by plain threads over one database in memory. The
 // frame is allocated inside the timed part, as the machine allocates its own.
 double shared_memory_seconds(const tracer::Database& db, unsigned threads, std::vector<tracer::Color>& image) {
-  const int w = db.header.camera.width, h = db.header.camera.height;
-  std::atomic<int> next_row{0};
   const auto start = Clock::now();
-  image = std::vector<tracer::Color>(static_cast<std::size_t>(w) * static_cast<std::size_t>(h));
-  std::vector<std::thread> pool;
-  for (unsigned t = 0; t < threads; ++t)
-    pool.emplace_back([&] {
-      tracer::InMemoryPageSource pages(db);
-      tracer::Tracer tracer(db.header, pages);
-      tracer::RayStats stats;
-      for (int y = next_row++; y < h; y = next_row++)
-        for (int x = 0; x < w; ++x) image[static_cast<std::size_t>(y) * w + x] = tracer.trace_pixel(x, y, stats);
-    });
-  for (auto& t : pool) t.join();
+  tracer::RayStats stats;
+  image = tracer::render_frame(db, {}, stats, threads);
   return std::chrono::duration<double>(Clock::now() - start).count();
 }
 
@@ -116,7 +105,7 @@ void print_run(const char* label, const MachineRun& r, double baseline) {
     std::printf("%-46s failed: %s\n", label, r.error.c_str());
     return;
   }
-  std::printf("%-46s %6.3f s (fastest %6.3f)   ratio to shared memory %5.2fx   miss ratio %.4f   image %s\n", label,
+  std::printf("%-46s %6.3f s (fastest %6.3f)   ratio to single process %5.2fx   miss ratio %.4f   image %s\n", label,
               r.times.median(), r.times.fastest(), r.times.median() / baseline, r.miss_ratio,
               r.same_image ? "identical" : "DIFFERS");
 }
@@ -139,9 +128,9 @@ int main(int argc, char** argv) {
     shared1.seconds.push_back(shared_memory_seconds(db, 1, image));
     shared_t.seconds.push_back(shared_memory_seconds(db, threads, image));
   }
-  std::printf("shared memory, 1 thread                        %6.3f s (fastest %6.3f)\n", shared1.median(),
+  std::printf("single process, 1 thread                       %6.3f s (fastest %6.3f)\n", shared1.median(),
               shared1.fastest());
-  std::printf("shared memory, %u threads                       %6.3f s (fastest %6.3f)   speedup %.2fx\n", threads,
+  std::printf("single process, %u threads                      %6.3f s (fastest %6.3f)   speedup %.2fx\n", threads,
               shared_t.median(), shared_t.fastest(), shared1.median() / shared_t.median());
 
   for (int nodes : {16, 64}) {
@@ -166,7 +155,7 @@ int main(int argc, char** argv) {
                   plain.ok() ? one.times.median() / plain.times.median() : 0.0);
   }
 
-  std::printf("where the time goes: hypercube 16, %u threads, against shared memory on %u threads\n", threads,
+  std::printf("where the time goes: hypercube 16, %u threads, against the single process on %u threads\n", threads,
               threads);
   struct Line {
     const char* label;

@@ -1,6 +1,6 @@
 // The machine mode of vmpray: option parsing, and the binary end to end —
-// images identical to the single-process renderer, the machine fields of the
-// JSON report (parsed here by a small strict JSON reader), route traces,
+// images identical to the single-process renderer (on one thread or
+// several), the machine fields of the JSON report, route traces,
 // and one-line errors with no output file for each kind of bad input.
 #include <gtest/gtest.h>
 
@@ -203,6 +203,28 @@ TEST_F(MachineCli, EveryMachineMakesTheSingleProcessImage) {
     ASSERT_EQ(r.exit_code, 0) << m << ": " << r.err;
     EXPECT_TRUE(read_file(dir_ / "machine.ppm") == single) << m;
   }
+}
+
+// The single-process renderer on several threads makes the image and the
+// counts of one thread, and says how many threads traced.
+TEST_F(MachineCli, TheSingleProcessRendererOnThreadsMakesTheSameImageAndCounts) {
+  const std::string scene = "teapot:2 --width 24 --height 20 -q --single";
+  ASSERT_EQ(run(scene + " --threads 1 -o one.ppm --stats one.json").exit_code, 0);
+  const Json one = Json::parse(read_file(dir_ / "one.json"));
+  EXPECT_EQ(one.at("render_threads"), 1);
+  for (const char* threads : {"2", "3", "0", "64"}) {
+    const Outcome r = run(scene + " --threads " + threads + " -o many.ppm --stats many.json");
+    ASSERT_EQ(r.exit_code, 0) << threads << ": " << r.err;
+    EXPECT_TRUE(read_file(dir_ / "many.ppm") == read_file(dir_ / "one.ppm")) << threads;
+    const Json many = Json::parse(read_file(dir_ / "many.json"));
+    EXPECT_EQ(many.at("rays"), one.at("rays")) << threads;
+    EXPECT_EQ(many.at("tests"), one.at("tests")) << threads;
+    EXPECT_EQ(many.at("pages"), one.at("pages")) << threads;
+  }
+  // More threads than rows: as many as there are rows.
+  EXPECT_EQ(Json::parse(read_file(dir_ / "many.json")).at("render_threads"), 20);
+  const Outcome r = run("teapot:2 --width 24 --height 20 --single --threads 2 -o out.ppm");
+  EXPECT_NE(r.out.find("on 2 threads"), std::string::npos) << r.out;
 }
 
 TEST_F(MachineCli, EachBadInputIsOneLineWithNoOutputFile) {

@@ -102,7 +102,7 @@ TEST(Options, AnExplicitZeroSizeOrTessellationIsAnError) {
 
 // --single has no machine to give these to; ignoring them would mislead.
 TEST(Options, MachineOptionsWithSingleAreErrors) {
-  for (const char* option : {"--nodes", "--cache-pages", "--grain", "--threads", "--trace-routes"})
+  for (const char* option : {"--nodes", "--cache-pages", "--grain", "--trace-routes"})
     EXPECT_EQ(error_of({"--single", option, "4"}),
               std::string(option) + ": an option of the machine, but --single renders without one");
   for (const auto& [option, value] : {std::pair{"--topology", "ring"}, {"--timing", "virtual"},
@@ -112,6 +112,8 @@ TEST(Options, MachineOptionsWithSingleAreErrors) {
   EXPECT_NE(error_of({"--single", "--compare-serial"}).find("--compare-serial"), std::string::npos);
   const Options o = parse({"--single", "--width", "8", "--shadow-rays", "all"});
   EXPECT_TRUE(o.single);
+  // --threads is the one machine option the single-process renderer takes.
+  EXPECT_EQ(parse({"--single", "--threads", "3"}).machine.threads, 3u);
 }
 
 TEST(Options, HelpAndVersionAreActions) {

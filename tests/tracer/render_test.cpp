@@ -5,9 +5,12 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstring>
 #include <numbers>
+#include <thread>
+#include <vector>
 
 #include "test_scenes.hpp"
 #include "tracer/generators.hpp"
@@ -123,6 +126,60 @@ TEST(Render, SpdProcedureTracesCornersAndAveragesThem) {
       tracer.trace_sample(3, 4, stats), tracer.trace_sample(4, 4, stats),
       tracer.trace_sample(3, 5, stats), tracer.trace_sample(4, 5, stats));
   EXPECT_EQ(image[4 * 8 + 3], expected);
+}
+
+bool same_stats(const RayStats& a, const RayStats& b) {
+  return a.primary == b.primary && a.primary_hits == b.primary_hits && a.shadow == b.shadow &&
+         a.reflected == b.reflected && a.refracted == b.refracted && a.box_tests == b.box_tests &&
+         a.prim_tests == b.prim_tests && a.record_reads == b.record_reads && a.page_calls == b.page_calls &&
+         a.samples == b.samples && a.distinct_pages == b.distinct_pages;
+}
+
+// The frame on several threads is the frame on one, pixels and counts, with
+// and without SPD corner samples (which go in bands of rows: 70 rows make
+// three, the last one short).
+TEST(Render, ThreadsGiveTheSameImageAndTheSameCounts) {
+  Scene scene = testing::showcase_scene(kSize);
+  scene.camera.width = 23;
+  scene.camera.height = 70;
+  const Database db = build_database(scene, {.page_size = 256});
+  for (const bool spd : {false, true}) {
+    const TraceOptions trace{.spd_procedure = spd};
+    InMemoryPageSource pages(db);
+    RayStats one;
+    const std::vector<Color> expected = render_frame(db.header, pages, trace, one);
+    for (unsigned threads : {0u, 1u, 2u, 3u, 8u, 100u}) {
+      RayStats stats;
+      const std::vector<Color> image = render_frame(db, trace, stats, threads);
+      ASSERT_EQ(image.size(), expected.size());
+      EXPECT_EQ(std::memcmp(image.data(), expected.data(), image.size() * sizeof(Color)), 0)
+          << threads << " threads, spd " << spd;
+      EXPECT_TRUE(same_stats(stats, one)) << threads << " threads, spd " << spd;
+    }
+  }
+}
+
+// Progress comes on the calling thread only, never falls, and ends at the last row.
+TEST(Render, ThreadedProgressIsOnTheCallersThreadAndNeverFalls) {
+  Scene scene = testing::showcase_scene(kSize);
+  const Database db = build_database(scene);
+  for (const bool spd : {false, true}) {
+    std::vector<int> seen;
+    bool elsewhere = false;
+    const auto caller = std::this_thread::get_id();
+    RayStats stats;
+    render_frame(db, {.spd_procedure = spd}, stats, 4, [&](int rows) {
+      elsewhere |= std::this_thread::get_id() != caller;
+      seen.push_back(rows);
+    });
+    EXPECT_FALSE(elsewhere);
+    ASSERT_FALSE(seen.empty());
+    EXPECT_TRUE(std::is_sorted(seen.begin(), seen.end()));
+    EXPECT_LE(seen.back(), kSize);
+    if (spd) {
+      EXPECT_EQ(seen.back(), kSize);  // bands report when they are averaged, the last at the end
+    }
+  }
 }
 
 TEST(Render, MaxDepthOneTracesNoSecondaryRays) {
