@@ -7,6 +7,7 @@
 #include <stdexcept>
 
 #include "app/experiments.hpp"
+#include "app/machine_report.hpp"
 #include "app/output_files.hpp"
 #include "app/viz/ownership.hpp"
 #include "nodes/messages.hpp"
@@ -74,7 +75,7 @@ std::vector<std::uint16_t> pixel_owners(const nodes::MachineReport& report, int 
 viz::Timeline timeline(const nodes::MachineReport& report) {
   viz::Timeline t;
   t.title = report.topology + ", " + std::to_string(report.threads) + " thread(s): tiles over time";
-  t.time_axis = report.cost_model.empty() ? "wall time (s)" : "virtual time (s)";
+  t.time_axis = !report.model ? "wall time (s)" : "virtual time (s)";
   t.nodes = report.nodes;
   t.workers_per_node = report.workers_per_node;
   for (std::size_t n = 0; n < report.per_node.size(); ++n)
@@ -100,8 +101,8 @@ viz::KeyValueTable machine_statistics(const nodes::MachineReport& r) {
             {"links cut between ranks", std::to_string(r.cut_links)},
             {"pixel imbalance (max/mean)", fixed(r.item_imbalance(), 3)},
             {"wall time", fixed(r.wall_seconds, 2) + " s"}};
-  if (!r.cost_model.empty()) {
-    t.rows.push_back({"machine model", r.cost_model});
+  if (!!r.model) {
+    t.rows.push_back({"machine model", r.model->describe()});
     t.rows.push_back({"predicted synthesis time", paper_duration(r.predicted_seconds)});
   }
   return t;
@@ -133,12 +134,11 @@ std::vector<viz::Table> machine_tables(const nodes::MachineReport& r) {
                      .header = {"rank", "nodes", "threads", "packets sent", "bytes sent", "packets received",
                                 "bytes received", "MPI messages", "scene bytes at peak", "cpu (s)", "wall (s)"}};
     for (const nodes::RankReport& k : r.ranks)
-      ranks.rows.push_back({std::to_string(k.rank),
-                            std::to_string(k.first_node) + "-" + std::to_string(k.first_node + k.node_count - 1),
-                            std::to_string(k.threads), std::to_string(k.bridge.packets_sent),
-                            std::to_string(k.bridge.bytes_sent), std::to_string(k.bridge.packets_received),
-                            std::to_string(k.bridge.bytes_received), std::to_string(k.bridge.messages_sent),
-                            std::to_string(k.peak_scene_bytes), fixed(k.cpu_seconds, 3), fixed(k.wall_seconds, 3)});
+      ranks.rows.push_back({std::to_string(k.rank), rank_nodes(k), std::to_string(k.threads),
+                            std::to_string(k.bridge.packets_sent), std::to_string(k.bridge.bytes_sent),
+                            std::to_string(k.bridge.packets_received), std::to_string(k.bridge.bytes_received),
+                            std::to_string(k.bridge.messages_sent), std::to_string(k.peak_scene_bytes),
+                            fixed(k.cpu_seconds, 3), fixed(k.wall_seconds, 3)});
     tables.push_back(std::move(ranks));
   }
   return tables;

@@ -105,6 +105,14 @@ Json json_routes(const nodes::NetworkStats& s) {
 }
 
 // Which ranks ran which nodes, and what crossed between them.
+}  // namespace
+
+std::string rank_nodes(const nodes::RankReport& rank) {
+  return std::to_string(rank.first_node) + "-" + std::to_string(rank.first_node + rank.node_count - 1);
+}
+
+namespace {
+
 void print_ranks(std::ostream& out, const nodes::MachineReport& r) {
   if (r.ranks.empty()) return;
   const topology::Topology t = topology::parse_topology(r.topology);
@@ -116,11 +124,10 @@ void print_ranks(std::ostream& out, const nodes::MachineReport& r) {
       << "packets out" << std::setw(13) << "bytes out" << std::setw(11) << "messages" << std::setw(13)
       << "scene bytes" << std::setw(9) << "cpu s" << std::setw(9) << "wall s" << "\n";
   for (const nodes::RankReport& k : r.ranks) {
-    const std::string nodes = std::to_string(k.first_node) + "-" + std::to_string(k.first_node + k.node_count - 1);
-    out << "  " << std::setw(4) << k.rank << std::setw(13) << nodes << std::setw(8) << k.threads << std::setw(13)
-        << k.bridge.packets_sent << std::setw(13) << k.bridge.bytes_sent << std::setw(11) << k.bridge.messages_sent
-        << std::setw(13) << k.peak_scene_bytes << std::setprecision(3) << std::setw(9) << k.cpu_seconds
-        << std::setw(9) << k.wall_seconds << "\n";
+    out << "  " << std::setw(4) << k.rank << std::setw(13) << rank_nodes(k) << std::setw(8) << k.threads
+        << std::setw(13) << k.bridge.packets_sent << std::setw(13) << k.bridge.bytes_sent << std::setw(11)
+        << k.bridge.messages_sent << std::setw(13) << k.peak_scene_bytes << std::setprecision(3) << std::setw(9)
+        << k.cpu_seconds << std::setw(9) << k.wall_seconds << "\n";
   }
 }
 
@@ -208,7 +215,7 @@ void print_relays(std::ostream& out, const nodes::MachineReport& r) {
 }  // namespace
 
 double MachineSummary::parallel_seconds() const {
-  return report.cost_model.empty() ? report.wall_seconds : report.predicted_seconds;
+  return report.model ? report.predicted_seconds : report.wall_seconds;
 }
 
 double MachineSummary::speedup() const {
@@ -245,17 +252,18 @@ void print_machine_report(std::ostream& out, const MachineSummary& m) {
   out << nodes::format_summary(r.network, topology::parse_topology(r.topology), kind_name);
   print_ranks(out, r);
   out << std::setprecision(3) << "wall time      " << r.wall_seconds << " s on " << count_of(r.threads, "thread");
-  if (r.cost_model.empty())
+  if (!r.model)
     out << std::setprecision(1) << ", idle " << 100 * r.idle_share() << "% of thread time" << std::setprecision(3);
-  else out << "; predicted " << r.predicted_seconds << " s (" << r.cost_model << ")";
+  else
+    out << "; predicted " << r.predicted_seconds << " s (" << r.model->describe() << ")";
   out << "\n";
-  if (r.cost_model.empty()) print_thread_use(out, r.host_threads);
+  if (!r.model) print_thread_use(out, r.host_threads);
   print_relays(out, r);
   if (m.serial)
     out << "speedup        " << m.speedup() << " (1 node: " << m.serial->seconds << " s on "
-        << count_of(m.serial->threads, "thread") << "; " << count_of(r.nodes, "node") << ": "
-        << m.parallel_seconds() << " s on " << count_of(r.threads, "thread") << (r.cost_model.empty() ? "" : ", predicted")
-        << "), efficiency " << m.efficiency() << "\n";
+        << count_of(m.serial->threads, "thread") << "; " << count_of(r.nodes, "node") << ": " << m.parallel_seconds()
+        << " s on " << count_of(r.threads, "thread") << (r.model ? ", predicted" : "") << "), efficiency "
+        << m.efficiency() << "\n";
 }
 
 void print_routes(std::ostream& out, const nodes::MachineReport& report) {
@@ -326,12 +334,12 @@ Json machine_json(const MachineSummary& m) {
             {"cut_links", r.cut_links},
             {"ranks", json_ranks(r)},
             {"wall_seconds", r.wall_seconds}};
-  if (r.cost_model.empty()) {
+  if (!r.model) {
     j["host_threads"] = json_host_threads(r.host_threads);
     j["relayed_links"] = r.relayed_links;
     j["relays"] = json_relays(r);
   } else {
-    j["cost_model"] = r.model ? cost_model_json(*r.model) : Json(r.cost_model);
+    j["cost_model"] = cost_model_json(*r.model);
     j["predicted_seconds"] = r.predicted_seconds;
   }
   j["serial"] = nullptr;

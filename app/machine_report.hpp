@@ -55,6 +55,9 @@ std::vector<std::uint8_t> parse_trace_kinds(const std::string& names);
 std::string tiles_csv(const nodes::MachineReport& report);
 // The machine's part of the --stats document, the same fields as the summary.
 Json machine_json(const MachineSummary& m);
+
+// The block of nodes a rank runs, "first-last", as the text and the page show it.
+std::string rank_nodes(const nodes::RankReport& rank);
 // A virtual-time cost model as an object: its name and every constant
 // (seconds, and link bytes per second), then its one-line description.
 Json cost_model_json(const nodes::CostModel& model);

@@ -393,7 +393,6 @@ Executed execute(const tracer::DatabaseHeader& header, const topology::Topology&
   if (report.relayed_links > 0)
     for (unsigned t = 0; t < runtime.threads(); ++t) report.relays.push_back(net.relay_counters(t));
   if (timing) {
-    report.cost_model = timing->model().describe();
     report.model = timing->model();
     report.predicted_seconds = timing->predicted_seconds();
     report.compute_seconds = timing->compute_seconds();

@@ -134,8 +134,7 @@ struct MachineReport {
   std::vector<csp::ThreadUse> host_threads;  // how each OS thread spent the run
   std::size_t relayed_links = 0;             // links between threads carried by thread relays
   std::vector<RelayCounters> relays;         // per thread, what its relay carried (empty without relays)
-  std::string cost_model;          // CostModel::describe(), empty without virtual time
-  std::optional<CostModel> model;  // the virtual-time model itself; none in real time
+  std::optional<CostModel> model;            // the virtual-time model; none in real time
   double predicted_seconds = 0;    // virtual time at the end of the run
   double compute_seconds = 0;      // virtual compute time summed over the pixel computers
   std::vector<std::uint16_t> owners;  // per pixel (or corner sample), in scanline order: the node that computed it
