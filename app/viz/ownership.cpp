@@ -33,7 +33,7 @@ constexpr int min_shown_width = 256;
 constexpr int max_side = 16384;
 constexpr std::size_t compact_above = 256;     // entries; more: the compact key
 constexpr int swatch = 12, row_step = 16;      // the labelled key
-constexpr int small_swatch = 8, per_row = 32;  // the compact key
+constexpr int small_swatch = 8;                // the compact key: 32 a row, 64 over 1024 entries
 constexpr double key_font = 11;
 
 struct KeyLayout {
@@ -58,10 +58,11 @@ KeyLayout key_layout(const std::vector<KeyEntry>& key, int shown_w, int shown_h)
   const int n = static_cast<int>(key.size());
   if (key.size() > compact_above) {
     k.compact = true;
-    k.cell_w = k.cell_h = small_swatch;
+    k.cell_w = small_swatch + 1;  // swatches a pixel apart, rows two apart: the labels need the room
+    k.cell_h = small_swatch + 2;
     k.label_w = widest_label(key) + 4;
-    k.columns = per_row;
-    k.rows = (n + per_row - 1) / per_row;
+    k.columns = key.size() > 1024 ? 64 : 32;
+    k.rows = (n + k.columns - 1) / k.columns;
     k.left = margin;
     k.top = margin + shown_h + margin;
     return k;
