@@ -17,7 +17,6 @@ struct Rect {
   double left = 0, top = 0, width = 0, height = 0;
   double right() const { return left + width; }
   double bottom() const { return top + height; }
-  bool contains(Point p) const { return p.x >= left && p.x <= right() && p.y >= top && p.y <= bottom(); }
 };
 
 // Fonts of a plot's text, in px.
