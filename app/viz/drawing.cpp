@@ -74,17 +74,23 @@ cairo_status_t append(void* closure, const unsigned char* data, unsigned int len
 std::size_t utf8_sequence(std::string_view s, std::size_t i) {
   const auto b = [&](std::size_t k) { return static_cast<unsigned char>(s[k]); };
   const unsigned char c = b(i);
-  std::size_t n = 0;
-  std::uint32_t code = 0, min = 0;
   if (c < 0x80) return 1;
-  if ((c & 0xE0) == 0xC0)
-    n = 2, code = c & 0x1F, min = 0x80;
-  else if ((c & 0xF0) == 0xE0)
-    n = 3, code = c & 0x0F, min = 0x800;
-  else if ((c & 0xF8) == 0xF0)
-    n = 4, code = c & 0x07, min = 0x10000;
-  else
-    return 0;
+  // Lead byte: the sequence's length, its payload bits, and the least code
+  // point that needs that length (shorter encodings are invalid).
+  struct Lead {
+    unsigned char mask, value, payload;
+    std::size_t length;
+    std::uint32_t min;
+  };
+  static constexpr Lead leads[] = {
+      {0xE0, 0xC0, 0x1F, 2, 0x80}, {0xF0, 0xE0, 0x0F, 3, 0x800}, {0xF8, 0xF0, 0x07, 4, 0x10000}};
+  const Lead* lead = nullptr;
+  for (const Lead& l : leads)
+    if ((c & l.mask) == l.value) lead = &l;
+  if (lead == nullptr) return 0;
+  const std::size_t n = lead->length;
+  const std::uint32_t min = lead->min;
+  std::uint32_t code = c & lead->payload;
   if (i + n > s.size()) return 0;
   for (std::size_t k = 1; k < n; ++k) {
     if ((b(i + k) & 0xC0) != 0x80) return 0;

@@ -1,17 +1,16 @@
 // A timeline of a render's farming, drawn with cairo and written as SVG, PNG
-// or PDF: one row per processor (node 0 at the top, split into one lane per
-// pixel computer, worker 0 at the top, with a line between lanes and, where
-// they have room, each lane named), one bar per tile from the
-// time its worker started it to the time it finished it, coloured by the page
-// requests it took per item, under a time axis. It shows how busy every
-// processor was, how the last tiles fall at the end of the run, and which
-// tiles waited on pages.
-// Invariants: one row per node and one bar per tile of timeline_bars; a bar
-// is one tile, except that consecutive tiles of one worker
-// that would each be drawn narrower than a pixel, with no visible gap
-// between them, share a bar (at most two pixels wide, coloured by their
-// requests over their items), so the picture stays small for any number of
-// tiles. Every coordinate is finite.
+// or PDF: one row per processor (node 0 at the top), split into one lane per
+// pixel computer (worker 0 at the top, a line between lanes, each lane named
+// where it has room), one bar per tile from the time its worker started it
+// to the time it finished it, coloured by the page requests it took per
+// item, under a time axis. It shows how busy every processor was, how the
+// last tiles fall at the end of the run, and which tiles waited on pages.
+// Invariants: one row per node and one bar per element of timeline_bars; a
+// bar is one tile, except that consecutive tiles of one worker that would
+// each be drawn narrower than a pixel, with no visible gap between them,
+// share a bar (at most two pixels wide, coloured by their requests over
+// their items), so the picture stays small for any number of tiles. Every
+// coordinate is finite.
 #pragma once
 
 #include <cstdint>
