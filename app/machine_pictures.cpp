@@ -173,8 +173,9 @@ std::vector<std::filesystem::path> write_machine_pictures(const PictureFiles& fi
   OutputFiles outputs;
   if (!files.machine_svg.empty()) written.push_back(outputs.write_text(files.machine_svg, machine));
   if (!files.ownership_png.empty())
-    written.push_back(
-        outputs.write(files.ownership_png, [&](const auto& p) { ownership.write_image(p.string()); }));
+    written.push_back(outputs.write(files.ownership_png, [&](const auto& p) {
+      viz::ownership_picture(ownership, ownership_key(static_cast<int>(report.nodes))).write_image(p.string());
+    }));
   if (!files.timeline_svg.empty()) written.push_back(outputs.write_text(files.timeline_svg, tiles));
   if (!files.report_html.empty()) {
     // The page takes the image and the ownership picture themselves: a copy

@@ -70,22 +70,35 @@ std::vector<viz::Series> series_of(const SweepTable& t, double (*y)(const Experi
   return series;
 }
 
+// "<scene>: <what> against <axis>", naming the topology when the plot has
+// only one (then there is no legend to name it).
+std::string title_of(const SweepTable& t, const std::vector<viz::Series>& series, const std::string& what) {
+  const std::string axis = t.kind == SweepOptions::Kind::nodes ? "processors" : "cache size";
+  return t.scene + (series.size() == 1 ? " on " + series.front().name : "") + ": " + what + " against " + axis;
+}
+
 std::vector<viz::LinePlot> nodes_plots(const SweepTable& t) {
-  viz::LinePlot time{.title = t.scene + ": predicted synthesis time", .x_label = "processors",
-                     .y_label = "seconds", .x_scale = viz::AxisScale::log2, .y_scale = viz::AxisScale::log10};
+  viz::LinePlot time{
+      .x_label = "processors", .y_label = "seconds", .x_scale = viz::AxisScale::log2, .y_scale = viz::AxisScale::log10};
   time.series = series_of(t, [](const ExperimentPoint& p) { return p.predicted_seconds; });
+  time.title = title_of(t, time.series, "predicted synthesis time");
   viz::Series paper{.name = "paper (iPSC/2)", .style = viz::LineStyle::dashed};
   for (const ExperimentPoint& p : t.points)
     if (const auto s = paper_seconds(t, p); s && (paper.points.empty() || paper.points.back().x < p.nodes))
       paper.points.push_back({double(p.nodes), *s});
   if (!paper.points.empty()) time.series.push_back(paper);
-  viz::LinePlot eff{.title = t.scene + ": efficiency", .x_label = "processors", .y_label = "efficiency (%)",
-                    .x_scale = viz::AxisScale::log2, .y_min = 0.0, .y_max = 105.0};
+  viz::LinePlot eff{.x_label = "processors",
+                    .y_label = "efficiency (%)",
+                    .x_scale = viz::AxisScale::log2,
+                    .y_min = 0.0,
+                    .y_max = 105.0};
   eff.series = series_of(t, [](const ExperimentPoint& p) { return 100 * p.efficiency(); });
+  eff.title = title_of(t, eff.series, "efficiency");
   eff.thresholds.push_back({78, "paper: 78% at 64"});
-  viz::LinePlot speed{.title = t.scene + ": speedup", .x_label = "processors", .y_label = "speedup",
-                      .x_scale = viz::AxisScale::log2, .y_scale = viz::AxisScale::log2};
+  viz::LinePlot speed{
+      .x_label = "processors", .y_label = "speedup", .x_scale = viz::AxisScale::log2, .y_scale = viz::AxisScale::log2};
   speed.series = series_of(t, [](const ExperimentPoint& p) { return p.speedup(); });
+  speed.title = title_of(t, speed.series, "speedup");
   viz::Series ideal{.name = "ideal", .style = viz::LineStyle::dashed, .markers = false};
   for (const auto& p : speed.series.front().points) ideal.points.push_back({p.x, p.x});
   speed.series.push_back(ideal);
@@ -93,16 +106,20 @@ std::vector<viz::LinePlot> nodes_plots(const SweepTable& t) {
 }
 
 std::vector<viz::LinePlot> cache_plots(const SweepTable& t) {
-  viz::LinePlot eff{.title = t.scene + ": efficiency", .x_label = "cache (pages)", .y_label = "efficiency (%)",
-                    .x_scale = viz::AxisScale::log2, .y_min = 0.0, .y_max = 105.0};
+  viz::LinePlot eff{.x_label = "cache (pages)",
+                    .y_label = "efficiency (%)",
+                    .x_scale = viz::AxisScale::log2,
+                    .y_min = 0.0,
+                    .y_max = 105.0};
   eff.series = series_of(t, [](const ExperimentPoint& p) { return 100 * p.efficiency(); });
+  eff.title = title_of(t, eff.series, "efficiency");
   eff.thresholds.push_back({50, "50% threshold"});
-  viz::LinePlot miss{.title = t.scene + ": miss ratio", .x_label = "cache (pages)", .y_label = "miss ratio (%)",
-                     .x_scale = viz::AxisScale::log2};
+  viz::LinePlot miss{.x_label = "cache (pages)", .y_label = "miss ratio (%)", .x_scale = viz::AxisScale::log2};
   miss.series = series_of(t, [](const ExperimentPoint& p) { return 100 * p.miss_ratio; });
-  viz::LinePlot comm{.title = t.scene + ": page communications", .x_label = "cache (pages)",
-                     .y_label = "pages sent", .x_scale = viz::AxisScale::log2};
+  miss.title = title_of(t, miss.series, "miss ratio");
+  viz::LinePlot comm{.x_label = "cache (pages)", .y_label = "pages sent", .x_scale = viz::AxisScale::log2};
   comm.series = series_of(t, [](const ExperimentPoint& p) { return double(p.misses); });
+  comm.title = title_of(t, comm.series, "page communications (pages sent)");
   return {eff, miss, comm};
 }
 

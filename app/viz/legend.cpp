@@ -1,24 +1,17 @@
-// Colour legends (see legend.hpp).
+// Captioned colour bars (see legend.hpp).
 #include "app/viz/legend.hpp"
 
 #include "app/viz/ticks.hpp"
 
-namespace viz {
+namespace viz::detail {
 
-void scale_gradient(SvgDocument& doc, const std::string& id, Rgb8 (*scale)(double)) {
-  doc.open("linearGradient", {{"id", id}});
-  for (int i = 0; i <= 10; ++i)
-    doc.leaf("stop", {{"offset", num(i / 10.0)}, {"stop-color", hex(scale(i / 10.0))}});
-  doc.close();
+void colour_bar(cairo_t* cr, double x, double y, Rgb8 (*scale)(double), const std::string& caption, double max) {
+  set_colour(cr, {0, 0, 0});
+  show_text(cr, x, y, caption, {12});
+  gradient_bar(cr, x, y + 6, colour_bar_width, 10, scale);
+  set_colour(cr, {0, 0, 0});
+  show_text(cr, x, y + 30, "0", {11});
+  show_text(cr, x + colour_bar_width, y + 30, format_number(max), {11}, Align::right);
 }
 
-void colour_bar(SvgDocument& doc, double x, double y, const std::string& id, const std::string& caption,
-                double max) {
-  doc.text(caption, {{"x", num(x)}, {"y", num(y)}, {"font-size", "12"}});
-  doc.leaf("rect", {{"x", num(x)}, {"y", num(y + 6)}, {"width", "160"}, {"height", "10"},
-                    {"fill", "url(#" + id + ")"}, {"stroke", "#333333"}});
-  doc.text("0", {{"x", num(x)}, {"y", num(y + 30)}, {"font-size", "11"}});
-  doc.text(format_number(max), {{"x", num(x + 160)}, {"y", num(y + 30)}, {"font-size", "11"}, {"text-anchor", "end"}});
-}
-
-}  // namespace viz
+}  // namespace viz::detail

@@ -1,21 +1,18 @@
-// Colour legends shared by the viz pictures: a colour scale as an SVG
-// gradient, and a captioned bar that shows it from 0 to a maximum.
-// Invariant: a gradient's id names its scale alone, so the same id may appear
-// in several pictures inlined in one page.
+// Internal to the viz library: the captioned colour bar that the machine
+// drawing and the timeline use to show a colour scale from 0 to a maximum.
+// Invariant: the bar spans colour_bar_width px, 0 at its left end.
 #pragma once
 
 #include <string>
 
 #include "app/viz/colour.hpp"
-#include "app/viz/svg.hpp"
+#include "app/viz/drawing.hpp"
 
-namespace viz {
+namespace viz::detail {
 
-// A <linearGradient> of `scale` from 0 to 1 (inside an open <defs>).
-void scale_gradient(SvgDocument& doc, const std::string& id, Rgb8 (*scale)(double));
+constexpr double colour_bar_width = 160;
 
-// Caption at (x, y), the gradient `id` below it, 160 wide, labelled 0 and max.
-void colour_bar(SvgDocument& doc, double x, double y, const std::string& id, const std::string& caption,
-                double max);
+// Caption with its baseline at y, the bar of `scale` below it, labelled 0 and max.
+void colour_bar(cairo_t* cr, double x, double y, Rgb8 (*scale)(double), const std::string& caption, double max);
 
-}  // namespace viz
+}  // namespace viz::detail

@@ -1,4 +1,5 @@
-// A picture of the machine after a render, as SVG: every processor as a node
+// A picture of the machine after a render, drawn with cairo and written as
+// SVG, PNG or PDF: every processor as a node
 // filled by the pixels it computed, ringed by the page requests it served, and
 // every directed link coloured and sized by the traffic it carried.
 // Layouts: hypercube bits alternate between x (even bits) and y (odd bits)
@@ -7,19 +8,20 @@
 // and complete graph on a circle, node 0 at the top, ids clockwise.
 // The picture grows with the layout, up to a bound, so that node labels stay
 // legible (at least 10 px for every kind up to 64 nodes).
-// Invariants: one element of class "node" per node. Up to 4096 listed links
-// (every machine of up to 64 nodes): one element of class "link", with a
-// tooltip, per directed link that carried packets (the two directions of a
-// link are drawn side by side, each offset to the right of its direction of
-// travel), one of class "idle-link" per listed link that carried none. More
-// links than that are drawn in bulk: busy links grouped by traffic into at
-// most 16 elements of class "link-band", idle links left out and counted in
-// the legend.
+// Invariants: one disk per node, filled by the work scale. Up to 4096 listed
+// links (every machine of up to 64 nodes): one stroke per directed link that
+// carried packets (the two directions of a link are drawn side by side, each
+// offset to the right of its direction of travel), heaviest on top, and a
+// thin grey one per listed link that carried none. More links than that are
+// drawn in bulk: busy links grouped by traffic into at most 16 strokes, idle
+// links left out and counted in the legend.
 #pragma once
 
 #include <cstdint>
 #include <string>
 #include <vector>
+
+#include "tracer/image.hpp"
 
 namespace viz {
 
@@ -51,8 +53,21 @@ struct MachineDrawing {
 // std::invalid_argument naming the problem for impossible dimensions.
 int machine_node_count(const MachineDrawing& m);
 
-// Throws std::invalid_argument if nodes.size() does not match the topology or
-// a link names a node out of range.
-std::string machine_svg(const MachineDrawing& m);
+// Each throws std::invalid_argument if nodes.size() does not match the
+// topology or a link names a node out of range.
+std::string machine_svg(const MachineDrawing& m);      // ready to inline, see svg.hpp
+std::string machine_pdf(const MachineDrawing& m);      // the bytes of a PDF file
+tracer::Image machine_image(const MachineDrawing& m);  // at the SVG's size in px
+
+// Where the picture draws node i, in px: its centre, radius and the font
+// size of its label.
+struct NodePlace {
+  double x = 0, y = 0, radius = 0, label_size = 0;
+};
+std::vector<NodePlace> machine_node_places(const MachineDrawing& m);
+
+// The lines of the legend under the colour bars, in order: only what the
+// picture has (rings if some node served pages, the rest if there are links).
+std::vector<std::string> machine_legend_notes(const MachineDrawing& m);
 
 }  // namespace viz

@@ -5,7 +5,7 @@
 #include <cmath>
 #include <limits>
 
-#include "app/viz/colour.hpp"
+#include "app/viz/text.hpp"
 
 namespace viz::detail {
 namespace {
@@ -42,20 +42,22 @@ Ticks y_axis(const LinePlot& plot, Range r) {
   return kept;
 }
 
-std::size_t longest(const std::vector<std::string>& texts) {
-  std::size_t n = 0;
-  for (const std::string& s : texts) n = std::max(n, s.size());
-  return n;
+double widest(const std::vector<std::string>& texts, double font_size) {
+  double w = 0;
+  for (const std::string& s : texts) w = std::max(w, text_width(s, {font_size}));
+  return w;
 }
 
 }  // namespace
 
-PlotGeometry::PlotGeometry(const LinePlot& plot, Rect panel, double char_width)
-    : plot_(plot), panel_(panel) {
+PlotGeometry::PlotGeometry(const LinePlot& plot, Rect panel) : plot_(plot), panel_(panel) {
   Range xr, yr;
   for (const Series& s : plot.series)
     for (const Point& p : s.points)
-      if (drawable(p)) { xr.add(p.x); yr.add(p.y); }
+      if (drawable(p)) {
+        xr.add(p.x);
+        yr.add(p.y);
+      }
   if (xr.empty()) xr = plot.x_scale == AxisScale::linear ? Range{0, 1} : Range{1, 2};
   x_ticks_ = make_ticks(plot.x_scale, xr.lo, xr.hi);
   y_ticks_ = y_axis(plot, yr);
@@ -63,24 +65,26 @@ PlotGeometry::PlotGeometry(const LinePlot& plot, Rect panel, double char_width)
   std::vector<std::string> names;
   for (const Series& s : plot.series)
     if (!s.name.empty()) names.push_back(s.name);
+  legend_lists_series_ = names.size() >= 2;
+  if (!legend_lists_series_) names.clear();
   for (const Threshold& t : plot.thresholds)
-    if (!t.label.empty() && usable(plot.y_scale, t.y)) names.push_back(t.label);
-  const double legend_w =
-      names.empty() ? 0.0
-                    : std::min(panel.width * 0.4, 34.0 + char_width * static_cast<double>(longest(names)));
+    if (!t.label.empty() && drawable(t)) names.push_back(t.label);
+  const double legend_w = names.empty() ? 0.0 : std::min(panel.width * 0.4, 34.0 + widest(names, legend_font));
   const double top = plot.title.empty() ? 12.0 : 32.0;
   const double bottom = plot.x_label.empty() ? 28.0 : 46.0;
-  const double left = 14.0 + char_width * static_cast<double>(longest(y_ticks_.labels)) +
-                      (plot.y_label.empty() ? 0.0 : 20.0);
+  const double left = 14.0 + widest(y_ticks_.labels, tick_font) + (plot.y_label.empty() ? 0.0 : 20.0);
   const double right = legend_w > 0 ? legend_w + 12.0 : 16.0;
   area_ = {panel.left + left, panel.top + top, std::max(10.0, panel.width - left - right),
            std::max(10.0, panel.height - top - bottom)};
-  legend_ = {area_.right() + 8.0, area_.top, legend_w, 16.0 * static_cast<double>(names.size()) + 8.0};
+  legend_ = {area_.right() + 8.0, area_.top, legend_w,
+             names.empty() ? 0.0 : legend_step * static_cast<double>(names.size()) + 8.0};
 }
 
 bool PlotGeometry::drawable(const Point& p) const {
   return usable(plot_.x_scale, p.x) && usable(plot_.y_scale, p.y);
 }
+
+bool PlotGeometry::drawable(const Threshold& t) const { return usable(plot_.y_scale, t.y); }
 
 double PlotGeometry::x(double data_x) const {
   const double a = axis_coordinate(plot_.x_scale, x_ticks_.lo);
@@ -99,10 +103,6 @@ std::vector<Point> PlotGeometry::pixels(const Series& s) const {
   for (const Point& p : s.points)
     if (drawable(p)) out.push_back({x(p.x), y(p.y)});
   return out;
-}
-
-std::string series_colour_hex(const Series& s, int index) {
-  return s.colour.empty() ? hex(series_colour(index)) : s.colour;
 }
 
 }  // namespace viz::detail

@@ -1,7 +1,5 @@
-// Line plots rasterised into a tracer::Image (write it with write_png): the
-// same layout as plot_svg (grid, axes, tick values, thresholds, lines,
-// markers, legend), with all text in a built-in 5x7 bitmap font that has
-// capitals, digits and common punctuation only (lower case is drawn as capitals).
+// Line plots as pictures in a tracer::Image (write it with write_png): the
+// drawing of plot.hpp on a cairo image surface, text anti-aliased.
 #pragma once
 
 #include "app/viz/plot.hpp"

@@ -1,10 +1,16 @@
-// SVG text building; see svg.hpp for the invariants.
+// XML escaping and inlinable SVG documents; see svg.hpp for the invariants.
 #include "app/viz/svg.hpp"
 
-#include <cmath>
-#include <cstdio>
+#include <array>
+#include <atomic>
+#include <cstdint>
 
 namespace viz {
+namespace {
+
+std::atomic<std::uint64_t> documents{0};
+
+}  // namespace
 
 std::string escape_xml(std::string_view text) {
   std::string out;
@@ -22,72 +28,33 @@ std::string escape_xml(std::string_view text) {
   return out;
 }
 
-std::string num(double value) {
-  if (!std::isfinite(value)) return "0";
-  char buf[48];
-  std::snprintf(buf, sizeof buf, "%.2f", value);
-  std::string s = buf;
-  // Trim trailing zeros (and a bare point) to keep files small.
-  while (!s.empty() && s.back() == '0') s.pop_back();
-  if (!s.empty() && s.back() == '.') s.pop_back();
-  if (s == "-0") s = "0";
-  return s;
-}
-
-SvgDocument::SvgDocument(double width, double height) {
-  out_ += "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"" + num(width) + "\" height=\"" +
-          num(height) + "\" viewBox=\"0 0 " + num(width) + " " + num(height) +
-          "\" font-family=\"sans-serif\">\n";
-  open_.push_back("svg");
-}
-
-void SvgDocument::write_start(std::string_view tag, std::initializer_list<Attr> attrs) {
-  out_ += '<';
-  out_ += tag;
-  for (const Attr& a : attrs) {
-    out_ += ' ';
-    out_ += a.name;
-    out_ += "=\"";
-    out_ += escape_xml(a.value);
-    out_ += '"';
+std::string inlinable_svg(std::string_view svg) {
+  if (svg.substr(0, 5) == "<?xml") {
+    const std::size_t end = svg.find("?>");
+    svg.remove_prefix(end == std::string_view::npos ? svg.size() : end + 2);
   }
-}
-
-void SvgDocument::leaf(std::string_view tag, std::initializer_list<Attr> attrs) {
-  write_start(tag, attrs);
-  out_ += "/>\n";
-}
-
-void SvgDocument::text(std::string_view content, std::initializer_list<Attr> attrs) {
-  write_start("text", attrs);
-  out_ += '>';
-  out_ += escape_xml(content);
-  out_ += "</text>\n";
-}
-
-void SvgDocument::title(std::string_view content) {
-  out_ += "<title>" + escape_xml(content) + "</title>";
-}
-
-void SvgDocument::open(std::string_view tag, std::initializer_list<Attr> attrs) {
-  write_start(tag, attrs);
-  out_ += ">";
-  open_.emplace_back(tag);
-}
-
-void SvgDocument::close() {
-  // The root is closed only by finish(), so a stray close() cannot end the document.
-  if (open_.size() <= 1) return;
-  out_ += "</" + open_.back() + ">\n";
-  open_.pop_back();
-}
-
-std::string SvgDocument::finish() {
-  while (!open_.empty()) {
-    out_ += "</" + open_.back() + ">\n";
-    open_.pop_back();
+  while (!svg.empty() && (svg.front() == '\n' || svg.front() == '\r' || svg.front() == ' ')) svg.remove_prefix(1);
+  const std::string prefix = "viz" + std::to_string(++documents) + "-";
+  // Where an id is defined or referred to: the prefix goes right after each.
+  static constexpr std::array<std::string_view, 3> openings{" id=\"", "href=\"#", "url(#"};
+  std::array<std::size_t, openings.size()> next{};  // where each opening occurs next
+  for (std::size_t k = 0; k < openings.size(); ++k) next[k] = svg.find(openings[k]);
+  std::string out;
+  out.reserve(svg.size() + svg.size() / 16);
+  std::size_t i = 0;
+  for (;;) {
+    std::size_t k = 0;
+    for (std::size_t j = 1; j < openings.size(); ++j)
+      if (next[j] < next[k]) k = j;
+    if (next[k] == std::string_view::npos) break;
+    const std::size_t end = next[k] + openings[k].size();
+    out.append(svg.substr(i, end - i));
+    out += prefix;
+    i = end;
+    next[k] = svg.find(openings[k], i);
   }
-  return std::move(out_);
+  out.append(svg.substr(i));
+  return out;
 }
 
 }  // namespace viz

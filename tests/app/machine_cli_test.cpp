@@ -431,11 +431,8 @@ TEST_F(MachineCli, TimelineDrawsARowPerNode) {
   ASSERT_EQ(r.exit_code, 0) << r.err;
   const std::string svg = read_file(dir_ / "tiles.svg");
   EXPECT_TRUE(svg.starts_with("<svg")) << svg.substr(0, 40);
-  std::size_t rows = 0;
-  for (std::size_t at = svg.find("class=\"row\""); at != std::string::npos; at = svg.find("class=\"row\"", at + 1))
-    ++rows;
-  EXPECT_EQ(rows, 8u);
-  EXPECT_NE(svg.find("wall time (s)"), std::string::npos);
+  // Its text is drawn as outlines: the rows are checked in tests/viz/timeline_test.cpp.
+  EXPECT_TRUE(svg.ends_with("</svg>\n")) << svg.substr(svg.size() - std::min<std::size_t>(svg.size(), 40));
 
   const Outcome single = run("tetra:3 --width 32 --height 32 --single -o single.png --timeline t.svg");
   EXPECT_EQ(single.exit_code, 2);

@@ -1,5 +1,7 @@
 // Pixel-ownership images: one distinct colour per node, stable colours,
-// overlay blending, size checks.
+// overlay blending, size checks; their pictures with a key.
+#include "app/viz/ownership.hpp"
+
 #include <gtest/gtest.h>
 
 #include <set>
@@ -7,7 +9,7 @@
 #include <tuple>
 
 #include "app/viz/colour.hpp"
-#include "app/viz/ownership.hpp"
+#include "picture_check.hpp"
 
 namespace viz {
 namespace {
@@ -71,6 +73,60 @@ TEST(Ownership, RejectsWrongOwnerCount) {
   EXPECT_THROW(ownership_image(4, 4, std::vector<std::uint16_t>(15)), std::invalid_argument);
   EXPECT_THROW(ownership_image(0, 4, {}), std::invalid_argument);
   EXPECT_THROW(ownership_overlay(tracer::Image(2, 2), {1, 2, 3}), std::invalid_argument);
+}
+
+std::vector<KeyEntry> key_of(int nodes) {
+  std::vector<KeyEntry> key;
+  for (int n = 0; n < nodes; ++n) key.push_back({std::to_string(n), node_colour(n)});
+  return key;
+}
+
+// Pixels of exactly colour c.
+int pixels_of(const tracer::Rgb8Image& img, Rgb8 c) {
+  int n = 0;
+  for (int y = 0; y < img.height; ++y)
+    for (int x = 0; x < img.width; ++x) n += test::pixel(img, x, y) == c;
+  return n;
+}
+
+// Every pixel owned by node 0, so colours of other nodes come from the key.
+TEST(OwnershipPicture, KeyShowsEveryNodesColour) {
+  for (int nodes : {1, 4, 16, 64, 300}) {
+    const tracer::Image owners = ownership_image(12, 10, std::vector<std::uint16_t>(120, 0));
+    const tracer::Image picture = ownership_picture(owners, key_of(nodes));
+    EXPECT_GT(picture.width(), owners.width());
+    EXPECT_GT(picture.height(), owners.height());
+    const tracer::Rgb8Image bytes = picture.to_rgb8();
+    for (int n = 1; n < nodes; ++n) EXPECT_GE(pixels_of(bytes, node_colour(n)), 16) << n << " of " << nodes << " nodes";
+  }
+}
+
+// A small image is enlarged by a whole factor with its pixels kept sharp:
+// the picture holds many pixels of each of its two owners' colours.
+TEST(OwnershipPicture, SmallImagesAreEnlargedSharply) {
+  std::vector<std::uint16_t> owners(12 * 10, 3);
+  for (int i = 0; i < 60; ++i) owners[static_cast<std::size_t>(i)] = 5;
+  const tracer::Image picture = ownership_picture(ownership_image(12, 10, owners), {});
+  EXPECT_GE(picture.width(), 256);
+  const tracer::Rgb8Image bytes = picture.to_rgb8();
+  const int factor = (256 + 11) / 12;
+  EXPECT_GE(pixels_of(bytes, node_colour(5)), 60 * factor * factor);
+  EXPECT_GE(pixels_of(bytes, node_colour(3)), 60 * factor * factor);
+}
+
+// Labels are drawn as text: dark pixels in the picture where the image has none.
+TEST(OwnershipPicture, KeyIsLabelled) {
+  const tracer::Image owners = ownership_image(300, 200, std::vector<std::uint16_t>(60000, 1));
+  const tracer::Rgb8Image unlabelled = ownership_picture(owners, {{"", node_colour(0)}}).to_rgb8();
+  const tracer::Rgb8Image labelled = ownership_picture(owners, key_of(4)).to_rgb8();
+  EXPECT_EQ(test::dark_pixels(unlabelled, 0, 0, unlabelled.width, unlabelled.height), 0);
+  EXPECT_GT(test::dark_pixels(labelled, 0, 0, labelled.width, labelled.height), 10);
+  EXPECT_GT(test::intermediate_greys(labelled, 0, 0, labelled.width, labelled.height), 10);
+}
+
+TEST(OwnershipPicture, RejectsEmptyAndHugeImages) {
+  EXPECT_THROW(ownership_picture(tracer::Image{}, key_of(2)), std::invalid_argument);
+  EXPECT_THROW(ownership_picture(tracer::Image(20000, 1), key_of(2)), std::invalid_argument);
 }
 
 }  // namespace

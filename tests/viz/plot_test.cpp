@@ -1,14 +1,16 @@
-// Line plots: well-formed SVG, finite coordinates, geometry monotone with the
-// data, log axes, thresholds and small multiples.
+// Line plots: well-formed SVG with unique ids, valid PDF, geometry monotone
+// with the data, log axes, thresholds, small multiples, titles that fit.
+#include "app/viz/plot.hpp"
+
 #include <gtest/gtest.h>
 
 #include <algorithm>
 #include <cmath>
 #include <limits>
-#include <sstream>
 
-#include "app/viz/plot.hpp"
 #include "app/viz/plot_geometry.hpp"
+#include "app/viz/text.hpp"
+#include "picture_check.hpp"
 #include "xml_check.hpp"
 
 namespace viz {
@@ -25,22 +27,6 @@ LinePlot speedup_plot() {
   return p;
 }
 
-std::vector<std::pair<double, double>> polyline_points(const test::XmlElement& e) {
-  std::vector<std::pair<double, double>> pts;
-  std::istringstream in(e.attrs.at("points"));
-  double x = 0, y = 0;
-  char comma = 0;
-  while (in >> x >> comma >> y) pts.emplace_back(x, y);
-  return pts;
-}
-
-std::vector<test::XmlElement> polylines(const test::XmlCheck& doc) {
-  std::vector<test::XmlElement> out;
-  for (const auto& e : doc.elements)
-    if (e.tag == "polyline") out.push_back(e);
-  return out;
-}
-
 bool has_non_finite(const test::XmlCheck& doc) {
   for (const auto& e : doc.elements)
     for (const auto& [k, v] : e.attrs)
@@ -49,45 +35,73 @@ bool has_non_finite(const test::XmlCheck& doc) {
 }
 
 TEST(LinePlot, SvgIsWellFormedAndFinite) {
-  const test::XmlCheck doc = test::check_xml(plot_svg(speedup_plot()));
+  const std::string svg = plot_svg(speedup_plot());
+  EXPECT_EQ(svg.rfind("<svg", 0), 0u) << svg.substr(0, 40);  // no XML declaration: ready to inline
+  const test::XmlCheck doc = test::check_xml(svg);
   ASSERT_TRUE(doc.ok) << doc.error;
   EXPECT_EQ(doc.elements.front().tag, "svg");
   EXPECT_FALSE(has_non_finite(doc));
 }
 
-TEST(LinePlot, EscapesTitle) {
-  const std::string svg = plot_svg(speedup_plot());
-  EXPECT_NE(svg.find("Synthesis time &lt;teapot&gt; &amp; co"), std::string::npos);
+// Text is drawn as outlines: more of them with a title than without, and
+// no reference to glyphs defined elsewhere.
+TEST(LinePlot, SvgTextIsDrawnAsOutlines) {
+  LinePlot p = speedup_plot();
+  const std::string titled = plot_svg(p);
+  p.title.clear();
+  const std::string untitled = plot_svg(p);
+  EXPECT_GT(titled.size(), untitled.size() + 1000);
+  EXPECT_EQ(titled.find("href"), std::string::npos);
+}
+
+TEST(LinePlot, IdsAreUniqueAcrossDocumentsAndResolve) {
+  LinePlot clipped = speedup_plot();
+  clipped.y_max = 1000;  // the data goes beyond the area, so its clip is in the document
+  const std::string a = plot_svg(clipped), b = plot_svg(clipped);
+  const std::set<std::string> ids_a = test::svg_ids(a), ids_b = test::svg_ids(b);
+  ASSERT_FALSE(ids_a.empty());
+  for (const std::string& id : ids_a) EXPECT_EQ(ids_b.count(id), 0u) << id;
+  for (const std::string& r : test::svg_references(a)) EXPECT_EQ(ids_a.count(r), 1u) << r;
+  for (const std::string& r : test::svg_references(b)) EXPECT_EQ(ids_b.count(r), 1u) << r;
+  EXPECT_FALSE(test::svg_references(a).empty());
+}
+
+TEST(LinePlot, PdfIsAPdf) {
+  EXPECT_TRUE(test::is_pdf(plot_pdf(speedup_plot())));
+  EXPECT_TRUE(test::is_pdf(plots_pdf({speedup_plot(), LinePlot{}}, 2)));
 }
 
 TEST(LinePlot, PixelsFollowTheData) {
   // Time falls as processors rise: x pixels increase, y pixels increase (downwards).
-  const test::XmlCheck doc = test::check_xml(plot_svg(speedup_plot()));
-  const auto lines = polylines(doc);
-  ASSERT_EQ(lines.size(), 2u);
-  const auto pts = polyline_points(lines[0]);
+  const LinePlot p = speedup_plot();
+  const detail::PlotGeometry g(p, {0, 0, 520, 340});
+  const std::vector<Point> pts = g.pixels(p.series[0]);
   ASSERT_EQ(pts.size(), 7u);
   for (std::size_t i = 1; i < pts.size(); ++i) {
-    EXPECT_GT(pts[i].first, pts[i - 1].first);
-    EXPECT_GT(pts[i].second, pts[i - 1].second);
+    EXPECT_GT(pts[i].x, pts[i - 1].x);
+    EXPECT_GT(pts[i].y, pts[i - 1].y);
+  }
+  for (const Point& q : pts) {
+    EXPECT_TRUE(q.x >= g.area().left && q.x <= g.area().right()) << q.x;
+    EXPECT_TRUE(q.y >= g.area().top && q.y <= g.area().bottom()) << q.y;
   }
 }
 
 TEST(LinePlot, Log2AxisSpacesDoublingsEvenly) {
-  const test::XmlCheck doc = test::check_xml(plot_svg(speedup_plot()));
-  const auto pts = polyline_points(polylines(doc)[0]);
-  const double step = pts[1].first - pts[0].first;
-  for (std::size_t i = 1; i < pts.size(); ++i) EXPECT_NEAR(pts[i].first - pts[i - 1].first, step, 0.02);
+  const LinePlot p = speedup_plot();
+  const std::vector<Point> pts = detail::PlotGeometry(p, {0, 0, 520, 340}).pixels(p.series[0]);
+  const double step = pts[1].x - pts[0].x;
+  for (std::size_t i = 1; i < pts.size(); ++i) EXPECT_NEAR(pts[i].x - pts[i - 1].x, step, 1e-9);
 }
 
 TEST(LinePlot, SkipsPointsThatCannotBeDrawn) {
   LinePlot p;
   p.x_scale = AxisScale::log2;
   p.series.push_back({"s", {{0, 1}, {1, std::nan("")}, {2, 3}, {std::numeric_limits<double>::infinity(), 1}, {4, 5}}});
+  EXPECT_EQ(detail::PlotGeometry(p, {0, 0, 520, 340}).pixels(p.series[0]).size(), 2u);
   const test::XmlCheck doc = test::check_xml(plot_svg(p));
   ASSERT_TRUE(doc.ok) << doc.error;
   EXPECT_FALSE(has_non_finite(doc));
-  EXPECT_EQ(polyline_points(polylines(doc)[0]).size(), 2u);
 }
 
 TEST(LinePlot, EmptyPlotStillWellFormed) {
@@ -96,41 +110,29 @@ TEST(LinePlot, EmptyPlotStillWellFormed) {
   EXPECT_FALSE(has_non_finite(doc));
 }
 
-TEST(LinePlot, ThresholdDrawnAtItsValue) {
-  LinePlot p;
-  p.y_min = 0;
-  p.y_max = 1;
-  p.series.push_back({"efficiency", {{1, 1.0}, {8, 0.2}}});
-  p.thresholds.push_back({0.5, "50%"});
-  const test::XmlCheck doc = test::check_xml(plot_svg(p));
-  ASSERT_EQ(test::count_class(doc, "threshold"), 1u);
-  const detail::PlotGeometry g(p, {0, 0, 520, 340}, 6.6);
-  for (const auto& e : doc.elements) {
-    if (e.attrs.count("class") && e.attrs.at("class") == "threshold") {
-      EXPECT_NEAR(std::stod(e.attrs.at("y1")), (g.y(0.0) + g.y(1.0)) / 2, 0.01);
-    }
-  }
+// Text that is not UTF-8 is drawn with '?' for its bad bytes, not refused.
+TEST(LinePlot, InvalidUtf8IsReplaced) {
+  EXPECT_EQ(detail::valid_utf8("a\xff"
+                               "b\xc3\xa9\xe2\x82"),
+            "a?b\xc3\xa9??");
+  LinePlot p = speedup_plot();
+  p.title = "bad \xc0\xaf title";
+  EXPECT_TRUE(test::check_xml(plot_svg(p)).ok);
 }
 
-// The label goes in the legend, where it cannot cover the lines that end
-// near the threshold.
 TEST(LinePlot, ThresholdLabelIsInTheLegend) {
   LinePlot p;
   p.y_min = 0;
   p.y_max = 100;
   p.series.push_back({"hypercube", {{1, 100}, {64, 78}}});
   p.thresholds.push_back({78, "paper: 78% at 64"});
-  const test::XmlCheck doc = test::check_xml(plot_svg(p));
-  const detail::PlotGeometry g(p, {0, 0, 520, 340}, 6.6);
-  std::size_t labels = 0;
-  for (const auto& e : doc.elements) {
-    if (e.tag != "text" || e.text != "paper: 78% at 64") continue;
-    ++labels;
-    EXPECT_GE(std::stod(e.attrs.at("x")), g.legend().left);
-    EXPECT_GE(std::stod(e.attrs.at("y")), g.legend().top);
-    EXPECT_LE(std::stod(e.attrs.at("y")), g.legend().bottom());
-  }
-  EXPECT_EQ(labels, 1u);
+  const detail::PlotGeometry g(p, {0, 0, 520, 340});
+  EXPECT_GE(g.legend().left, g.area().right());
+  EXPECT_GE(g.legend().width, detail::text_width("paper: 78% at 64", {detail::legend_font}));
+  EXPECT_NEAR(g.y(78), g.area().bottom() - 0.78 * g.area().height, 1e-9);
+  p.thresholds.push_back({-1, "off the axis"});
+  p.y_scale = AxisScale::log10;
+  EXPECT_FALSE(detail::PlotGeometry(p, {0, 0, 520, 340}).drawable(p.thresholds[1]));
 }
 
 TEST(LinePlot, FixedRangeBoundsTheAxis) {
@@ -138,7 +140,7 @@ TEST(LinePlot, FixedRangeBoundsTheAxis) {
   p.y_min = 0.25;
   p.y_max = 0.75;
   p.series.push_back({"s", {{0, 0.3}, {1, 0.7}}});
-  const detail::PlotGeometry g(p, {0, 0, 400, 300}, 6.6);
+  const detail::PlotGeometry g(p, {0, 0, 400, 300});
   EXPECT_DOUBLE_EQ(g.y(0.25), g.area().bottom());
   EXPECT_DOUBLE_EQ(g.y(0.75), g.area().top);
   for (double v : g.y_ticks().values) {
@@ -149,54 +151,42 @@ TEST(LinePlot, FixedRangeBoundsTheAxis) {
 
 TEST(LinePlot, SmallMultiplesHoldEveryPanel) {
   std::vector<LinePlot> panels(3, speedup_plot());
-  panels[1].title = "miss ratio";
-  panels[2].title = "page communications";
   const test::XmlCheck doc = test::check_xml(plots_svg(panels, 3));
   ASSERT_TRUE(doc.ok) << doc.error;
-  EXPECT_EQ(test::count_class(doc, "plot"), 3u);
   EXPECT_EQ(std::stod(doc.elements.front().attrs.at("width")), 3 * PlotSize{}.width);
+  EXPECT_EQ(std::stod(doc.elements.front().attrs.at("height")), PlotSize{}.height);
+  const test::XmlCheck column = test::check_xml(plots_svg(panels, 1));
+  EXPECT_EQ(std::stod(column.elements.front().attrs.at("height")), 3 * PlotSize{}.height);
 }
 
-std::size_t utf8_chars(const std::string& s) {
-  return static_cast<std::size_t>(
-      std::count_if(s.begin(), s.end(), [](char c) { return (static_cast<unsigned char>(c) & 0xC0) != 0x80; }));
-}
-
-// Small multiples side by side, as a sweep draws them, with titles that start
-// with a long scene name: each title, at a generous estimate of bold
-// sans-serif (0.62 em a character), stays inside its own panel, and the
-// panel's tooltip keeps the whole title.
-TEST(LinePlot, LongTitlesStayInsideTheirPanels) {
+// Titles as long as a sweep's with a long scene name: shrunk to fit, and
+// when that is not enough, their middle gives way to an ellipsis.
+TEST(LinePlot, LongTitlesFitTheirPanels) {
   const std::string scene = "a_rather_long_scene_file_name_for_the_class_demo.nff";
-  std::vector<LinePlot> panels(3, speedup_plot());
-  panels[0].title = scene + ": predicted synthesis time";
-  panels[1].title = scene + scene + ": speedup";
-  panels[2].title = "short";
-  const PlotSize size{};
-  const test::XmlCheck doc = test::check_xml(plots_svg(panels, 3, size));
-  ASSERT_TRUE(doc.ok) << doc.error;
-  std::vector<std::string> tooltips, shown;
-  std::size_t panel = 0;
-  for (const auto& e : doc.elements) {
-    if (e.tag == "title") tooltips.push_back(e.text);
-    if (!e.attrs.count("class") || e.attrs.at("class") != "plot-title") continue;
-    ASSERT_EQ(e.attrs.at("text-anchor"), "middle");
-    const double half = 0.5 * 0.62 * std::stod(e.attrs.at("font-size")) * static_cast<double>(utf8_chars(e.text));
-    const double x = std::stod(e.attrs.at("x"));
-    EXPECT_GE(x - half, panel * size.width) << e.text;
-    EXPECT_LE(x + half, (panel + 1) * size.width) << e.text;
-    EXPECT_GE(std::stod(e.attrs.at("font-size")), 11.0);
-    shown.push_back(e.text);
-    ++panel;
-  }
-  ASSERT_EQ(panel, 3u);
-  // Too long to fit even when shrunk: the start of the scene and what the panel shows remain.
-  EXPECT_EQ(shown[1].rfind("a_rather", 0), 0u) << shown[1];
-  EXPECT_NE(shown[1].find("\u2026"), std::string::npos) << shown[1];
-  EXPECT_EQ(shown[1].substr(shown[1].size() - 9), ": speedup");
-  EXPECT_EQ(shown[2], "short");
-  for (const LinePlot& p : panels)
-    EXPECT_NE(std::find(tooltips.begin(), tooltips.end(), p.title), tooltips.end()) << p.title;
+  const double room = PlotSize{}.width - 8;
+  const detail::Font title{detail::title_font_max, true};
+  const auto [shrunk, shrunk_font] =
+      detail::fit_text(scene + ": predicted synthesis time", title, detail::title_font_min, room);
+  EXPECT_LE(detail::text_width(shrunk, shrunk_font), room);
+  EXPECT_GE(shrunk_font.size, detail::title_font_min);
+  const auto [cut, cut_font] = detail::fit_text(scene + scene + ": speedup", title, detail::title_font_min, room);
+  EXPECT_LE(detail::text_width(cut, cut_font), room);
+  EXPECT_EQ(cut_font.size, detail::title_font_min);
+  EXPECT_EQ(cut.rfind("a_rather", 0), 0u) << cut;
+  EXPECT_NE(cut.find("\u2026"), std::string::npos) << cut;
+  EXPECT_EQ(cut.substr(cut.size() - 9), ": speedup");
+  const auto [kept, kept_font] = detail::fit_text("short", title, detail::title_font_min, room);
+  EXPECT_EQ(kept, "short");
+  EXPECT_EQ(kept_font.size, detail::title_font_max);
+}
+
+TEST(Text, WidthGrowsWithTextAndSize) {
+  const double a = detail::text_width("processors", {12});
+  EXPECT_GT(a, 30);
+  EXPECT_LT(a, 120);
+  EXPECT_NEAR(detail::text_width("processors", {24}), 2 * a, 0.01 * a);
+  EXPECT_GT(detail::text_width("processors", {12, true}), a);
+  EXPECT_EQ(detail::text_width("", {12}), 0);
 }
 
 TEST(Ticks, LinearTicksAreNiceAndCoverTheRange) {
