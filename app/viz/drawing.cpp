@@ -164,14 +164,7 @@ void show_text(cairo_t* cr, double x, double y, std::string_view text, Font font
   if (align == Align::centre) x -= e.x_advance / 2;
   if (align == Align::right) x -= e.x_advance;
   cairo_move_to(cr, x, y);
-  if (cairo_surface_get_type(cairo_get_target(cr)) == CAIRO_SURFACE_TYPE_SVG) {
-    // Outlines, not glyphs <use>d by reference: the document then refers to
-    // nothing but its clips and gradients, which the HTML report requires.
-    cairo_text_path(cr, s.c_str());
-    cairo_fill(cr);
-  } else {
-    cairo_show_text(cr, s.c_str());
-  }
+  cairo_show_text(cr, s.c_str());
   cairo_new_path(cr);
 }
 

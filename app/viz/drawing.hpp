@@ -4,8 +4,8 @@
 // (returned as text ready to inline in HTML, see svg.hpp) or a PDF surface.
 // Invariants: every surface starts white; a cairo failure, on the context or
 // the surface, throws std::runtime_error naming what was being drawn; all
-// text goes through show_text in the font of text.hpp (as glyphs in PNG and
-// PDF, as filled outlines in SVG, so that an SVG document holds no href).
+// text goes through show_text in the font of text.hpp (in SVG, each glyph
+// is drawn once and <use>d by reference within the document).
 #pragma once
 
 #include <cairo.h>
