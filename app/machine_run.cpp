@@ -19,7 +19,8 @@ nodes::MachineResult run_with_progress(tracer::Database db, nodes::MachineOption
   const std::uint64_t w = db.header.camera.width, h = db.header.camera.height;
   const bool samples = machine.trace.spd_procedure;
   ProgressBar bar(samples ? (w + 1) * (h + 1) : w * h, (samples ? "samples" : "pixels") + which,
-                  !o.quiet && stderr_is_terminal());
+                  !o.quiet && stderr_is_terminal(), "render", STDERR_FILENO,
+                  "starting the machine and handing out its " + std::to_string(db.header.page_count) + " pages");
   // The collector calls this on its own thread only, so the bar needs no lock.
   machine.progress = [&bar](std::uint64_t done, std::uint64_t) { bar.update(done); };
   nodes::MachineResult result =

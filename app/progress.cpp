@@ -72,11 +72,23 @@ std::optional<double> eta_seconds(const RecentRate& rate, std::uint64_t done, st
   return static_cast<double>(total > done ? total - done : 0) / per_second;
 }
 
-ProgressBar::ProgressBar(std::uint64_t total, std::string unit, bool enabled, std::string phase, int fd)
-    : total_(total), unit_(std::move(unit)), phase_(std::move(phase)), enabled_(enabled), fd_(fd),
-      start_(Clock::now()), last_draw_(start_) {
+ProgressBar::ProgressBar(std::uint64_t total, std::string unit, bool enabled, std::string phase, int fd,
+                         const std::string& setup)
+    : total_(total),
+      unit_(std::move(unit)),
+      phase_(std::move(phase)),
+      enabled_(enabled),
+      fd_(fd),
+      start_(Clock::now()),
+      last_draw_(start_),
+      started_(setup.empty()) {
   if (!enabled_) return;
   show_line(fd_);
+  if (!started_) {
+    const std::string line = "\r" + setup + "...\033[K";
+    write_all(fd_, line.data(), line.size());
+    return;
+  }
   rate_.add(0, 0);
   draw(0, 0);
 }
@@ -85,6 +97,13 @@ ProgressBar::~ProgressBar() { finish(); }
 
 void ProgressBar::update(std::uint64_t done) {
   if (!enabled_) return;
+  if (!started_) {  // the work begins: the bar replaces the setup line, its clock starts now
+    started_ = true;
+    start_ = last_draw_ = Clock::now();
+    rate_.add(0, done);
+    draw(done, 0);
+    return;
+  }
   const auto now = Clock::now();
   const double elapsed = std::chrono::duration<double>(now - start_).count();
   // A sample each 50 ms is plenty for the rate, however often the work reports.

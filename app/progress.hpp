@@ -42,9 +42,12 @@ std::optional<double> eta_seconds(const RecentRate& rate, std::uint64_t done, st
 class ProgressBar {
  public:
   // unit: what is counted ("pixels"); phase: what the line says it is doing;
-  // enabled is usually stderr_is_terminal() && !quiet. Drawn at once, at 0.
-  ProgressBar(std::uint64_t total, std::string unit, bool enabled, std::string phase = "render",
-              int fd = STDERR_FILENO);
+  // enabled is usually stderr_is_terminal() && !quiet. Drawn at once, at 0,
+  // unless `setup` names what comes first ("starting 16 processors"): then
+  // the line says that until the first update(), where the bar and its
+  // clock start, so the rate and the ETA count the work alone.
+  ProgressBar(std::uint64_t total, std::string unit, bool enabled, std::string phase = "render", int fd = STDERR_FILENO,
+              const std::string& setup = "");
   ProgressBar(const ProgressBar&) = delete;
   ProgressBar& operator=(const ProgressBar&) = delete;
   ~ProgressBar();
@@ -61,6 +64,7 @@ class ProgressBar {
   Clock::time_point start_, last_draw_;
   double last_sample_ = 0;  // seconds since the start, of the rate's last sample
   RecentRate rate_;
+  bool started_ = false;  // false while the setup line is shown
 };
 
 // A phase with no counts, named on the line while it lives ("reading

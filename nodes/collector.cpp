@@ -10,6 +10,7 @@ Collector::Collector(FrameAssembler& frame, csp::In<Packet> in, Progress progres
     : frame_(frame), in_(std::move(in)), progress_(std::move(progress)), owners_(owners) {}
 
 void Collector::run() {
+  if (progress_) progress_(0, frame_.items());  // the machine is built and running
   while (!frame_.complete()) {
     const Packet packet = in_.read();
     if (static_cast<MessageKind>(packet.kind) != MessageKind::result)

@@ -2,8 +2,9 @@
 //
 // Reads the local channel from the farmer (not a network port):
 //   result {port, first, count, colours} -> stored (each item exactly once)
-// Ends after the last item. progress(received, total) is called after each
-// result.
+// Ends after the last item. progress(received, total) is called once with
+// received 0 as it starts (every process of the machine is running), then
+// after each result.
 #pragma once
 
 #include <cstdint>

@@ -86,7 +86,7 @@ struct MachineOptions {
   std::size_t buffer_capacity = 4;     // packets per network queue
   tracer::TraceOptions trace;
   std::optional<CostModel> timing;     // virtual time under this model (the run takes one thread)
-  Progress progress;                   // called by the collector (on its thread)
+  Progress progress;                   // called by the collector (on its thread): at 0 as it starts, then per result
 };
 
 // The most tiles a worker may keep asked for ahead: its answers and a page

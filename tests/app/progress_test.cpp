@@ -71,6 +71,22 @@ TEST_F(ProgressLine, EachPhaseIsNamedThenCleared) {
   EXPECT_EQ(drawn(), "\r\033[K");
 }
 
+// A bar with a setup says so until the work reports, and only then draws
+// the bar, with a clock that starts there.
+TEST_F(ProgressLine, ASetupIsNamedUntilTheWorkBegins) {
+  app::ProgressBar bar(100, "pixels", true, "render", fds_[1], "starting the machine");
+  EXPECT_EQ(drawn(), "\rstarting the machine...\033[K");
+  bar.update(0);
+  const std::string first = drawn();
+  EXPECT_EQ(first.rfind("\rrender [", 0), 0u) << first;
+  EXPECT_NE(first.find("0/100 pixels"), std::string::npos) << first;
+  EXPECT_NE(first.find("ETA --"), std::string::npos) << "no rate yet: " << first;
+  bar.update(100);
+  EXPECT_NE(drawn().find("100/100 pixels"), std::string::npos);
+  bar.finish();
+  EXPECT_EQ(drawn(), "\r\033[K");
+}
+
 // An interrupt while the bar is shown clears the line first, then goes on
 // to the handler there was before (here the test's; by default, the end of
 // the process).

@@ -11,7 +11,9 @@
 #include <algorithm>
 #include <cstring>
 #include <map>
+#include <set>
 #include <string>
+#include <thread>
 #include <tuple>
 
 #include "tests/nodes/test_database.hpp"
@@ -236,6 +238,30 @@ TEST(Machine, EveryPixelIsComputedExactlyOnce) {
   EXPECT_EQ(r.farmer.stops, 16u * 2u * 2u);
   EXPECT_EQ(r.farmer.results, r.farmer.tiles);
   EXPECT_EQ(r.rays().samples, pixels);
+}
+
+// Progress starts at 0 once the machine runs, never falls, and ends at the
+// frame's items, on the collector's one thread.
+TEST(Machine, ProgressStartsAtZeroAndEndsAtTheFrame) {
+  MachineOptions options;
+  options.topology = "ring";
+  options.nodes = 4;
+  options.threads = 2;
+  auto db = make_db("teapot:2", 1024, 16);
+  options.cache_pages = db.header.page_count;
+  std::vector<std::uint64_t> seen;
+  std::set<std::thread::id> threads;
+  options.progress = [&](std::uint64_t done, std::uint64_t total) {
+    EXPECT_EQ(total, 256u);
+    seen.push_back(done);
+    threads.insert(std::this_thread::get_id());
+  };
+  nodes::run_machine(std::move(db), options);
+  ASSERT_GE(seen.size(), 2u);
+  EXPECT_EQ(seen.front(), 0u);
+  EXPECT_EQ(seen.back(), 256u);
+  EXPECT_TRUE(std::is_sorted(seen.begin(), seen.end()));
+  EXPECT_EQ(threads.size(), 1u);
 }
 
 // The tile timeline accounts for the whole run: each item in exactly one
