@@ -38,7 +38,7 @@ tracer::Scene read_scene(const std::string& spec, const tracer::TessellationChec
   } catch (const std::invalid_argument& e) {
     // A name that is neither a file nor a built-in is a bad argument, as a bad option value is.
     const std::string file_note = directory ? "that name " + not_a_file : "no file of that name";
-    throw UsageError(std::string(e.what()) + " (and " + file_note + ")");
+    throw UsageError(std::string(e.what()) + " (and " + file_note + "; vmpray --help lists the built-in scenes)");
   }
 }
 

@@ -55,11 +55,11 @@ std::unique_ptr<NodeState> node_state(const PagePlacement& placement, int n, std
 }
 
 void validate(const MachineOptions& options) {
-  if (options.workers_per_node < 1) throw std::invalid_argument("--workers-per-node must be at least 1");
-  if (options.grain < 1) throw std::invalid_argument("--grain must be at least 1");
+  if (options.workers_per_node < 1) throw std::invalid_argument("workers_per_node must be at least 1");
+  if (options.grain < 1) throw std::invalid_argument("grain must be at least 1");
   if (options.buffer_capacity < 1) throw std::invalid_argument("network buffer capacity must be at least 1");
   if (options.prefetch > max_prefetch(options))
-    throw std::invalid_argument("--prefetch must be at most " + std::to_string(max_prefetch(options)) +
+    throw std::invalid_argument("prefetch must be at most " + std::to_string(max_prefetch(options)) +
                                 " (a worker's answers and a page reply must fit the network buffer of " +
                                 std::to_string(options.buffer_capacity) + " packets)");
 }
@@ -230,15 +230,15 @@ std::uint32_t default_cache_pages(const tracer::DatabaseHeader& header) {
 
 std::uint32_t cache_pages_for(const MachineOptions& options, const tracer::DatabaseHeader& header) {
   if (options.cache_pages && options.cache_kb)
-    throw std::invalid_argument("give --cache-pages or --cache-kb, not both");
+    throw std::invalid_argument("cache_pages and cache_kb both set: give one of them");
   if (options.cache_pages) {
-    if (*options.cache_pages == 0) throw std::invalid_argument("--cache-pages must be at least 1");
+    if (*options.cache_pages == 0) throw std::invalid_argument("cache_pages must be at least 1");
     return *options.cache_pages;
   }
   if (options.cache_kb) {
     const std::uint64_t pages = *options.cache_kb * 1024 / header.page_size;
     if (pages == 0)
-      throw std::invalid_argument("--cache-kb " + std::to_string(*options.cache_kb) + " is less than one page (" +
+      throw std::invalid_argument("cache_kb " + std::to_string(*options.cache_kb) + " is less than one page (" +
                                   std::to_string(header.page_size) + " bytes)");
     return static_cast<std::uint32_t>(std::min<std::uint64_t>(pages, UINT32_MAX));
   }
@@ -278,8 +278,8 @@ void run_runtime(csp::Runtime& runtime, std::size_t nodes, SplitState* split, in
     try {
       runtime.run();
     } catch (const csp::ThreadNotStarted& e) {
-      throw csp::ThreadNotStarted(std::string(e.what()) + "; try fewer --threads (" +
-                                  std::to_string(runtime.threads()) + " here), or see ulimit -v and ulimit -u");
+      throw csp::ThreadNotStarted(std::string(e.what()) + "; try fewer threads (" + std::to_string(runtime.threads()) +
+                                  " here), or see ulimit -v and ulimit -u");
     } catch (const csp::ProcessNotStarted& e) {
       throw csp::ProcessNotStarted(std::string(e.what()) + "; " + needs_more_memory(nodes));
     } catch (const std::bad_alloc&) {

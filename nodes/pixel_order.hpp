@@ -24,7 +24,7 @@ namespace nodes {
 
 enum class PixelOrder { scanline, hilbert };
 
-// The name --pixel-order takes: scanline or hilbert.
+// The order's name: scanline or hilbert.
 const char* pixel_order_name(PixelOrder order);
 
 // Item k's scanline position (y * width + x), for every item of a

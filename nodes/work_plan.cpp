@@ -17,7 +17,7 @@ const char* schedule_name(Schedule schedule) {
 
 WorkPlan::WorkPlan(std::uint32_t items, std::uint32_t grain, Schedule schedule, int nodes, int workers_per_node)
     : items_(items), grain_(grain), schedule_(schedule), nodes_(nodes), workers_(workers_per_node) {
-  if (grain == 0) throw std::invalid_argument("--grain must be at least 1");
+  if (grain == 0) throw std::invalid_argument("grain must be at least 1");
   if (nodes < 1 || workers_per_node < 1) throw std::invalid_argument("work plan needs at least one worker");
   if (schedule == Schedule::dynamic) return;
   for (int n = 0; n < nodes; ++n)

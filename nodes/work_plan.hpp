@@ -39,7 +39,7 @@ namespace nodes {
 
 enum class Schedule { dynamic, static_split, affinity };
 
-// The name --schedule takes: dynamic, static or affinity.
+// The schedule's name: dynamic, static or affinity.
 const char* schedule_name(Schedule schedule);
 
 class WorkPlan {

@@ -44,7 +44,7 @@ std::pair<unsigned, unsigned> parse_grid(std::string_view spec, std::string_view
   return {parse_count(spec, text.substr(0, x)), parse_count(spec, text.substr(x + 1))};
 }
 
-// The number of nodes a bare kind gets from --nodes, or from its own size.
+// The number of nodes a bare kind gets from the count given, or from its own size.
 std::size_t checked_nodes(std::string_view spec, std::optional<std::size_t> nodes) {
   if (!nodes) fail(spec, "give a size (e.g. mesh:8x8) or a node count");
   if (*nodes == 0) fail(spec, "needs at least one node");
@@ -115,8 +115,7 @@ Topology parse_topology(std::string_view spec, std::optional<std::size_t> nodes)
   if (colon == std::string_view::npos) return from_count(spec, *kind, checked_nodes(spec, nodes));
   Topology t = from_size(spec, *kind, spec.substr(colon + 1));
   if (nodes && *nodes != t.size())
-    fail(spec, "has " + std::to_string(t.size()) + " nodes but --nodes is " +
-                   std::to_string(*nodes));
+    fail(spec, "has " + std::to_string(t.size()) + " nodes, but the node count asked for is " + std::to_string(*nodes));
   return t;
 }
 

@@ -1,12 +1,12 @@
 // Parsing of topology specifications given on a command line:
 //   "hypercube:6"  "mesh:8x8"  "torus:4x4"  "ring:64"  "complete:16"
-// or a bare kind ("mesh") together with a node count (--nodes N), for which
+// or a bare kind ("mesh") together with a node count (N), for which
 // a mesh or torus takes the squarest W x H with W >= H.
 //
 // Invariant: every failure is a std::invalid_argument whose what() is one
 // line naming the problem (unknown kind, malformed size, a hypercube that is
 // not a power of two, 0 or more than max_nodes nodes, a size that disagrees
-// with --nodes). A result always satisfies 1 <= size() <= max_nodes.
+// with a node count). A result always satisfies 1 <= size() <= max_nodes.
 #pragma once
 
 #include <cstddef>

@@ -65,7 +65,7 @@ Scene generate_scene(std::string_view spec, const TessellationCheck& before_tess
   const Entry* entry = nullptr;
   for (const Entry& e : table())
     if (parts[0] == e.name) entry = &e;
-  if (!entry) bad_spec(spec, "unknown built-in scene (see --help for the list)");
+  if (!entry) bad_spec(spec, "unknown built-in scene");
   if (parts.size() > 3) bad_spec(spec, "expected NAME[:SIZE][:tRES]");
   int size = std::abs(entry->default_size), tess = entry->tessellation;
   std::size_t next = 1;

@@ -24,7 +24,7 @@ namespace tracer {
 
 struct BuiltinScene {
   std::string name;         // as written in a spec, e.g. "mount" or "mountain"
-  std::string description;  // one line, for --help
+  std::string description;  // one line, for a list of the scenes
 };
 
 // Called with the scene and the resolution before a spec's tRES tessellates
@@ -36,7 +36,7 @@ using TessellationCheck = std::function<void(const Scene& scene, int resolution)
 // out of range or a malformed spec.
 Scene generate_scene(std::string_view spec, const TessellationCheck& before_tessellating = {});
 
-// Every accepted NAME with a one-line description, in --help order.
+// Every accepted NAME with a one-line description, in the order to list them.
 std::vector<BuiltinScene> builtin_scenes();
 
 // Each generator, for callers that want one directly (sizes as in the spec;

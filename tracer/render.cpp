@@ -564,6 +564,7 @@ std::vector<Color> render_frame(const Database& db, const TraceOptions& options,
           for (int x = 0; x < w; ++x) out[std::size_t(y) * w + x] = lane.tracer.trace_pixel(x, y, lane.stats);
         },
         report);
+    report(h);  // the other threads may have done the last rows, or all of them
   } else {
     // Sample row r of the band starting at pixel row y0 is corner row y0 + r;
     // row 0 is the last row of the band before (or corner row 0, traced first).

@@ -122,7 +122,8 @@ std::vector<Color> render_frame(const DatabaseHeader& header, PageSource& pages,
 // of per-sample counts (a Tracer forgets its last page at every sample).
 // In SPD mode each corner sample is traced once, as there: bands of rows of
 // samples are traced in parallel, then averaged. `progress(rows_done)` is
-// called on the calling thread only, with counts that never decrease. An
+// called on the calling thread only, with counts that never decrease, the
+// last of them h. An
 // exception on any thread is rethrown here once all have stopped.
 std::vector<Color> render_frame(const Database& db, const TraceOptions& options, RayStats& stats, unsigned threads,
                                 const std::function<void(int)>& progress = {});

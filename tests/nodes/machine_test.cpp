@@ -417,23 +417,23 @@ void expect_error(const Case& c, MachineOptions options, const std::string& frag
   }
 }
 
-TEST(Machine, BadOptionsFailWithOneLineNamingTheOption) {
+TEST(Machine, BadOptionsFailWithOneLineNamingTheField) {
   const Case c{"hypercube", 4, 1, 1024, 4, Schedule::dynamic, 1, 1};
   MachineOptions zero_cache;
   zero_cache.cache_pages = 0;
-  expect_error(c, zero_cache, "--cache-pages");
+  expect_error(c, zero_cache, "cache_pages");
   MachineOptions tiny_kb;
   tiny_kb.cache_kb = 0;
-  expect_error(c, tiny_kb, "--cache-kb");
+  expect_error(c, tiny_kb, "cache_kb");
   MachineOptions workers;
   workers.workers_per_node = 0;
-  expect_error(c, workers, "--workers-per-node");
+  expect_error(c, workers, "workers_per_node");
   MachineOptions grain;
   grain.grain = 0;
-  expect_error(c, grain, "--grain");
+  expect_error(c, grain, "grain");
   MachineOptions prefetch;
   prefetch.prefetch = 4;  // the network buffers 4 packets per queue
-  expect_error(c, prefetch, "--prefetch");
+  expect_error(c, prefetch, "prefetch");
   expect_error({"hypercube", 48, 1, 1024, 4, Schedule::dynamic, 1, 1}, MachineOptions{}, "48");
   expect_error({"mesh:8x8", 32, 1, 1024, 4, Schedule::dynamic, 1, 1}, MachineOptions{}, "32");
 }

@@ -130,12 +130,12 @@ TEST(WorkPlan, AffinityLeavesEachOwnerItsFirstTile) {
   EXPECT_EQ(larger.steals(), 2u);
 }
 
-TEST(WorkPlan, ZeroGrainIsRejectedNamingTheOption) {
+TEST(WorkPlan, ZeroGrainIsRejectedNamingTheField) {
   try {
     WorkPlan(10, 0, Schedule::dynamic, 1, 1);
     FAIL();
   } catch (const std::invalid_argument& e) {
-    EXPECT_NE(std::string(e.what()).find("--grain"), std::string::npos);
+    EXPECT_NE(std::string(e.what()).find("grain must be at least 1"), std::string::npos);
   }
 }
 

@@ -50,7 +50,7 @@ TEST(Spec, ImpossibleSpecsAreRejectedWithAClearMessage) {
   EXPECT_NE(error_of("complete:5000").find("maximum"), std::string::npos);
   EXPECT_NE(error_of("mesh:128x64").find("maximum"), std::string::npos);
   EXPECT_NE(error_of("hypercube:13").find("4096"), std::string::npos);
-  EXPECT_NE(error_of("mesh:8x8", 32).find("--nodes is 32"), std::string::npos);
+  EXPECT_NE(error_of("mesh:8x8", 32).find("the node count asked for is 32"), std::string::npos);
   EXPECT_NE(error_of("banana:4").find("unknown kind 'banana'"), std::string::npos);
   EXPECT_NE(error_of("mesh:8y8").find("WIDTHxHEIGHT"), std::string::npos);
   EXPECT_NE(error_of("ring:abc").find("not a number"), std::string::npos);

@@ -175,10 +175,7 @@ TEST(Render, ThreadedProgressIsOnTheCallersThreadAndNeverFalls) {
     EXPECT_FALSE(elsewhere);
     ASSERT_FALSE(seen.empty());
     EXPECT_TRUE(std::is_sorted(seen.begin(), seen.end()));
-    EXPECT_LE(seen.back(), kSize);
-    if (spd) {
-      EXPECT_EQ(seen.back(), kSize);  // bands report when they are averaged, the last at the end
-    }
+    EXPECT_EQ(seen.back(), kSize);
   }
 }
 
