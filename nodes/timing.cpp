@@ -25,8 +25,8 @@ using Seconds = std::chrono::duration<double>;
 // software page-table look-up about a fifth. Only their ratio matters here:
 // `unit` is fitted to Teapot on one node (Table 2: 3h12mn2s at 512x512).
 constexpr double ipsc2_box = 1.0, ipsc2_prim = 2.0, ipsc2_shade = 5.0, ipsc2_page = 0.2;
-// Fitted by `vmpray sweep nodes teapot --size 512 --nodes 1 --cache-pages 3072
-// --fit-seconds 11522` (Teapot, 3h12mn2s on one node; see app/experiments.hpp).
+// Fitted so that Teapot at 512x512 on one node with the paper's 3072 pages
+// of cache takes 11522 s, 3h12mn2s (docs/paper.md gives the sweep that fits it).
 constexpr double ipsc2_unit = 371.437e-6;
 // The virtual clock counts picoseconds in 64 bits: about 106 days.
 constexpr double max_virtual_seconds = 9e6;
