@@ -426,12 +426,12 @@ TEST_F(MachineCli, TilesWritesOneCsvRowPerTile) {
   EXPECT_FALSE(fs::exists(dir_ / "t.csv"));
 }
 
-TEST_F(MachineCli, TimelineDrawsARowPerNode) {
+TEST_F(MachineCli, TimelineIsAnSvgOfAMachineRunAndRefusedWithSingle) {
   const Outcome r = run(std::string(kSmall) + " -q --nodes 8 -o out.png --timeline tiles.svg");
   ASSERT_EQ(r.exit_code, 0) << r.err;
   const std::string svg = read_file(dir_ / "tiles.svg");
   EXPECT_TRUE(svg.starts_with("<svg")) << svg.substr(0, 40);
-  // Its text is drawn as outlines: the rows are checked in tests/viz/timeline_test.cpp.
+  // Its rows, one per node, are checked from the layout in tests/app/viz/timeline_test.cpp.
   EXPECT_TRUE(svg.ends_with("</svg>\n")) << svg.substr(svg.size() - std::min<std::size_t>(svg.size(), 40));
 
   const Outcome single = run("tetra:3 --width 32 --height 32 --single -o single.png --timeline t.svg");

@@ -11,7 +11,7 @@
 
 #include "app/machine_pictures.hpp"
 #include "app/viz/colour.hpp"
-#include "tests/viz/xml_check.hpp"
+#include "tests/app/viz/xml_check.hpp"
 #include "tracer/generators.hpp"
 
 namespace {

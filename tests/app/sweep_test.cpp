@@ -21,7 +21,7 @@
 #include "app/options.hpp"
 #include "app/paper_figures.hpp"
 #include "tests/support/scratch.hpp"
-#include "tests/viz/xml_check.hpp"
+#include "tests/app/viz/xml_check.hpp"
 #include "tracer/generators.hpp"
 
 namespace {
