@@ -21,6 +21,7 @@
 
 #include "app/experiments.hpp"
 #include "app/output_files.hpp"
+#include "app/viz/plot.hpp"
 
 namespace app {
 
@@ -71,6 +72,11 @@ SweepTable run_sweep(const SweepOptions& options, std::ostream* progress);
 
 std::string sweep_csv(const SweepTable& table);
 std::string sweep_json(const SweepTable& table);
+// The plots a sweep draws: time, speedup and efficiency against processors
+// (nodes), or efficiency, miss ratio and page communications against the
+// cache (cache); one series per kind of topology, plus the paper's times
+// and the ideal speedup where they apply.
+std::vector<viz::LinePlot> sweep_plots(const SweepTable& table);
 // Writes csv, json, svg, png panels and html into dir, adding each to
 // `outputs` (and dir first, if it makes it): the caller keeps them once its
 // command has finished. Returns the files written. Throws std::runtime_error

@@ -1,5 +1,6 @@
 // What a sweep writes: CSV and JSON tables, the plots (SVG, one PNG per
 // panel), the HTML page, and the subcommand's entry point (see sweep.hpp).
+#include <algorithm>
 #include <cmath>
 #include <iomanip>
 #include <iostream>
@@ -70,11 +71,22 @@ std::vector<viz::Series> series_of(const SweepTable& t, double (*y)(const Experi
   return series;
 }
 
-// "<scene>: <what> against <axis>", naming the topology when the plot has
-// only one (then there is no legend to name it).
+// "<scene> <W>x<H>[ on <topology>], <what stays fixed>: <what>": the
+// topology when the plot has only one (then no legend names it), and the
+// cache of a nodes sweep or the nodes of a cache sweep when every point
+// shares it. The axes say what the plot is against.
 std::string title_of(const SweepTable& t, const std::vector<viz::Series>& series, const std::string& what) {
-  const std::string axis = t.kind == SweepOptions::Kind::nodes ? "processors" : "cache size";
-  return t.scene + (series.size() == 1 ? " on " + series.front().name : "") + ": " + what + " against " + axis;
+  std::string title = t.scene + " " + std::to_string(t.width) + "x" + std::to_string(t.height);
+  if (series.size() == 1) title += " on " + series.front().name;
+  const bool nodes = t.kind == SweepOptions::Kind::nodes;
+  const auto fixed = [&](const ExperimentPoint& p) {
+    return nodes ? std::uint64_t(p.cache_pages) : std::uint64_t(p.nodes);
+  };
+  const bool shared = !t.points.empty() && std::all_of(t.points.begin(), t.points.end(), [&](const ExperimentPoint& p) {
+    return fixed(p) == fixed(t.points.front());
+  });
+  if (shared) title += ", " + std::to_string(fixed(t.points.front())) + (nodes ? " pages of cache" : " nodes");
+  return title + ": " + what;
 }
 
 std::vector<viz::LinePlot> nodes_plots(const SweepTable& t) {
@@ -158,6 +170,10 @@ viz::Table html_table(const SweepTable& t) {
 
 }  // namespace
 
+std::vector<viz::LinePlot> sweep_plots(const SweepTable& t) {
+  return t.kind == SweepOptions::Kind::nodes ? nodes_plots(t) : cache_plots(t);
+}
+
 std::string sweep_csv(const SweepTable& t) {
   std::ostringstream out;
   out << csv_header << "\n";
@@ -220,7 +236,7 @@ std::vector<std::filesystem::path> write_sweep(const SweepTable& t, const std::f
   std::filesystem::create_directories(dir, error);
   if (error) throw std::runtime_error(dir.string() + ": cannot create the directory: " + error.message());
   const std::string stem = kind_name(t.kind);
-  const auto plots = t.kind == SweepOptions::Kind::nodes ? nodes_plots(t) : cache_plots(t);
+  const auto plots = sweep_plots(t);
   std::vector<std::filesystem::path> files;
   files.push_back(outputs.write_text(dir / (stem + ".csv"), sweep_csv(t)));
   files.push_back(outputs.write_text(dir / (stem + ".json"), sweep_json(t)));

@@ -207,6 +207,18 @@ TEST(Sweep, NodesSweepWritesWellFormedTablesAndPlots) {
             std::string::npos);
   EXPECT_EQ(html.find("src=\"nodes-"), std::string::npos);
 
+  // One series per kind of topology, whatever the node count; the titles say
+  // the scene, the image and the cache every point shares.
+  const auto plots = app::sweep_plots(table);
+  ASSERT_EQ(plots.size(), 3u);
+  for (const viz::LinePlot& plot : plots) {
+    EXPECT_EQ(plot.series.at(0).name, "hypercube") << plot.title;
+    EXPECT_EQ(plot.series.at(1).name, "ring") << plot.title;
+    EXPECT_EQ(plot.series.at(0).points.size(), 3u) << plot.title;
+    EXPECT_EQ(
+        plot.title.rfind("teapot:2 12x12, " + std::to_string(table.points[0].cache_pages) + " pages of cache: ", 0), 0u)
+        << plot.title;
+  }
   const std::string svg_text = read(dir / "nodes.svg");
   const auto svg = viz::test::check_xml(svg_text);
   EXPECT_TRUE(svg.ok) << svg.error;
@@ -325,6 +337,7 @@ TEST(Sweep, APaperSceneGetsTable2BesideItsPoints) {
     app::ExperimentPoint p;
     p.topology = "ring:" + std::to_string(n);
     p.nodes = n;
+    p.cache_pages = 3072;
     p.predicted_seconds = t.serial_seconds / n;
     p.serial_seconds = t.serial_seconds;
     t.points.push_back(p);
@@ -352,6 +365,15 @@ TEST(Sweep, APaperSceneGetsTable2BesideItsPoints) {
   EXPECT_NE(html.find(">3h12mn02s</td>"), std::string::npos);
   EXPECT_NE(html.find(">+10.0%</td>"), std::string::npos);
   EXPECT_NE(html.find("Table 2"), std::string::npos);
+
+  // The time plot has the paper's line; the title names the one topology.
+  const auto plots = app::sweep_plots(t);
+  ASSERT_EQ(plots[0].series.size(), 2u);
+  EXPECT_EQ(plots[0].series[1].name, "paper (iPSC/2)");
+  ASSERT_EQ(plots[0].series[1].points.size(), 1u);  // N = 1 only: the paper has no N = 3
+  EXPECT_EQ(plots[0].series[1].points[0].y, 11522);
+  EXPECT_EQ(plots[0].title.rfind("teapot 512x512 on ring, 3072 pages of cache: predicted synthesis time", 0), 0u)
+      << plots[0].title;
 
   t.scene = "teapot:2";  // not the paper's scene: nothing beside it
   EXPECT_EQ(csv_rows(app::sweep_csv(t))[1][16], "");
