@@ -201,7 +201,7 @@ Database build_database(const Scene& scene, const BuildOptions& opt) {
   sec[int(Section::materials)] = packer.add(material_records(scene), "material");
   if (opt.accel == Accel::bvh) {
     const BuildRefs refs = split_large_triangles(f.prims, f.bounds, opt.bvh_split_depth);
-    BvhBuild bvh = build_bvh(refs, opt.bvh_max_leaf);
+    BvhBuild bvh = build_bvh(refs, opt.bvh_max_leaf, {.threads = opt.threads});
     if (opt.bvh_layout == BvhLayout::treelet) lay_out_treelets(bvh, opt.page_size / sizeof(BvhNode));
     for (std::uint32_t& k : bvh.order) k = refs.prim[k];
     reorder(f, bvh.order);
