@@ -6,6 +6,7 @@
 #include <boost/program_options.hpp>
 #include <sstream>
 
+#include "app/cpu_count.hpp"
 #include "app/machine_report.hpp"
 #include "topology/spec.hpp"
 #include "topology/topology.hpp"
@@ -275,8 +276,13 @@ std::string accel_description(tracer::Accel accel, tracer::BvhLayout layout) {
   return std::string(accel_name(accel)) + ", " + bvh_layout_name(layout) + " layout";
 }
 
+// The build uses the threads the run has (--threads, 0: the usable CPUs); the
+// database is the same for any count.
 tracer::BuildOptions build_options(const Options& o) {
-  return {.accel = o.accel, .bvh_layout = o.bvh_layout, .page_size = o.page_size};
+  return {.accel = o.accel,
+          .bvh_layout = o.bvh_layout,
+          .page_size = o.page_size,
+          .threads = o.machine.threads == 0 ? usable_cpus() : o.machine.threads};
 }
 
 std::string default_output(const std::string& scene) {

@@ -1,12 +1,29 @@
 // Binned SAH BVH builder (16 bins on each axis of the centroid box). A set of
 // at most four triangles always becomes one leaf: traversal tests such a leaf
 // in one four-wide step, so splitting it further only adds nodes to visit.
+//
+// Parallel build: a node of at least `large_node` references computes its
+// bounds, its bins and its partition in chunks of `chunk` references, which
+// the caller and helper threads share; per-chunk boxes and counts are merged
+// in chunk order. Box3f::extend keeps, on a tie, the later value, so merging
+// chunk results in order gives the bits of one pass over all references, and
+// the stable partition is unique: every node is what the sequential build
+// makes of it. Below a large node, its left subtree may be built on a thread
+// of its own into a separate segment of binary nodes; the collapse to
+// four-wide nodes walks the binary tree by structure alone, so where a
+// binary node is stored never reaches the output. Threads only decide who
+// computes what: the tree is the same for every thread count.
 #include "tracer/bvh.hpp"
 
 #include <algorithm>
 #include <array>
+#include <atomic>
 #include <cmath>
+#include <condition_variable>
 #include <deque>
+#include <exception>
+#include <mutex>
+#include <thread>
 
 namespace tracer {
 namespace {
@@ -15,10 +32,14 @@ constexpr int kBins = 16;
 constexpr float kTraversalCost = 1.0f;  // relative to one primitive test
 constexpr std::uint32_t kLeafLanes = 4;  // triangles a leaf test handles in one step
 
+// A binary node's address: the segment it is stored in (high 32 bits) and its index there.
+using NodeRef = std::uint64_t;
+NodeRef make_ref(std::uint32_t segment, std::uint32_t index) { return (NodeRef{segment} << 32) | index; }
+
 // A node of the binary tree before it is collapsed to four-wide nodes.
 struct BinNode {
   Box3f box;
-  std::uint32_t left = 0, right = 0;  // inner node: children in bin_
+  NodeRef left = 0, right = 0;         // inner node: its children
   std::uint32_t first = 0, count = 0;  // leaf (count > 0): primitives in order
 };
 
@@ -28,10 +49,51 @@ struct Split {
   float cost = 0;
 };
 
+// Bins of all three axes, for one chunk or merged over a node.
+struct Bins {
+  std::array<std::array<Box3f, kBins>, 3> box{};
+  std::array<std::array<std::uint32_t, kBins>, 3> count{};
+};
+
+// Slots for the threads that may run at once, the caller's included: a
+// thread that runs build work holds one; one waiting to join gives it back.
+class ThreadBudget {
+ public:
+  explicit ThreadBudget(unsigned threads) : free_(threads > 1 ? threads - 1 : 0) {}
+  bool try_take() {
+    std::lock_guard lock(mutex_);
+    if (free_ == 0) return false;
+    --free_;
+    return true;
+  }
+  void take() {
+    std::unique_lock lock(mutex_);
+    freed_.wait(lock, [&] { return free_ > 0; });
+    --free_;
+  }
+  void give() {
+    {
+      std::lock_guard lock(mutex_);
+      ++free_;
+    }
+    freed_.notify_one();
+  }
+
+ private:
+  std::mutex mutex_;
+  std::condition_variable freed_;
+  unsigned free_;  // slots not held (the caller holds one from the start)
+};
+
 class Builder {
  public:
-  Builder(const std::vector<Box3f>& bounds, const std::vector<bool>& triangle, int max_leaf)
-      : bounds_(bounds), triangle_(triangle), max_leaf_(std::max(1, max_leaf)) {
+  Builder(const std::vector<Box3f>& bounds, const std::vector<bool>& triangle, int max_leaf, const BvhParallelism& par)
+      : bounds_(bounds),
+        triangle_(triangle),
+        max_leaf_(std::max(1, max_leaf)),
+        large_node_(std::max<std::uint32_t>(par.large_node, 2)),
+        chunk_(std::max<std::uint32_t>(par.chunk, 1)),
+        budget_(par.threads) {
     out_.order.resize(bounds.size());
     for (std::uint32_t i = 0; i < bounds.size(); ++i) out_.order[i] = i;
   }
@@ -40,12 +102,13 @@ class Builder {
     out_.nodes.emplace_back();
     for (int lane = 0; lane < 4; ++lane) set_lane_box(out_.nodes[0], lane, Box3f{});
     if (bounds_.empty()) return std::move(out_);
-    bin_.emplace_back();
-    build(0, 0, static_cast<std::uint32_t>(bounds_.size()));
-    if (bin_[0].count > 0) {  // one leaf: a root with a single used lane
-      set_lane_box(out_.nodes[0], 0, bin_[0].box);
-      out_.nodes[0].child[0] = bin_[0].first;
-      out_.nodes[0].count[0] = bin_[0].count;
+    segments_.emplace_back(1);
+    build(segments_[0], 0, 0, 0, static_cast<std::uint32_t>(bounds_.size()));
+    const BinNode& root = segments_[0][0];
+    if (root.count > 0) {  // one leaf: a root with a single used lane
+      set_lane_box(out_.nodes[0], 0, root.box);
+      out_.nodes[0].child[0] = root.first;
+      out_.nodes[0].count[0] = root.count;
     } else {
       collapse(0, 0, 1);
     }
@@ -53,29 +116,204 @@ class Builder {
   }
 
  private:
-  // Builds the binary subtree of primitives [begin, end) into bin_[index].
-  void build(std::uint32_t index, std::uint32_t begin, std::uint32_t end) {
-    Box3f box, centroids;
-    for (std::uint32_t k = begin; k < end; ++k) {
-      box.extend(bounds_[out_.order[k]]);
-      centroids.extend(bounds_[out_.order[k]].centre());
-    }
-    bin_[index].box = box;
+  using Segment = std::vector<BinNode>;
+
+  const BinNode& node(NodeRef ref) const { return segments_[ref >> 32][ref & 0xffffffffu]; }
+
+  // Builds the binary subtree of primitives [begin, end) into seg[index];
+  // `segment` is seg's number. Only this thread touches seg until it returns.
+  void build(Segment& seg, std::uint32_t segment, std::uint32_t index, std::uint32_t begin, std::uint32_t end) {
     const std::uint32_t n = end - begin;
-    const Split split = find_split(begin, end, centroids, box);
+    const bool large = n >= large_node_;
+    Box3f box, centroids;
+    if (large) {
+      chunked_bounds(begin, end, box, centroids);
+    } else {
+      for (std::uint32_t k = begin; k < end; ++k) {
+        box.extend(bounds_[out_.order[k]]);
+        centroids.extend(bounds_[out_.order[k]].centre());
+      }
+    }
+    seg[index].box = box;
+    const Split split = large ? chunked_split(begin, end, centroids, box) : find_split(begin, end, centroids, box);
     if (n <= static_cast<std::uint32_t>(max_leaf_) &&
         (split.axis < 0 || split.cost >= static_cast<float>(n) || one_step_leaf(begin, end))) {
-      bin_[index].first = begin;
-      bin_[index].count = n;
+      seg[index].first = begin;
+      seg[index].count = n;
       return;
     }
-    const std::uint32_t mid = partition(begin, end, centroids, split);
-    const auto left = static_cast<std::uint32_t>(bin_.size());
-    bin_.resize(bin_.size() + 2);
-    bin_[index].left = left;
-    bin_[index].right = left + 1;
-    build(left, begin, mid);
-    build(left + 1, mid, end);
+    const std::uint32_t mid =
+        large ? chunked_partition(begin, end, centroids, split) : partition(begin, end, centroids, split);
+    if (large && std::min(mid - begin, end - mid) >= chunk_ && budget_.try_take()) {
+      fork_left(seg, segment, index, begin, mid, end);
+      return;
+    }
+    const auto left = static_cast<std::uint32_t>(seg.size());
+    seg.resize(seg.size() + 2);
+    seg[index].left = make_ref(segment, left);
+    seg[index].right = make_ref(segment, left + 1);
+    build(seg, segment, left, begin, mid);
+    build(seg, segment, left + 1, mid, end);
+  }
+
+  // Builds [begin, mid) on a new thread, into a new segment, holding the
+  // slot the caller took, and [mid, end) here; returns once both are built,
+  // rethrowing what either threw.
+  void fork_left(Segment& seg, std::uint32_t segment, std::uint32_t index, std::uint32_t begin, std::uint32_t mid,
+                 std::uint32_t end) {
+    Segment* left_seg = nullptr;
+    std::uint32_t left_segment = 0;
+    {
+      std::lock_guard lock(segments_mutex_);
+      left_segment = static_cast<std::uint32_t>(segments_.size());
+      left_seg = &segments_.emplace_back(1);  // deque: earlier segments stay where they are
+    }
+    const auto right = static_cast<std::uint32_t>(seg.size());
+    seg.emplace_back();
+    seg[index].left = make_ref(left_segment, 0);
+    seg[index].right = make_ref(segment, right);
+    std::exception_ptr left_error;
+    std::thread thread;
+    try {
+      thread = std::thread([&, left_seg, left_segment] {
+        try {
+          build(*left_seg, left_segment, 0, begin, mid);
+        } catch (...) {
+          left_error = std::current_exception();
+        }
+        budget_.give();
+      });
+    } catch (...) {  // no thread to be had: build both here
+      budget_.give();
+      build(*left_seg, left_segment, 0, begin, mid);
+    }
+    std::exception_ptr right_error;
+    try {
+      build(seg, segment, right, mid, end);
+    } catch (...) {
+      right_error = std::current_exception();
+    }
+    if (thread.joinable()) {
+      budget_.give();  // waiting is not working: another thread may run meanwhile
+      thread.join();
+      budget_.take();
+    }
+    if (left_error) std::rethrow_exception(left_error);
+    if (right_error) std::rethrow_exception(right_error);
+  }
+
+  // Runs work(c) for chunks c = 0..chunks-1 on this thread and on the helper
+  // threads the budget allows (about four chunks each at least); returns once
+  // every helper has stopped, rethrowing the first exception caught.
+  template <class Work>
+  void for_chunks(std::uint32_t chunks, const Work& work) {
+    std::atomic<std::uint32_t> next{0};
+    std::mutex error_mutex;
+    std::exception_ptr error;
+    const auto drain = [&] {
+      try {
+        for (std::uint32_t c; (c = next.fetch_add(1)) < chunks;) work(c);
+      } catch (...) {
+        std::lock_guard lock(error_mutex);
+        if (!error) error = std::current_exception();
+        next.store(chunks);
+      }
+    };
+    std::vector<std::thread> helpers;
+    for (std::uint32_t h = 0; h + 1 < chunks / 4 && budget_.try_take(); ++h) {
+      try {
+        helpers.emplace_back([&] {
+          drain();
+          budget_.give();
+        });
+      } catch (...) {
+        budget_.give();
+        break;
+      }
+    }
+    drain();
+    for (std::thread& t : helpers) t.join();
+    if (error) std::rethrow_exception(error);
+  }
+
+  std::uint32_t chunk_count(std::uint32_t begin, std::uint32_t end) const {
+    return (end - begin + chunk_ - 1) / chunk_;
+  }
+  std::uint32_t chunk_end(std::uint32_t first, std::uint32_t end) const {
+    return end - first > chunk_ ? first + chunk_ : end;
+  }
+
+  void chunked_bounds(std::uint32_t begin, std::uint32_t end, Box3f& box, Box3f& centroids) {
+    std::vector<std::pair<Box3f, Box3f>> part(chunk_count(begin, end));
+    for_chunks(static_cast<std::uint32_t>(part.size()), [&](std::uint32_t c) {
+      const std::uint32_t first = begin + c * chunk_, last = chunk_end(first, end);
+      for (std::uint32_t k = first; k < last; ++k) {
+        part[c].first.extend(bounds_[out_.order[k]]);
+        part[c].second.extend(bounds_[out_.order[k]].centre());
+      }
+    });
+    for (const auto& [b, cb] : part) {
+      box.extend(b);
+      centroids.extend(cb);
+    }
+  }
+
+  Split chunked_split(std::uint32_t begin, std::uint32_t end, const Box3f& centroids, const Box3f& parent) {
+    std::vector<Bins> part(chunk_count(begin, end));
+    for_chunks(static_cast<std::uint32_t>(part.size()), [&](std::uint32_t c) {
+      const std::uint32_t first = begin + c * chunk_, last = chunk_end(first, end);
+      for (int axis = 0; axis < 3; ++axis) {
+        if (!(centroids.hi[axis] > centroids.lo[axis])) continue;
+        for (std::uint32_t k = first; k < last; ++k) {
+          const int b = bin_of(out_.order[k], axis, centroids);
+          part[c].box[axis][b].extend(bounds_[out_.order[k]]);
+          ++part[c].count[axis][b];
+        }
+      }
+    });
+    Bins all;
+    for (const Bins& p : part)
+      for (int axis = 0; axis < 3; ++axis)
+        for (int b = 0; b < kBins; ++b) {
+          all.box[axis][b].extend(p.box[axis][b]);
+          all.count[axis][b] += p.count[axis][b];
+        }
+    Split best{-1, 0, 1e30f};
+    const float parent_area = std::max(parent.half_area(), 1e-30f);
+    for (int axis = 0; axis < 3; ++axis)
+      if (centroids.hi[axis] > centroids.lo[axis])
+        evaluate_axis(axis, all.box[axis], all.count[axis], parent_area, best);
+    return best;
+  }
+
+  // The stable partition of partition(), chunk by chunk: each chunk's left
+  // and right references go to offsets given by the counts of the chunks before it.
+  std::uint32_t chunked_partition(std::uint32_t begin, std::uint32_t end, const Box3f& centroids, const Split& split) {
+    if (split.axis < 0) return begin + (end - begin) / 2;
+    const auto goes_left = [&](std::uint32_t prim) { return bin_of(prim, split.axis, centroids) < split.bin; };
+    const std::uint32_t chunks = chunk_count(begin, end);
+    std::vector<std::uint32_t> lefts(chunks + 1, 0);  // lefts[c + 1]: left references in chunk c
+    for_chunks(chunks, [&](std::uint32_t c) {
+      const std::uint32_t first = begin + c * chunk_, last = chunk_end(first, end);
+      lefts[c + 1] =
+          static_cast<std::uint32_t>(std::count_if(out_.order.begin() + first, out_.order.begin() + last, goes_left));
+    });
+    for (std::uint32_t c = 0; c < chunks; ++c) lefts[c + 1] += lefts[c];
+    const std::uint32_t left_total = lefts[chunks];
+    std::vector<std::uint32_t> moved(end - begin);
+    for_chunks(chunks, [&](std::uint32_t c) {
+      const std::uint32_t first = begin + c * chunk_, last = chunk_end(first, end);
+      std::uint32_t l = lefts[c], r = left_total + (first - begin) - lefts[c];
+      for (std::uint32_t k = first; k < last; ++k) {
+        const std::uint32_t prim = out_.order[k];
+        moved[goes_left(prim) ? l++ : r++] = prim;
+      }
+    });
+    for_chunks(chunks, [&](std::uint32_t c) {
+      const std::uint32_t first = c * chunk_, last = chunk_end(first, end - begin);
+      std::copy(moved.begin() + first, moved.begin() + last, out_.order.begin() + begin + first);
+    });
+    return begin + left_total;
   }
 
   // Whether primitives [begin, end) are triangles few enough for one four-wide leaf test.
@@ -88,35 +326,35 @@ class Builder {
 
   // The binary nodes that become the lanes of the four-wide node for `index`:
   // its children, with the largest inner ones opened until there are four.
-  std::vector<std::uint32_t> lanes_of(std::uint32_t index) const {
-    std::vector<std::uint32_t> lanes = {bin_[index].left, bin_[index].right};
+  std::vector<NodeRef> lanes_of(NodeRef ref) const {
+    std::vector<NodeRef> lanes = {node(ref).left, node(ref).right};
     while (lanes.size() < 4) {
       int pick = -1;
       for (int i = 0; i < static_cast<int>(lanes.size()); ++i)
-        if (bin_[lanes[i]].count == 0 &&
-            (pick < 0 || bin_[lanes[i]].box.half_area() > bin_[lanes[pick]].box.half_area()))
+        if (node(lanes[i]).count == 0 &&
+            (pick < 0 || node(lanes[i]).box.half_area() > node(lanes[pick]).box.half_area()))
           pick = i;
       if (pick < 0) break;
-      const BinNode opened = bin_[lanes[pick]];
+      const BinNode opened = node(lanes[pick]);
       lanes[pick] = opened.left;
       lanes.insert(lanes.begin() + pick + 1, opened.right);
     }
     return lanes;
   }
 
-  // Fills four-wide node `slot` from inner binary node `index`. The inner
+  // Fills four-wide node `slot` from inner binary node `ref`. The inner
   // children of a node get consecutive slots, so siblings share cache lines
   // and pages.
-  void collapse(std::uint32_t slot, std::uint32_t index, std::uint32_t depth) {
+  void collapse(std::uint32_t slot, NodeRef ref, std::uint32_t depth) {
     out_.depth = std::max(out_.depth, depth);
-    const std::vector<std::uint32_t> lanes = lanes_of(index);
-    std::vector<std::pair<std::uint32_t, std::uint32_t>> inner;  // (slot, binary node)
+    const std::vector<NodeRef> lanes = lanes_of(ref);
+    std::vector<std::pair<std::uint32_t, NodeRef>> inner;  // (slot, binary node)
     auto next = static_cast<std::uint32_t>(out_.nodes.size());
     for (int lane = 0; lane < 4; ++lane) {
       const bool used = lane < static_cast<int>(lanes.size());
-      set_lane_box(out_.nodes[slot], lane, used ? bin_[lanes[lane]].box : Box3f{});
+      set_lane_box(out_.nodes[slot], lane, used ? node(lanes[lane]).box : Box3f{});
       if (!used) continue;
-      const BinNode& b = bin_[lanes[lane]];
+      const BinNode& b = node(lanes[lane]);
       out_.nodes[slot].count[lane] = b.count;
       out_.nodes[slot].child[lane] = b.count > 0 ? b.first : next;
       if (b.count == 0) inner.emplace_back(next++, lanes[lane]);
@@ -189,7 +427,10 @@ class Builder {
   const std::vector<Box3f>& bounds_;
   const std::vector<bool>& triangle_;
   int max_leaf_;
-  std::vector<BinNode> bin_;
+  std::uint32_t large_node_, chunk_;
+  ThreadBudget budget_;
+  std::mutex segments_mutex_;     // guards segments_ while threads add to it
+  std::deque<Segment> segments_;  // the binary tree; segments_[0][0] is its root
   BvhBuild out_;
 };
 
@@ -212,8 +453,8 @@ Box3f lane_box(const BvhNode& node, int lane) {
   return b;
 }
 
-BvhBuild build_bvh(const BuildRefs& refs, int max_leaf) {
-  return Builder(refs.bounds, refs.triangle, max_leaf).run();
+BvhBuild build_bvh(const BuildRefs& refs, int max_leaf, const BvhParallelism& parallelism) {
+  return Builder(refs.bounds, refs.triangle, max_leaf, parallelism).run();
 }
 
 namespace {

@@ -3,7 +3,8 @@
 // of its largest inner children until it has four). The builder sees only
 // reference boxes and which references are triangles, so the tree, and with
 // it the order in which a ray meets primitives, does not depend on how it is
-// later packed into pages.
+// later packed into pages, nor on how many threads build it: the nodes and
+// `order` are the same bits for every BvhParallelism.
 // Output invariants: nodes[0] is the root; an inner lane's node index is
 // greater than its parent's, and a node's inner children are consecutive
 // (nodes in depth-first order of their sibling groups);
@@ -36,7 +37,21 @@ struct BuildRefs {
   std::vector<bool> triangle;
 };
 
-BvhBuild build_bvh(const BuildRefs& refs, int max_leaf);
+// The threads a build may use, and where it starts to use them. Nodes of at
+// least `large_node` references are binned and partitioned in chunks of
+// `chunk` references shared among threads, and their children at least a
+// chunk large may be built on threads of their own. Never more than `threads`
+// threads work at once (0 and 1: the caller's only). The defaults suit
+// scenes of millions of triangles; tests lower them to reach the parallel
+// paths on small scenes. None of it changes the tree.
+struct BvhParallelism {
+  unsigned threads = 1;
+  std::uint32_t large_node = 1u << 16;
+  std::uint32_t chunk = 1u << 14;
+};
+
+// On an exception in any build thread, waits for all of them to stop, then rethrows it.
+BvhBuild build_bvh(const BuildRefs& refs, int max_leaf, const BvhParallelism& parallelism = {});
 
 // Renumbers the nodes so that each page holds a treelet: starting from a
 // root, the candidate a ray is most likely to visit next (the largest

@@ -10,6 +10,7 @@
 
 #include "tracer/bvh.hpp"
 #include "tracer/grid.hpp"
+#include "tracer/parallel.hpp"
 
 namespace tracer {
 namespace {
@@ -92,9 +93,11 @@ Flattened flatten(const Scene& scene) {
 }
 
 // Appends sections of fixed-size records, each starting on a fresh page.
+// Pages are filled in pieces of kPagesPerPiece on the build's threads; each
+// page's bytes depend only on the records.
 class Packer {
  public:
-  explicit Packer(std::uint32_t page_size) : page_size_(page_size) {}
+  Packer(std::uint32_t page_size, unsigned threads) : page_size_(page_size), threads_(threads) {}
 
   template <class T>
   SectionLayout add(const std::vector<T>& records, const char* what) {
@@ -109,12 +112,17 @@ class Packer {
     if (pages_.size() + npages > std::numeric_limits<PageId>::max())
       throw DatabaseError("scene too large: more than 2^32 pages");
     const auto* src = reinterpret_cast<const std::byte*>(records.data());
-    for (std::size_t p = 0; p < npages; ++p) {
-      std::vector<std::byte> page(page_size_, std::byte{0});
-      const std::size_t n = std::min<std::size_t>(page_size_, bytes - p * page_size_);
-      std::memcpy(page.data(), src + p * page_size_, n);
-      pages_.push_back(std::move(page));
-    }
+    const std::size_t base = pages_.size();
+    pages_.resize(base + npages);
+    const std::size_t pieces = (npages + kPagesPerPiece - 1) / kPagesPerPiece;
+    parallel_pieces(threads_, pieces, [&](std::size_t piece) {
+      for (std::size_t p = piece * kPagesPerPiece; p < std::min(npages, (piece + 1) * kPagesPerPiece); ++p) {
+        std::vector<std::byte> page(page_size_, std::byte{0});
+        const std::size_t n = std::min<std::size_t>(page_size_, bytes - p * page_size_);
+        std::memcpy(page.data(), src + p * page_size_, n);
+        pages_[base + p] = std::move(page);
+      }
+    });
     payload_ += bytes;
     return s;
   }
@@ -123,7 +131,9 @@ class Packer {
   std::uint64_t payload() const { return payload_; }
 
  private:
+  static constexpr std::size_t kPagesPerPiece = 256;  // filled together on one thread
   std::uint32_t page_size_;
+  unsigned threads_;
   std::vector<std::vector<std::byte>> pages_;
   std::uint64_t payload_ = 0;
 };
@@ -196,12 +206,12 @@ Database build_database(const Scene& scene, const BuildOptions& opt) {
 
   t0 = Clock::now();
   DatabaseHeader& h = db.header;
-  Packer packer(opt.page_size);
+  Packer packer(opt.page_size, opt.threads);
   auto& sec = h.sections;
   sec[int(Section::materials)] = packer.add(material_records(scene), "material");
   if (opt.accel == Accel::bvh) {
     const BuildRefs refs = split_large_triangles(f.prims, f.bounds, opt.bvh_split_depth);
-    BvhBuild bvh = build_bvh(refs, opt.bvh_max_leaf);
+    BvhBuild bvh = build_bvh(refs, opt.bvh_max_leaf, {.threads = opt.threads});
     if (opt.bvh_layout == BvhLayout::treelet) lay_out_treelets(bvh, opt.page_size / sizeof(BvhNode));
     for (std::uint32_t& k : bvh.order) k = refs.prim[k];
     reorder(f, bvh.order);

@@ -17,7 +17,8 @@
 //    at offset (i*size) % page_size.
 //  - Packing is deterministic and the acceleration structure is built before
 //    packing, so the floats the tracer computes with do not depend on page size
-//    (the treelet layout numbers BVH nodes by pages, but the tree is the same).
+//    (the treelet layout numbers BVH nodes by pages, but the tree is the same),
+//    nor on BuildOptions::threads: every thread count gives the same pages.
 //
 // PageSource contract: the pointer returned by page(id) is valid only until
 // the next call to page() on the same source; readers copy out (memcpy) what
@@ -68,6 +69,7 @@ struct BuildOptions {
   int bvh_max_leaf = 4;            // primitives per BVH leaf at most
   int bvh_split_depth = 3;         // large triangles split into <= 2^depth references (0: none)
   float grid_density = 2.0f;       // grid cells per primitive (approximately)
+  unsigned threads = 1;            // OS threads the build may use (0, 1: the caller's only)
 };
 
 // Throws DatabaseError unless page_size is a power of two in [256, 65536].

@@ -1,5 +1,6 @@
 // The BVH and the grid find the same closest hits as testing every primitive;
-// the treelet layout renumbers the same tree.
+// the treelet layout renumbers the same tree; any number of build threads
+// builds the same tree.
 #include <gtest/gtest.h>
 
 #include <cstring>
@@ -230,6 +231,62 @@ TEST(BvhLayout, FirstPageIsTheLargestTopOfTheTree) {
     lay_out_treelets(relaid, per_page);
     expect_first_page_is_a_treelet(relaid, per_page);
   }
+}
+
+// Random boxes, some of them triangles, plus a pile of identical boxes (no
+// centroid extent: halved, not binned) and boxes touching the planes
+// through 0 with both signs of zero, where min and max meet ties.
+BuildRefs awkward_boxes(unsigned seed, int count) {
+  BuildRefs refs = random_boxes(seed, count);
+  for (std::size_t i = 0; i < refs.triangle.size(); i += 3) refs.triangle[i] = true;
+  const auto add = [&](const Box3f& b) {
+    refs.bounds.push_back(b);
+    refs.prim.push_back(static_cast<std::uint32_t>(refs.prim.size()));
+    refs.triangle.push_back(true);
+  };
+  for (int i = 0; i < count / 10; ++i) add({{1, 2, 3}, {1.5f, 2.5f, 3.5f}});
+  for (int i = 0; i < count / 10; ++i) {
+    const float zero = i % 2 ? -0.0f : 0.0f, w = 0.1f + 0.001f * static_cast<float>(i % 97);
+    add({{zero, zero, static_cast<float>(i % 13)}, {w, w, static_cast<float>(i % 13) + w}});
+  }
+  return refs;
+}
+
+void expect_identical(const BvhBuild& expected, const BvhBuild& got, const std::string& what) {
+  ASSERT_EQ(expected.nodes.size(), got.nodes.size()) << what;
+  EXPECT_EQ(0, std::memcmp(expected.nodes.data(), got.nodes.data(), expected.nodes.size() * sizeof(BvhNode))) << what;
+  EXPECT_EQ(expected.order, got.order) << what;
+  EXPECT_EQ(expected.depth, got.depth) << what;
+}
+
+// Large enough that the default thresholds split the top nodes into chunks
+// and build subtrees on threads of their own.
+TEST(BvhParallel, SameTreeOnAnyThreadCount) {
+  const BuildRefs refs = awkward_boxes(13, 150000);
+  const BvhBuild one = build_bvh(refs, 4);
+  ASSERT_GT(one.nodes.size(), 10000u);
+  for (unsigned threads : {0u, 2u, 3u, 8u})
+    expect_identical(one, build_bvh(refs, 4, {.threads = threads}), std::to_string(threads) + " threads");
+}
+
+// Tiny thresholds put most nodes on the chunked, threaded paths: they must
+// give what the sequential build gives, with any chunk size.
+TEST(BvhParallel, ChunkedNodesMatchTheSequentialBuild) {
+  const BuildRefs refs = awkward_boxes(17, 8000);
+  const BvhBuild sequential = build_bvh(refs, 4);
+  for (unsigned threads : {1u, 2u, 3u, 8u})
+    for (std::uint32_t chunk : {7u, 64u}) {
+      const BvhParallelism par{.threads = threads, .large_node = 4 * chunk, .chunk = chunk};
+      expect_identical(sequential, build_bvh(refs, 4, par),
+                       std::to_string(threads) + " threads, chunks of " + std::to_string(chunk));
+    }
+}
+
+TEST(BvhParallel, OneAndNoReferencesOnManyThreads) {
+  const BuildRefs one = random_boxes(1, 1), none;
+  const BvhParallelism par{.threads = 8, .large_node = 2, .chunk = 1};
+  expect_identical(build_bvh(one, 4), build_bvh(one, 4, par), "one reference");
+  expect_identical(build_bvh(none, 4), build_bvh(none, 4, par), "no reference");
 }
 
 }  // namespace

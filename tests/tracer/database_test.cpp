@@ -6,6 +6,7 @@
 #include <cstring>
 
 #include "test_scenes.hpp"
+#include "tracer/generators.hpp"
 
 namespace tracer {
 namespace {
@@ -84,6 +85,24 @@ TEST(Database, PackingIsDeterministic) {
   const Scene scene = testing::random_scene(9, 300, 30);
   const Database a = build_database(scene), b = build_database(scene);
   EXPECT_EQ(a.pages, b.pages);
+}
+
+// tetra:8 has 65536 triangles: the BVH root is binned in chunks and its
+// subtrees may be built on threads of their own.
+TEST(Database, PagesAreTheSameOnAnyThreadCount) {
+  const Scene scene = generate_tetra(8);
+  for (const auto& [accel, layout] :
+       {std::pair{Accel::bvh, BvhLayout::treelet}, std::pair{Accel::bvh, BvhLayout::depth_first},
+        std::pair{Accel::grid, BvhLayout::treelet}}) {
+    const Database one = build_database(scene, {.accel = accel, .bvh_layout = layout});
+    ASSERT_GE(one.header.primitive_count, 65536u);
+    for (unsigned threads : {2u, 3u, 8u}) {
+      const Database many = build_database(scene, {.accel = accel, .bvh_layout = layout, .threads = threads});
+      EXPECT_TRUE(one.pages == many.pages) << threads << " threads, accel " << int(accel) << ", layout " << int(layout);
+      EXPECT_EQ(one.header.page_count, many.header.page_count);
+      EXPECT_EQ(one.header.bvh_depth, many.header.bvh_depth);
+    }
+  }
 }
 
 TEST(Database, TriangulatesPolygonsAndCountsPolygons) {
