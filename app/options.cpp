@@ -56,49 +56,54 @@ po::options_description describe_render(Options& o, Raw& raw) {
   return d;
 }
 
+// One option a line, as Boost's examples lay them out.
+// clang-format off
 po::options_description describe_machine(Options& o, Raw& raw) {
   po::options_description d("Machine options (the image is the same for every setting)");
-  d.add_options()("single", po::bool_switch(&o.single),
-                  "render in this process with the whole database in memory, no machine (the options below but "
-                  "--threads are then errors)")(
-      "topology", po::value(&raw.topology)->default_value("hypercube"),
-      "hypercube, mesh, torus, ring or complete (with --nodes), or a full spec: "
-      "hypercube:4, mesh:4x4, torus:4x4, ring:16, complete:16")(
-      "nodes", po::value(&raw.nodes),
-      ("processors, at most " + std::to_string(topology::max_nodes) + " (default 16, or the full spec's)").c_str())(
-      "threads", po::value(&raw.threads)->default_value(0),
-      "OS threads carrying the processors, 0..4096 (0: the CPUs this process may use, by its affinity and CPU quota; "
-      "at most --nodes); "
-      "with --single, threads tracing rows (at most the image's rows)")(
-      "cache-pages", po::value(&raw.cache_pages),
-      "remote pages cached per node (default: 1/8 of the database, at least 64 pages)")(
-      "cache-kb", po::value(&raw.cache_kb), "the cache per node in KB instead of pages")(
-      "grain", po::value(&raw.grain)->default_value(16),
-      "pixels per tile handed out (affinity: the smallest tile), a run of the pixel order")(
-      "schedule", po::value(&raw.schedule)->default_value("affinity"),
-      "affinity (dynamic, each processor working through its own region first), dynamic (pixels in frame "
-      "order to whoever asks, as in the paper), or static (fixed shares)")(
-      "pixel-order", po::value(&raw.pixel_order)->default_value("hilbert"),
-      "how pixels are numbered, so where a tile or a share lies: hilbert (along a Hilbert curve: compact "
-      "patches whose rays share pages) or scanline (rows, as in the paper)")(
-      "workers-per-node", po::value(&raw.workers)->default_value(1), "pixel computers per processor")(
-      "prefetch", po::value(&raw.prefetch)->default_value(1),
-      "tiles a pixel computer keeps asked for beyond the one it traces, 0..3 (0: ask when idle, as in the paper)")(
-      "distribution", po::value(&raw.distribution)->default_value("modulo"),
-      "page p on node p mod N (modulo), or consecutive runs of pages (block)")(
-      "trace-routes", po::value(&raw.trace_routes)->default_value(0),
-      "print the routes of the first N packets injected, hop by hop, 0..1048576 (of the kinds --trace-kind names)")(
-      "trace-kind", po::value(&raw.trace_kind),
-      "with --trace-routes: trace packets of these kinds only, comma-separated: work_request, work, stop, result, "
-      "page_request, page_reply, worker_done, server_stop, server_done")(
-      "tiles", po::value(&o.tiles_csv),
-      "write a CSV row per tile: node, worker, first item, items, start and end seconds (wall, or virtual "
-      "with --timing virtual), page requests and rays")(
-      "compare-serial", po::bool_switch(&o.compare_serial),
-      "also run the 1-node machine; report speedup and efficiency T1/(N*TN)");
+  d.add_options()
+      ("single", po::bool_switch(&o.single),
+       "render in this process with the whole database in memory, no machine (the options below but "
+       "--threads are then errors)")
+      ("topology", po::value(&raw.topology)->default_value("hypercube"),
+       "hypercube, mesh, torus, ring or complete (with --nodes), or a full spec: "
+       "hypercube:4, mesh:4x4, torus:4x4, ring:16, complete:16")
+      ("nodes", po::value(&raw.nodes),
+       ("processors, at most " + std::to_string(topology::max_nodes) + " (default 16, or the full spec's)").c_str())
+      ("threads", po::value(&raw.threads)->default_value(0),
+       "OS threads carrying the processors, 0..4096 (0: the CPUs this process may use, by its affinity and CPU "
+       "quota; at most --nodes); with --single, threads tracing rows (at most the image's rows); the database "
+       "is built on as many")
+      ("cache-pages", po::value(&raw.cache_pages),
+       "remote pages cached per node (default: 1/8 of the database, at least 64 pages)")
+      ("cache-kb", po::value(&raw.cache_kb), "the cache per node in KB instead of pages")
+      ("grain", po::value(&raw.grain)->default_value(16),
+       "pixels per tile handed out (affinity: the smallest tile), a run of the pixel order")
+      ("schedule", po::value(&raw.schedule)->default_value("affinity"),
+       "affinity (dynamic, each processor working through its own region first), dynamic (pixels in frame "
+       "order to whoever asks, as in the paper), or static (fixed shares)")
+      ("pixel-order", po::value(&raw.pixel_order)->default_value("hilbert"),
+       "how pixels are numbered, so where a tile or a share lies: hilbert (along a Hilbert curve: compact "
+       "patches whose rays share pages) or scanline (rows, as in the paper)")
+      ("workers-per-node", po::value(&raw.workers)->default_value(1),
+       "pixel computers per processor")
+      ("prefetch", po::value(&raw.prefetch)->default_value(1),
+       "tiles a pixel computer keeps asked for beyond the one it traces, 0..3 (0: ask when idle, as in the paper)")
+      ("distribution", po::value(&raw.distribution)->default_value("modulo"),
+       "page p on node p mod N (modulo), or consecutive runs of pages (block)")
+      ("trace-routes", po::value(&raw.trace_routes)->default_value(0),
+       "print the routes of the first N packets injected, hop by hop, 0..1048576 (of the kinds --trace-kind names)")
+      ("trace-kind", po::value(&raw.trace_kind),
+       "with --trace-routes: trace packets of these kinds only, comma-separated: work_request, work, stop, result, "
+       "page_request, page_reply, worker_done, server_stop, server_done")
+      ("tiles", po::value(&o.tiles_csv),
+       "write a CSV row per tile: node, worker, first item, items, start and end seconds (wall, or virtual "
+       "with --timing virtual), page requests and rays")
+      ("compare-serial", po::bool_switch(&o.compare_serial),
+       "also run the 1-node machine; report speedup and efficiency T1/(N*TN)");
   add_timing_options(d, raw.timing, o.pictures);
   return d;
 }
+// clang-format on
 
 // Width, height and tessellation are 0 (the scene's own) only when not given.
 void check_render(Options& o, const Raw& raw, const po::variables_map& vm) {

@@ -9,22 +9,25 @@ namespace app {
 
 namespace po = boost::program_options;
 
+// One option a line, as Boost's examples lay them out.
+// clang-format off
 void add_timing_options(po::options_description& d, TimingChoice& timing, PicturePaths& pictures) {
-  d.add_options()("timing", po::value(&timing.timing)->default_value("real"),
-                  "real (wall time) or virtual: the time a real machine would take under --profile "
-                  "(deterministic; the machine runs on one thread)")(
-      "profile", po::value(&timing.profile)->default_value("ipsc2"),
-      "machine model for virtual time: ipsc2, native (calibrated here), or a 'key = value' file")(
-      "cost", po::value(&timing.costs),
-      "costs over the profile: box=,prim=,shade=,page=,serve=,msg=,hop= (s, ms, us, ns), bw= (B/s, KB/s, MB/s; 0: "
-      "unlimited)")("machine-svg", po::value(&pictures.machine_svg),
-                    "after a machine render: the machine with its traffic, SVG")(
-      "ownership", po::value(&pictures.ownership_png), "after a machine render: which node computed each pixel, PNG")(
-      "timeline", po::value(&pictures.timeline_svg),
-      "after a machine render: when each processor traced each tile, coloured by its page requests, SVG")(
-      "report", po::value(&pictures.report_html),
-      "after a machine render: one self-contained HTML page with the image, statistics and pictures");
+  d.add_options()
+      ("timing", po::value(&timing.timing)->default_value("real"),
+       "real (wall time) or virtual: the time a real machine would take under --profile "
+       "(deterministic; the machine runs on one thread)")
+      ("profile", po::value(&timing.profile)->default_value("ipsc2"),
+       "machine model for virtual time: ipsc2, native (calibrated here), or a 'key = value' file")
+      ("cost", po::value(&timing.costs),
+       "costs over the profile: box=,prim=,shade=,page=,serve=,msg=,hop= (s, ms, us, ns), bw= (B/s, KB/s, MB/s; 0: unlimited)")
+      ("machine-svg", po::value(&pictures.machine_svg), "after a machine render: the machine with its traffic, SVG")
+      ("ownership", po::value(&pictures.ownership_png), "after a machine render: which node computed each pixel, PNG")
+      ("timeline", po::value(&pictures.timeline_svg),
+       "after a machine render: when each processor traced each tile, coloured by its page requests, SVG")
+      ("report", po::value(&pictures.report_html),
+       "after a machine render: one self-contained HTML page with the image, statistics and pictures");
 }
+// clang-format on
 
 nodes::CostModel cost_model_from(const std::string& profile, const std::string& costs) {
   nodes::CostModel model;
