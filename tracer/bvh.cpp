@@ -25,6 +25,8 @@
 #include <mutex>
 #include <thread>
 
+#include "tracer/parallel.hpp"
+
 namespace tracer {
 namespace {
 
@@ -203,37 +205,19 @@ class Builder {
   }
 
   // Runs work(c) for chunks c = 0..chunks-1 on this thread and on the helper
-  // threads the budget allows (about four chunks each at least); returns once
-  // every helper has stopped, rethrowing the first exception caught.
+  // threads the budget allows (about four chunks each at least), whose slots
+  // it holds until every chunk is done; rethrows the first exception caught.
   template <class Work>
   void for_chunks(std::uint32_t chunks, const Work& work) {
-    std::atomic<std::uint32_t> next{0};
-    std::mutex error_mutex;
-    std::exception_ptr error;
-    const auto drain = [&] {
-      try {
-        for (std::uint32_t c; (c = next.fetch_add(1)) < chunks;) work(c);
-      } catch (...) {
-        std::lock_guard lock(error_mutex);
-        if (!error) error = std::current_exception();
-        next.store(chunks);
-      }
-    };
-    std::vector<std::thread> helpers;
-    for (std::uint32_t h = 0; h + 1 < chunks / 4 && budget_.try_take(); ++h) {
-      try {
-        helpers.emplace_back([&] {
-          drain();
-          budget_.give();
-        });
-      } catch (...) {
-        budget_.give();
-        break;
-      }
+    unsigned helpers = 0;
+    while (helpers + 1 < chunks / 4 && budget_.try_take()) ++helpers;
+    try {
+      parallel_pieces(helpers + 1, chunks, [&](std::size_t c) { work(static_cast<std::uint32_t>(c)); });
+    } catch (...) {
+      for (unsigned h = 0; h < helpers; ++h) budget_.give();
+      throw;
     }
-    drain();
-    for (std::thread& t : helpers) t.join();
-    if (error) std::rethrow_exception(error);
+    for (unsigned h = 0; h < helpers; ++h) budget_.give();
   }
 
   std::uint32_t chunk_count(std::uint32_t begin, std::uint32_t end) const {

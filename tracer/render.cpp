@@ -8,11 +8,10 @@
 #include <cmath>
 #include <cstddef>
 #include <cstring>
-#include <exception>
 #include <limits>
 #include <memory>
-#include <mutex>
-#include <thread>
+
+#include "tracer/parallel.hpp"
 
 namespace tracer {
 
@@ -510,35 +509,18 @@ struct Lane {
 };
 
 // Runs row(lane, y) for y in [first, last) on every lane, lane 0 on this
-// thread, rows taken in order from a shared counter; after each row this
-// thread does, after_own_row(rows finished so far). The first exception
-// thrown stops the others at their next row and is rethrown here.
+// thread; after each row this thread does, after_own_row(rows finished so
+// far). See parallel_pieces for the order and for exceptions.
 template <class Row, class AfterOwnRow>
 void parallel_rows(std::vector<std::unique_ptr<Lane>>& lanes, int first, int last, const Row& row,
                    const AfterOwnRow& after_own_row) {
-  std::atomic<int> next{first}, finished{0};
-  std::atomic<bool> failed{false};
-  std::exception_ptr error;
-  std::mutex error_mutex;
-  const auto work = [&](Lane& lane, bool own) {
-    try {
-      for (int y = next++; y < last && !failed.load(std::memory_order_relaxed); y = next++) {
-        row(lane, y);
-        const int done = finished.fetch_add(1, std::memory_order_relaxed) + 1;
-        if (own) after_own_row(done);
-      }
-    } catch (...) {
-      std::lock_guard lock(error_mutex);
-      if (!error) error = std::current_exception();
-      failed = true;
-    }
-  };
-  std::vector<std::thread> helpers;
-  helpers.reserve(lanes.size() - 1);
-  for (std::size_t i = 1; i < lanes.size(); ++i) helpers.emplace_back(work, std::ref(*lanes[i]), false);
-  work(*lanes[0], true);
-  for (std::thread& t : helpers) t.join();
-  if (error) std::rethrow_exception(error);
+  std::atomic<int> finished{0};
+  parallel_pieces(static_cast<unsigned>(lanes.size()), static_cast<std::size_t>(last - first),
+                  [&](std::size_t i, unsigned worker) {
+                    row(*lanes[worker], first + static_cast<int>(i));
+                    const int done = finished.fetch_add(1, std::memory_order_relaxed) + 1;
+                    if (worker == 0) after_own_row(done);
+                  });
 }
 
 // Rows of SPD corner samples traced together: a band's samples are kept
