@@ -120,4 +120,11 @@ std::size_t count_class(const XmlCheck& doc, const std::string& cls) {
   }));
 }
 
+std::string first_non_finite_attribute(const XmlCheck& doc) {
+  for (const XmlElement& e : doc.elements)
+    for (const auto& [name, value] : e.attrs)
+      if (value.find("nan") != std::string::npos || value.find("inf") != std::string::npos) return name + "=" + value;
+  return {};
+}
+
 }  // namespace viz::test

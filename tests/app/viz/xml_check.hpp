@@ -28,4 +28,8 @@ XmlCheck check_xml(const std::string& text, const std::vector<std::string>& void
 
 std::size_t count_class(const XmlCheck& doc, const std::string& cls);
 
+// The first attribute, as "name=value", whose value holds "nan" or "inf" (a
+// coordinate that is not finite); empty if there is none.
+std::string first_non_finite_attribute(const XmlCheck& doc);
+
 }  // namespace viz::test
