@@ -75,6 +75,23 @@ std::size_t Alt::select() {
 
 std::size_t Alt::pri_select() { return select_from(0); }
 
+std::optional<std::size_t> Alt::poll() {
+  if (dirty_) prepare();
+  std::size_t ready = none;
+  if (bell_) {
+    ready = poll_each(0);
+  } else {
+    ready = poll_hints(0);
+    if (ready == none) {
+      lock_channels();
+      ready = poll_locked(0);
+      unlock_channels();
+    }
+  }
+  if (ready == none) return std::nullopt;
+  return ready;
+}
+
 std::size_t Alt::select_from(std::size_t first) {
   if (dirty_) prepare();
   if (channels_.empty() && timeout_guard_ == none && !has_skip_) {

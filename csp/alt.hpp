@@ -33,6 +33,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <memory>
+#include <optional>
 #include <vector>
 
 #include "csp/channel.hpp"
@@ -86,6 +87,11 @@ class Alt {
 
   std::size_t select();
   std::size_t pri_select();
+  // A PRI ALT with SKIP last, without a SKIP guard: the lowest ready guard,
+  // or none if nothing is ready; never waits. A doorbell ALT polls only the
+  // guards that rang, so a process that takes everything ready after a
+  // select pays for what is ready, not for its guard count.
+  std::optional<std::size_t> poll();
 
  private:
   enum class Kind { input, room, timeout, skip };

@@ -5,9 +5,10 @@
 #include <gtest/gtest.h>
 
 #include <array>
+#include <optional>
 #include <ostream>
-#include <string>
 #include <stdexcept>
+#include <string>
 #include <vector>
 
 #include "csp/csp.hpp"
@@ -197,6 +198,58 @@ TEST_P(Alt, GuardsMayChangeBetweenSelects) {
   alt.enable(0, false);
   alt.enable(1, false);
   EXPECT_EQ(alt.pri_select(), skip);
+}
+
+// poll() is a PRI ALT with SKIP last: the lowest ready guard, or nothing,
+// and it never waits, also with no guard enabled at all.
+TEST_P(Alt, PollTakesTheLowestReadyGuardOrNothing) {
+  csp::Channel<int> a("a", 4), b("b", 4);
+  csp::Alt alt(GetParam());
+  auto ia = a.reader();
+  auto ib = b.reader();
+  const std::size_t ga = alt.add_input(ia), gb = alt.add_input(ib);
+  EXPECT_FALSE(alt.poll().has_value());
+  b.writer().write(1);
+  EXPECT_EQ(alt.poll(), std::optional<std::size_t>(gb));
+  a.writer().write(2);
+  EXPECT_EQ(alt.poll(), std::optional<std::size_t>(ga));  // twice: nothing read yet
+  EXPECT_EQ(alt.poll(), std::optional<std::size_t>(ga));
+  EXPECT_EQ(ia.read(), 2);
+  EXPECT_EQ(alt.poll(), std::optional<std::size_t>(gb));
+  alt.enable(gb, false);
+  EXPECT_FALSE(alt.poll().has_value());  // b still holds 1, but its guard is off
+  alt.enable(ga, false);
+  EXPECT_FALSE(alt.poll().has_value());  // no guard at all: no STOP error, just nothing
+  alt.enable(gb, true);
+  EXPECT_EQ(alt.poll(), std::optional<std::size_t>(gb));
+  EXPECT_EQ(ib.read(), 1);
+  EXPECT_FALSE(alt.poll().has_value());
+}
+
+// A select after polls that found nothing still wakes on the next write, so
+// a process may poll until nothing is ready and then wait.
+TEST_P(Alt, SelectAfterEmptyPollsWakesOnTheNextWrite) {
+  const csp::Alt::Waiting waiting = GetParam();
+  csp::Runtime rt(2);
+  csp::Channel<int> c("c", 2);
+  std::vector<int> got;
+  rt.spawn("reader", 0, [&, in = c.reader()]() mutable {
+    csp::Alt alt(waiting);
+    const std::size_t g = alt.add_input(in);
+    for (int k = 0; k < 200; ++k) {
+      while (alt.poll()) got.push_back(in.read());
+      if (got.size() == 200) break;
+      EXPECT_EQ(alt.select(), g);
+      got.push_back(in.read());
+      if (got.size() == 200) break;
+    }
+  });
+  rt.spawn("writer", 1, [out = c.writer()]() mutable {
+    for (int i = 0; i < 200; ++i) out.write(i);
+  });
+  rt.run();
+  ASSERT_EQ(got.size(), 200u);
+  for (int i = 0; i < 200; ++i) EXPECT_EQ(got[i], i);
 }
 
 TEST_P(Alt, AllGuardsDisabledIsAnError) {
