@@ -97,15 +97,23 @@ class ThreadRelays::Relay {
     take_arrivals();  // anything signalled before the attach
     for (;;) {
       handle(alt_.select());
-      alt_.enable(skip_, true);
-      for (std::size_t g; (g = alt_.pri_select()) != skip_;) handle(g);
-      alt_.enable(skip_, false);
+      take_ready();
+      // The processes this wake made ready (the routers it delivered to, the
+      // page servers behind them) run before the flush, and what they send
+      // across goes in the same batch: a request that arrives here leaves
+      // as a reply with the credits for it, under one signal. A relay is of
+      // high priority, so the pixel computers of this thread wait for it.
+      for (int round = 0; round < max_rounds && csp::yield_requested(); ++round) {
+        csp::yield();
+        take_ready();
+      }
       flush();
     }
   }
 
  private:
   static constexpr std::size_t none = static_cast<std::size_t>(-1);
+  static constexpr int max_rounds = 8;  // yields before a flush, while other high-priority work is ready
   struct Outgoing {
     std::size_t link;
     std::size_t credits;
@@ -118,8 +126,9 @@ class ThreadRelays::Relay {
     std::size_t guard = 0;
   };
 
-  // Guard 0: the token; then per outgoing link its queue, per incoming link
-  // room in its input; last a skip guard, enabled while taking what is ready.
+  // Guard 0: the token; then per outgoing link its queue (enabled while it
+  // has credits), per incoming link room in its input (enabled while
+  // packets are staged for it).
   void build_alt() {
     token_guard_ = alt_.add_input(relays_.tokens_[thread_].reader());
     for (Outgoing& o : outgoing_) o.guard = alt_.add_input(relays_.links_[o.link].queue);
@@ -127,11 +136,16 @@ class ThreadRelays::Relay {
       i.guard = alt_.add_room(relays_.links_[i.link].into);
       alt_.enable(i.guard, false);
     }
-    skip_ = alt_.add_skip();
-    alt_.enable(skip_, false);
     guard_owner_.assign(alt_.guard_count(), {false, none});
     for (std::size_t k = 0; k < outgoing_.size(); ++k) guard_owner_[outgoing_[k].guard] = {true, k};
     for (std::size_t k = 0; k < incoming_.size(); ++k) guard_owner_[incoming_[k].guard] = {false, k};
+  }
+
+  // One select per wake, then polls until nothing is ready: the doorbell
+  // ALT polls only the guards that rang, and no guard is switched to do
+  // so, so a wake costs what it moves and not the number of links.
+  void take_ready() {
+    while (const std::optional<std::size_t> g = alt_.poll()) handle(*g);
   }
 
   void handle(std::size_t guard) {
@@ -227,7 +241,6 @@ class ThreadRelays::Relay {
   std::vector<bool> touched_;                      // per thread: written to since the last flush
   csp::Alt alt_{csp::Alt::Waiting::doorbell};
   std::size_t token_guard_ = 0;
-  std::size_t skip_ = 0;
 };
 
 ThreadRelays::ThreadRelays(unsigned threads, std::size_t capacity)

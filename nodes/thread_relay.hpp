@@ -24,9 +24,12 @@
 // dependencies are those of the unrelayed network. The deadlock detector
 // sees packets in a ring as work (a pending csp::Arrivals).
 //
-// Batching: a relay that wakes takes everything ready (packets from its
-// rings and queues, room in its inputs) before it signals the threads it
-// wrote to, once each; a busy thread notices the signal at its next switch.
+// Batching: a relay that wakes (one select) takes everything ready (its
+// rings, the queues it has credit for, room in the inputs it has staged
+// packets for), lets the high-priority processes it made ready run and
+// takes what they sent (a page request in, its reply out), then signals
+// the threads it wrote to, once each; a busy thread notices the signal at
+// its next switch.
 //
 // Orderly end: Network::shutdown() poisons the queues, the inputs and the
 // relays' tokens; each relay then ends, as the routers do.
