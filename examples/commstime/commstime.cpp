@@ -11,7 +11,10 @@
 // up to the hardware's threads), none talking to another: what the threads
 // cost each other through state the runtime shares between them. Last, what
 // a write costs its sender when the reader is on another thread that is
-// busy computing (no wake-up should reach the OS then).
+// busy computing (no wake-up should reach the OS then), and the floor under
+// every cross-thread figure: one cache line handed back and forth between
+// two spinning threads, no runtime at all (a packet that crosses threads
+// moves a few such lines: its ring slot, its payload, the ring's indices).
 //
 // One-thread figures are CPU time of that thread, two-thread ones wall time.
 // Each figure is the best of several runs, alternating csp and raw, so that
@@ -339,6 +342,34 @@ void print_hand_off(long count, int runs) {
               static_cast<unsigned long long>(best.asleep));
 }
 
+// Two threads take turns writing one atomic word; wall ns per round trip
+// (the line goes to the other core and comes back).
+double line_round_trip(long count) {
+  alignas(64) std::atomic<long> turn{0};
+  std::thread other([&] {
+    for (long i = 0; i < count; ++i) {
+      while (turn.load(std::memory_order_acquire) != 2 * i + 1) {
+      }
+      turn.store(2 * i + 2, std::memory_order_release);
+    }
+  });
+  const auto start = Clock::now();
+  for (long i = 0; i < count; ++i) {
+    turn.store(2 * i + 1, std::memory_order_release);
+    while (turn.load(std::memory_order_acquire) != 2 * i + 2) {
+    }
+  }
+  const auto elapsed = Clock::now() - start;
+  other.join();
+  return ns_per(elapsed, count);
+}
+
+void print_line_round_trip(long count, int runs) {
+  double best = std::numeric_limits<double>::max();
+  for (int r = 0; r < runs; ++r) best = std::min(best, line_round_trip(count));
+  std::printf("%10.1f ns per round trip of a cache line between two threads\n", best);
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -362,5 +393,11 @@ int main(int argc, char** argv) {
   for (std::size_t n : {1u, 4u, 16u}) print_alt(n, cycles, runs);
   std::printf("\nHanding values to a process on a busy thread (wall ns per write), best of %d runs\n", runs);
   print_hand_off(cycles, runs);
+  std::printf("\nThe machine's floor: one cache line between two spinning threads, best of %d runs\n", runs);
+  if (std::thread::hardware_concurrency() >= 2) {
+    print_line_round_trip(cycles, runs);
+  } else {
+    std::printf("(not measured: it needs two hardware threads)\n");
+  }
   return 0;
 }
