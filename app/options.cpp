@@ -8,6 +8,7 @@
 
 #include "app/cpu_count.hpp"
 #include "app/machine_report.hpp"
+#include "app/machine_run.hpp"
 #include "topology/spec.hpp"
 #include "topology/topology.hpp"
 #include "tracer/generators.hpp"
@@ -131,18 +132,13 @@ void check_topology(nodes::MachineOptions& m, const Raw& raw, const po::variable
   if (m.nodes) check_grid_shape(m.topology, *m.nodes);
 }
 
+// The cache's rules (one of the two, at least a page) are the machine's,
+// checked with the others in check_machine.
 void check_cache(Options& o, const Raw& raw, const po::variables_map& vm) {
   nodes::MachineOptions& m = o.machine;
-  if (vm.count("cache-pages") && vm.count("cache-kb"))
-    throw UsageError("--cache-pages and --cache-kb: give one of them, not both");
   if (vm.count("cache-pages"))
     m.cache_pages = in_range<std::uint32_t>(raw.cache_pages, 1, UINT32_MAX, "--cache-pages");
-  if (vm.count("cache-kb")) {
-    m.cache_kb = in_range<std::uint64_t>(raw.cache_kb, 1, std::int64_t(1) << 40, "--cache-kb");
-    if (*m.cache_kb * 1024 < o.page_size)
-      throw UsageError("--cache-kb: " + std::to_string(*m.cache_kb) + " KB is less than one page (" +
-                       std::to_string(o.page_size) + " bytes)");
-  }
+  if (vm.count("cache-kb")) m.cache_kb = in_range<std::uint64_t>(raw.cache_kb, 1, std::int64_t(1) << 40, "--cache-kb");
 }
 
 void check_machine(Options& o, const Raw& raw, const po::variables_map& vm) {
@@ -170,6 +166,12 @@ void check_machine(Options& o, const Raw& raw, const po::variables_map& vm) {
     throw UsageError("--compare-serial: a virtual-time run always reports speedup against the 1-node machine");
   // The tile CSV, the timeline and the report (which shows the timeline) need the tiles.
   m.record_tiles = !o.tiles_csv.empty() || !o.pictures.timeline_svg.empty() || !o.pictures.report_html.empty();
+  // The machine's own rules, now rather than after the scene is read.
+  try {
+    nodes::check_options(m, o.page_size);
+  } catch (const nodes::OptionError& e) {
+    throw usage_error(e);
+  }
 }
 
 // --single renders in this process: an option of the machine but --threads,
