@@ -1,5 +1,9 @@
-// The VM_pRAY machine: distribution of the pages, wiring of every process on
-// the network, and the report (see machine.hpp for the protocol).
+// The VM_pRAY machine (see machine.hpp for the protocol). A run is three
+// steps, each a few functions below: build (the pages moved to their owners,
+// the runtime, the network and every process on it), run (the runtime to its
+// end, and what ended it in the machine's terms: ResourceError, RankFailure)
+// and report (the figures, from the state the processes leave). The options
+// are checked once, before the first step (check_options).
 #include "nodes/machine.hpp"
 
 #include <algorithm>
