@@ -1,6 +1,7 @@
 // Machine rendering; see machine_run.hpp.
 #include "app/machine_run.hpp"
 
+#include <stdexcept>
 #include <string>
 #include <utility>
 
@@ -23,10 +24,23 @@ nodes::MachineResult run_with_progress(tracer::Database db, nodes::MachineOption
                   "starting the machine and handing out its " + std::to_string(db.header.page_count) + " pages");
   // The collector calls this on its own thread only, so the bar needs no lock.
   machine.progress = [&bar](std::uint64_t done, std::uint64_t) { bar.update(done); };
-  nodes::MachineResult result =
-      ranks ? std::move(*nodes::run_machine_rank(std::move(db), machine, *ranks)) : nodes::run_machine(std::move(db), machine);
-  bar.finish();
-  return result;
+  // The machine's own thread count, which --threads asks for (at most one a node).
+  const auto hinted = [](const nodes::ResourceError& e) {
+    return with_hint(e, "--threads, " + std::to_string(e.threads()) + " here");
+  };
+  try {
+    nodes::MachineResult result = ranks ? std::move(*nodes::run_machine_rank(std::move(db), machine, *ranks))
+                                        : nodes::run_machine(std::move(db), machine);
+    bar.finish();
+    return result;
+  } catch (const nodes::OptionError& e) {
+    throw usage_error(e);
+  } catch (const nodes::ResourceError& e) {
+    throw std::runtime_error(hinted(e));
+  } catch (const nodes::RankFailure& e) {
+    if (!e.resource()) throw;
+    throw nodes::RankFailure(e.rank(), hinted(*e.resource()));
+  }
 }
 
 SerialComparison run_serial(const tracer::Database& db, const nodes::MachineOptions& machine,
@@ -40,6 +54,33 @@ SerialComparison run_serial(const tracer::Database& db, const nodes::MachineOpti
 }
 
 }  // namespace
+
+std::string option_of_field(const std::string& field) {
+  // clang-format off
+  static const std::pair<const char*, const char*> options[] = {
+      {"topology", "--topology"}, {"nodes", "--nodes"}, {"threads", "--threads"},
+      {"cache_pages", "--cache-pages"}, {"cache_kb", "--cache-kb"}, {"grain", "--grain"},
+      {"schedule", "--schedule"}, {"pixel_order", "--pixel-order"}, {"workers_per_node", "--workers-per-node"},
+      {"prefetch", "--prefetch"}, {"distribution", "--distribution"}, {"trace_routes", "--trace-routes"},
+      {"trace_kinds", "--trace-kind"}, {"timing", "--timing"},
+  };
+  // clang-format on
+  for (const auto& [name, option] : options)
+    if (field == name) return option;
+  return field;
+}
+
+UsageError usage_error(const nodes::OptionError& error) {
+  return UsageError(option_of_field(error.field()) + ": " + error.reason());
+}
+
+std::string with_hint(const nodes::ResourceError& error, const std::string& fewer_threads) {
+  const std::string line = error.what();
+  if (error.resource() == nodes::ResourceError::Resource::thread)
+    return line + "; try fewer threads (" + fewer_threads + "), or see ulimit -v and ulimit -u";
+  return line + "; a machine of " + std::to_string(error.nodes()) +
+         " nodes needs more memory than this process may map (see ulimit -v)";
+}
 
 nodes::MachineOptions machine_options(const Options& o) {
   nodes::MachineOptions machine = o.machine;

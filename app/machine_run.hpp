@@ -15,8 +15,18 @@ namespace app {
 // The machine's options from the command line's, with the tracing options.
 nodes::MachineOptions machine_options(const Options& options);
 
-// Throws tracer::DatabaseError, std::invalid_argument (a machine option) or
-// std::runtime_error, each one line. With `ranks`, this process is rank 0
+// The machine's errors in the command line's terms. A MachineOptions field
+// is named by its option ("cache_kb" -> "--cache-kb"; a field no option sets
+// keeps its own name), and an OptionError becomes UsageError "OPTION: REASON".
+std::string option_of_field(const std::string& field);
+UsageError usage_error(const nodes::OptionError& error);
+// A machine the system could not give memory or threads: its line and what
+// to change. `fewer_threads` says how to ask for fewer ("--threads, 8 here").
+std::string with_hint(const nodes::ResourceError& error, const std::string& fewer_threads);
+
+// Throws tracer::DatabaseError, UsageError (a machine option),
+// nodes::RankFailure or std::runtime_error, each one line; a shortage of
+// memory or threads comes with its hint. With `ranks`, this process is rank 0
 // of a machine split over them (nodes::run_machine_rank); every other rank
 // runs nodes::run_machine_rank with machine_options(options) meanwhile.
 RenderResult render_machine(const Options& options, const tracer::Scene& scene, nodes::Transport* ranks = nullptr);

@@ -8,6 +8,7 @@
 
 #include "app/cpu_count.hpp"
 #include "app/machine_report.hpp"
+#include "app/machine_run.hpp"
 #include "topology/spec.hpp"
 #include "topology/topology.hpp"
 #include "tracer/generators.hpp"
@@ -20,14 +21,15 @@ namespace {
 
 // Values that need checking or converting before they reach Options.
 struct Raw {
-  std::string accel, bvh_layout, shadow_rays;
-  std::int64_t page_size = 0, max_depth = 0, width = 0, height = 0, tessellate = 0;
-  std::string topology, schedule, pixel_order, distribution, trace_kind;
-  std::int64_t nodes = 0, threads = 0, cache_pages = 0, cache_kb = 0, grain = 0, workers = 0,
-               prefetch = 0, trace_routes = 0;
+  SharedChoice shared;  // the options a sweep takes too
+  std::int64_t max_depth = 0, width = 0, height = 0, tessellate = 0;
+  std::string topology, distribution, trace_kind;
+  std::int64_t nodes = 0, threads = 0, cache_pages = 0, cache_kb = 0, workers = 0, trace_routes = 0;
   TimingChoice timing;
 };
 
+// One option a line, as Boost's examples lay them out.
+// clang-format off
 po::options_description describe_render(Options& o, Raw& raw) {
   po::options_description d("Options");
   d.add_options()
@@ -36,16 +38,9 @@ po::options_description describe_render(Options& o, Raw& raw) {
       ("output,o", po::value(&o.output), "output image, .png or .ppm (default: SCENE.png)")
       ("stats", po::value(&o.stats_path), "write the report as JSON to this file (- for standard output, the text report then going to stderr)")
       ("spd-procedure", po::bool_switch(&o.spd_procedure),
-       "SPD testing procedure: pixel-corner eye rays, depth 5, no adaptive cut-off")
-      ("accel", po::value(&raw.accel)->default_value("bvh"), "acceleration structure: bvh or grid")
-      ("bvh-layout", po::value(&raw.bvh_layout)->default_value("treelet"),
-       "how BVH nodes fill pages: treelet (each page a piece of the tree a ray goes down, so fewer pages "
-       "per pixel) or depth-first (siblings together)")
-      ("shadow-rays", po::value(&raw.shadow_rays)->default_value("facing"),
-       "facing: a shadow ray only to lights in front of the surface (SPD); all: one to every "
-       "light at every hit, as VM_pRAY counted them (same image, more rays)")
-      ("page-size", po::value(&raw.page_size)->default_value(1024),
-       "database page size in bytes, a power of two from 256 to 65536")
+       "SPD testing procedure: pixel-corner eye rays, depth 5, no adaptive cut-off");
+  add_database_options(d, raw.shared);
+  d.add_options()
       ("max-depth", po::value(&raw.max_depth)->default_value(5), "maximum ray depth (eye ray = 1)")
       ("width", po::value(&raw.width), "image width (default: the scene's)")
       ("height", po::value(&raw.height), "image height (default: the scene's)")
@@ -55,6 +50,7 @@ po::options_description describe_render(Options& o, Raw& raw) {
       ("quiet,q", po::bool_switch(&o.quiet), "no progress bar and no report");
   return d;
 }
+// clang-format on
 
 // One option a line, as Boost's examples lay them out.
 // clang-format off
@@ -75,19 +71,11 @@ po::options_description describe_machine(Options& o, Raw& raw) {
        "is built on as many")
       ("cache-pages", po::value(&raw.cache_pages),
        "remote pages cached per node (default: 1/8 of the database, at least 64 pages)")
-      ("cache-kb", po::value(&raw.cache_kb), "the cache per node in KB instead of pages")
-      ("grain", po::value(&raw.grain)->default_value(16),
-       "pixels per tile handed out (affinity: the smallest tile), a run of the pixel order")
-      ("schedule", po::value(&raw.schedule)->default_value("affinity"),
-       "affinity (dynamic, each processor working through its own region first), dynamic (pixels in frame "
-       "order to whoever asks, as in the paper), or static (fixed shares)")
-      ("pixel-order", po::value(&raw.pixel_order)->default_value("hilbert"),
-       "how pixels are numbered, so where a tile or a share lies: hilbert (along a Hilbert curve: compact "
-       "patches whose rays share pages) or scanline (rows, as in the paper)")
+      ("cache-kb", po::value(&raw.cache_kb), "the cache per node in KB instead of pages");
+  add_farming_options(d, raw.shared);
+  d.add_options()
       ("workers-per-node", po::value(&raw.workers)->default_value(1),
        "pixel computers per processor")
-      ("prefetch", po::value(&raw.prefetch)->default_value(1),
-       "tiles a pixel computer keeps asked for beyond the one it traces, 0..3 (0: ask when idle, as in the paper)")
       ("distribution", po::value(&raw.distribution)->default_value("modulo"),
        "page p on node p mod N (modulo), or consecutive runs of pages (block)")
       ("trace-routes", po::value(&raw.trace_routes)->default_value(0),
@@ -107,10 +95,11 @@ po::options_description describe_machine(Options& o, Raw& raw) {
 
 // Width, height and tessellation are 0 (the scene's own) only when not given.
 void check_render(Options& o, const Raw& raw, const po::variables_map& vm) {
-  o.accel = parse_accel(raw.accel);
-  o.bvh_layout = parse_bvh_layout(raw.bvh_layout);
-  o.shadow_rays_all = parse_shadow_rays(raw.shadow_rays);
-  o.page_size = checked_page_size(raw.page_size);
+  const DatabaseChoice database = parse_database(raw.shared);
+  o.accel = database.accel;
+  o.bvh_layout = database.bvh_layout;
+  o.shadow_rays_all = database.shadow_rays_all;
+  o.page_size = database.page_size;
   o.max_depth = in_range<int>(raw.max_depth, 1, 64, "--max-depth");
   if (vm.count("width")) o.width = in_range<int>(raw.width, 1, 16384, "--width");
   if (vm.count("height")) o.height = in_range<int>(raw.height, 1, 16384, "--height");
@@ -131,18 +120,13 @@ void check_topology(nodes::MachineOptions& m, const Raw& raw, const po::variable
   if (m.nodes) check_grid_shape(m.topology, *m.nodes);
 }
 
+// The cache's rules (one of the two, at least a page) are the machine's,
+// checked with the others in check_machine.
 void check_cache(Options& o, const Raw& raw, const po::variables_map& vm) {
   nodes::MachineOptions& m = o.machine;
-  if (vm.count("cache-pages") && vm.count("cache-kb"))
-    throw UsageError("--cache-pages and --cache-kb: give one of them, not both");
   if (vm.count("cache-pages"))
     m.cache_pages = in_range<std::uint32_t>(raw.cache_pages, 1, UINT32_MAX, "--cache-pages");
-  if (vm.count("cache-kb")) {
-    m.cache_kb = in_range<std::uint64_t>(raw.cache_kb, 1, std::int64_t(1) << 40, "--cache-kb");
-    if (*m.cache_kb * 1024 < o.page_size)
-      throw UsageError("--cache-kb: " + std::to_string(*m.cache_kb) + " KB is less than one page (" +
-                       std::to_string(o.page_size) + " bytes)");
-  }
+  if (vm.count("cache-kb")) m.cache_kb = in_range<std::uint64_t>(raw.cache_kb, 1, std::int64_t(1) << 40, "--cache-kb");
 }
 
 void check_machine(Options& o, const Raw& raw, const po::variables_map& vm) {
@@ -150,26 +134,32 @@ void check_machine(Options& o, const Raw& raw, const po::variables_map& vm) {
   check_topology(m, raw, vm);
   check_cache(o, raw, vm);
   m.threads = in_range<unsigned>(raw.threads, 0, 4096, "--threads");
-  m.grain = in_range<std::uint32_t>(raw.grain, 1, 1 << 20, "--grain");
+  const FarmingChoice farming = parse_farming(raw.shared, vm);
+  m.grain = farming.grain;
+  m.prefetch = farming.prefetch;
+  m.schedule = farming.schedule;
+  m.pixel_order = farming.pixel_order;
   m.workers_per_node = in_range<int>(raw.workers, 1, 64, "--workers-per-node");
-  m.prefetch = in_range<std::uint16_t>(raw.prefetch, 0, nodes::max_prefetch(m), "--prefetch");
   m.trace_routes = in_range<std::uint64_t>(raw.trace_routes, 0, 1 << 20, "--trace-routes");
   if (vm.count("trace-kind")) {
     if (m.trace_routes == 0) throw UsageError("--trace-kind: chooses the packets --trace-routes N traces; give that too");
     m.trace_kinds = parse_trace_kinds(raw.trace_kind);
   }
-  m.schedule = parse_schedule(raw.schedule);
-  m.pixel_order = parse_pixel_order(raw.pixel_order);
   if (raw.distribution == "modulo") m.distribution = nodes::Distribution::modulo;
   else if (raw.distribution == "block") m.distribution = nodes::Distribution::block;
   else throw UsageError("--distribution: expected modulo or block, got '" + raw.distribution + "'");
   m.timing = timing_from(raw.timing);
   // Options that would change nothing here are errors, as with --single.
-  check_grain(m.schedule, !vm["grain"].defaulted());
   if (m.timing && o.compare_serial)
     throw UsageError("--compare-serial: a virtual-time run always reports speedup against the 1-node machine");
   // The tile CSV, the timeline and the report (which shows the timeline) need the tiles.
   m.record_tiles = !o.tiles_csv.empty() || !o.pictures.timeline_svg.empty() || !o.pictures.report_html.empty();
+  // The machine's own rules, now rather than after the scene is read.
+  try {
+    nodes::check_options(m, o.page_size);
+  } catch (const nodes::OptionError& e) {
+    throw usage_error(e);
+  }
 }
 
 // --single renders in this process: an option of the machine but --threads,
@@ -215,6 +205,53 @@ void check_output_names(const Options& o, const po::variables_map& vm) {
 }
 
 }  // namespace
+
+// The sweep describes these too, with its own defaults (the choice's values).
+// clang-format off
+void add_database_options(po::options_description& d, SharedChoice& c) {
+  d.add_options()
+      ("accel", po::value(&c.accel)->default_value(c.accel), "acceleration structure: bvh or grid")
+      ("bvh-layout", po::value(&c.bvh_layout)->default_value(c.bvh_layout),
+       "how BVH nodes fill pages: treelet (each page a piece of the tree a ray goes down, so fewer pages "
+       "per pixel) or depth-first (siblings together)")
+      ("shadow-rays", po::value(&c.shadow_rays)->default_value(c.shadow_rays),
+       "facing: a shadow ray only to lights in front of the surface (SPD); all: one to every "
+       "light at every hit, as VM_pRAY counted them (same image, more rays)")
+      ("page-size", po::value(&c.page_size)->default_value(c.page_size),
+       "database page size in bytes, a power of two from 256 to 65536");
+}
+
+void add_farming_options(po::options_description& d, SharedChoice& c) {
+  d.add_options()
+      ("grain", po::value(&c.grain)->default_value(c.grain),
+       "pixels per tile handed out (affinity: the smallest tile), a run of the pixel order")
+      ("schedule", po::value(&c.schedule)->default_value(c.schedule),
+       "affinity (dynamic, each processor working through its own region first), dynamic (pixels in frame "
+       "order to whoever asks, as in the paper), or static (fixed shares)")
+      ("pixel-order", po::value(&c.pixel_order)->default_value(c.pixel_order),
+       "how pixels are numbered, so where a tile or a share lies: hilbert (along a Hilbert curve: compact "
+       "patches whose rays share pages) or scanline (rows, as in the paper)")
+      ("prefetch", po::value(&c.prefetch)->default_value(c.prefetch),
+       "tiles a pixel computer keeps asked for beyond the one it traces, 0..3 (0: ask when idle, as in the paper)");
+}
+// clang-format on
+
+DatabaseChoice parse_database(const SharedChoice& c) {
+  return {.accel = parse_accel(c.accel),
+          .bvh_layout = parse_bvh_layout(c.bvh_layout),
+          .shadow_rays_all = parse_shadow_rays(c.shadow_rays),
+          .page_size = checked_page_size(c.page_size)};
+}
+
+FarmingChoice parse_farming(const SharedChoice& c, const po::variables_map& vm) {
+  FarmingChoice f;
+  f.grain = in_range<std::uint32_t>(c.grain, 1, 1 << 20, "--grain");
+  f.prefetch = in_range<std::uint16_t>(c.prefetch, 0, nodes::max_prefetch(nodes::MachineOptions{}), "--prefetch");
+  f.schedule = parse_schedule(c.schedule);
+  f.pixel_order = parse_pixel_order(c.pixel_order);
+  check_grain(f.schedule, vm.count("grain") && !vm["grain"].defaulted());
+  return f;
+}
 
 std::uint32_t checked_page_size(std::int64_t bytes) {
   try {

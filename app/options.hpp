@@ -4,6 +4,8 @@
 // cache of at least one page (as far as that can be told without the scene).
 #pragma once
 
+#include <boost/program_options/options_description.hpp>
+#include <boost/program_options/variables_map.hpp>
 #include <cstdint>
 #include <stdexcept>
 #include <string>
@@ -45,6 +47,38 @@ struct Options {
   PicturePaths pictures;  // written after a machine render (timing_options.hpp)
   std::string tiles_csv;  // the machine's tile timeline (machine_report.hpp), none when empty
 };
+
+// ---- Options a render and a sweep share ----
+// Both commands describe them with add_database_options and
+// add_farming_options and parse them with parse_database and parse_farming;
+// each starts from its own defaults (these are the render's).
+struct SharedChoice {
+  std::string accel = "bvh", bvh_layout = "treelet", shadow_rays = "facing";
+  std::int64_t page_size = 1024;
+  std::int64_t grain = 16, prefetch = 1;
+  std::string schedule = "affinity", pixel_order = "hilbert";
+};
+
+// How the database is built and traced: --accel, --bvh-layout, --shadow-rays, --page-size.
+struct DatabaseChoice {
+  tracer::Accel accel = tracer::Accel::bvh;
+  tracer::BvhLayout bvh_layout = tracer::BvhLayout::treelet;
+  bool shadow_rays_all = false;
+  std::uint32_t page_size = 1024;
+};
+void add_database_options(boost::program_options::options_description& d, SharedChoice& choice);
+DatabaseChoice parse_database(const SharedChoice& choice);
+
+// How the pixels are handed out: --grain, --schedule, --pixel-order, --prefetch.
+struct FarmingChoice {
+  std::uint32_t grain = 16;
+  std::uint16_t prefetch = 1;
+  nodes::Schedule schedule = nodes::Schedule::affinity;
+  nodes::PixelOrder pixel_order = nodes::PixelOrder::hilbert;
+};
+void add_farming_options(boost::program_options::options_description& d, SharedChoice& choice);
+// Also refuses a --grain given with the static schedule (check_grain).
+FarmingChoice parse_farming(const SharedChoice& choice, const boost::program_options::variables_map& vm);
 
 // v as a T when lo <= v <= hi; else UsageError "OPTION: expected lo..hi, got v".
 template <class T>

@@ -59,48 +59,54 @@ std::vector<std::string> split(const std::string& text) {
   return parts;
 }
 
+// The sweep's own options as typed, and those it shares with the render
+// (options.hpp, timing_options.hpp) with the sweep's defaults: the paper's
+// dynamic scanline farming of small tiles, asked for when idle.
 struct RawSweep {
-  std::string kind, topologies = "hypercube", nodes, cache, profile = "ipsc2", costs, out;
-  std::string accel = "bvh", bvh_layout = "treelet", shadow_rays = "facing";
-  std::string schedule = "dynamic", pixel_order = "scanline";
-  std::int64_t size = 64, page_size = 1024, grain = 4, prefetch = 0, jobs = 0;
+  std::string kind, topologies = "hypercube", nodes, cache, out;
+  std::int64_t size = 64, jobs = 0;
+  SharedChoice shared{.grain = 4, .prefetch = 0, .schedule = "dynamic", .pixel_order = "scanline"};
+  TimingChoice model;
 };
 
+// One option a line, as Boost's examples lay them out.
+// clang-format off
 po::options_description describe(SweepOptions& o, RawSweep& raw) {
   po::options_description d("Sweep options");
   d.add_options()
       ("help,h", "show this help and exit")
       ("scene", po::value(&o.scene), "scene: NFF file or built-in (teapot, mountain, rings4, ...)")
       ("size", po::value(&raw.size), "image width and height in pixels (default 64; the paper: 512)")
-      ("page-size", po::value(&raw.page_size), "database page size in bytes (default 1024)")
       ("topology", po::value(&raw.topologies), "topologies, comma-separated (default hypercube)")
       ("nodes", po::value(&raw.nodes), "processor counts, comma-separated (nodes: default 1,2,...,64; cache: 16)")
-      ("cache-pages", po::value(&raw.cache), "cache sizes in pages, comma-separated (cache: the axis)")
-      ("grain", po::value(&raw.grain), "pixels per work item (default 4)")
-      ("prefetch", po::value(&raw.prefetch), "tiles asked for ahead, 0..3 (default 0: ask when idle, as in the paper)")
-      ("schedule", po::value(&raw.schedule), "dynamic (default, as in the paper), static or affinity")
-      ("pixel-order", po::value(&raw.pixel_order), "scanline (default, as in the paper) or hilbert")
-      ("accel", po::value(&raw.accel), "acceleration structure: bvh (default) or grid")
-      ("bvh-layout", po::value(&raw.bvh_layout), "BVH nodes in pages: treelet (default) or depth-first")
-      ("shadow-rays", po::value(&raw.shadow_rays),
-       "facing (default): shadow rays only to lights in front of the surface; all: to every light")
-      ("profile", po::value(&raw.profile), "machine profile: ipsc2, native, or a key = value file")
-      ("cost", po::value(&raw.costs), "costs over the profile: box=..,prim=..,shade=..,page=..,serve=..,msg=..,hop=..,bw=..")
+      ("cache-pages", po::value(&raw.cache), "cache sizes in pages, comma-separated (cache: the axis)");
+  add_farming_options(d, raw.shared);
+  add_database_options(d, raw.shared);
+  add_model_options(d, raw.model);
+  d.add_options()
       ("fit-seconds", po::value(&o.fit_seconds), "fit the compute unit so the one-node run takes this long")
       ("out", po::value(&raw.out), "output directory (default sweep-KIND)")
       ("jobs,j", po::value(&raw.jobs), "runs side by side, each on a thread of its own, as many as fit in the memory (0, the default: one per core)")
       ("quiet,q", po::bool_switch(&o.quiet), "print nothing but errors");
   return d;
 }
+// clang-format on
 
 void check_sweep(SweepOptions& o, const RawSweep& raw, const po::variables_map& vm) {
   if (raw.kind == "nodes") o.kind = SweepOptions::Kind::nodes;
   else if (raw.kind == "cache") o.kind = SweepOptions::Kind::cache;
   else throw UsageError("expected 'nodes' or 'cache' after 'sweep', got '" + raw.kind + "'");
   o.size = in_range<int>(raw.size, 1, 4096, "--size");
-  o.page_size = checked_page_size(raw.page_size);
-  o.grain = in_range<std::uint32_t>(raw.grain, 1, 1 << 20, "--grain");
-  o.prefetch = in_range<std::uint16_t>(raw.prefetch, 0, nodes::max_prefetch(nodes::MachineOptions{}), "--prefetch");
+  const DatabaseChoice database = parse_database(raw.shared);
+  o.page_size = database.page_size;
+  o.accel = database.accel;
+  o.bvh_layout = database.bvh_layout;
+  o.trace.shadow_rays_to_all_lights = database.shadow_rays_all;
+  const FarmingChoice farming = parse_farming(raw.shared, vm);
+  o.grain = farming.grain;
+  o.prefetch = farming.prefetch;
+  o.schedule = farming.schedule;
+  o.pixel_order = farming.pixel_order;
   o.jobs = in_range<unsigned>(raw.jobs, 0, 1024, "--jobs");
   if (o.jobs == 0) o.jobs = usable_cpus();
   if (vm.count("fit-seconds") && !(o.fit_seconds > 0 && std::isfinite(o.fit_seconds)))
@@ -129,12 +135,6 @@ void check_sweep(SweepOptions& o, const RawSweep& raw, const po::variables_map& 
   o.out_dir = raw.out.empty() ? "sweep-" + raw.kind : raw.out;
   // Found out now rather than after the runs, when the tables are written.
   check_writable_directory("--out", o.out_dir);
-  o.accel = parse_accel(raw.accel);
-  o.bvh_layout = parse_bvh_layout(raw.bvh_layout);
-  o.schedule = parse_schedule(raw.schedule);
-  check_grain(o.schedule, vm.count("grain") > 0);
-  o.pixel_order = parse_pixel_order(raw.pixel_order);
-  o.trace.shadow_rays_to_all_lights = parse_shadow_rays(raw.shadow_rays);
 }
 
 tracer::Database load_database(const SweepOptions& o) {
@@ -172,7 +172,7 @@ SweepOptions parse_sweep_options(int argc, const char* const argv[]) {
   }
   if (vm.count("help")) throw UsageError("help");
   check_sweep(o, raw, vm);
-  o.model = cost_model_from(raw.profile, raw.costs);
+  o.model = cost_model_from(raw.model.profile, raw.model.costs);
   return o;
 }
 

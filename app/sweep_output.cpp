@@ -10,6 +10,7 @@
 #include <stdexcept>
 #include <system_error>
 
+#include "app/machine_run.hpp"
 #include "app/options.hpp"
 #include "app/output_files.hpp"
 #include "app/paper_figures.hpp"
@@ -293,6 +294,9 @@ int sweep_main(int argc, const char* const argv[]) {
   } catch (const UsageError& e) {  // found in the run: a machine too large for the memory
     std::cerr << "vmpray sweep: " << e.what() << "\n";
     return 2;
+  } catch (const nodes::ResourceError& e) {  // each point runs on a thread of its own
+    std::cerr << "vmpray sweep: " << with_hint(e, "--jobs, " + std::to_string(options.jobs) + " here") << "\n";
+    return 1;
   } catch (const std::exception& e) {
     std::cerr << "vmpray sweep: " << e.what() << "\n";
     return 1;

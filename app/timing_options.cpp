@@ -11,15 +11,21 @@ namespace po = boost::program_options;
 
 // One option a line, as Boost's examples lay them out.
 // clang-format off
+void add_model_options(po::options_description& d, TimingChoice& timing) {
+  d.add_options()
+      ("profile", po::value(&timing.profile)->default_value("ipsc2"),
+       "machine model for virtual time: ipsc2, native (calibrated here), or a 'key = value' file")
+      ("cost", po::value(&timing.costs),
+       "costs over the profile: box=,prim=,shade=,page=,serve=,msg=,hop= (s, ms, us, ns), bw= (B/s, KB/s, MB/s; 0: unlimited)");
+}
+
 void add_timing_options(po::options_description& d, TimingChoice& timing, PicturePaths& pictures) {
   d.add_options()
       ("timing", po::value(&timing.timing)->default_value("real"),
        "real (wall time) or virtual: the time a real machine would take under --profile "
-       "(deterministic; the machine runs on one thread)")
-      ("profile", po::value(&timing.profile)->default_value("ipsc2"),
-       "machine model for virtual time: ipsc2, native (calibrated here), or a 'key = value' file")
-      ("cost", po::value(&timing.costs),
-       "costs over the profile: box=,prim=,shade=,page=,serve=,msg=,hop= (s, ms, us, ns), bw= (B/s, KB/s, MB/s; 0: unlimited)")
+       "(deterministic; the machine runs on one thread)");
+  add_model_options(d, timing);
+  d.add_options()
       ("machine-svg", po::value(&pictures.machine_svg), "after a machine render: the machine with its traffic, SVG")
       ("ownership", po::value(&pictures.ownership_png), "after a machine render: which node computed each pixel, PNG")
       ("timeline", po::value(&pictures.timeline_svg),

@@ -1,7 +1,7 @@
 // The command-line face of virtual time and of the pictures of a machine run:
 // --timing real|virtual, --profile NAME|FILE, --cost key=value,...,
 // --machine-svg, --ownership, --timeline, --report. Kept apart from options.cpp so the
-// sweep subcommand parses machine models the same way.
+// sweep subcommand describes and parses machine models the same way.
 #pragma once
 
 #include <optional>
@@ -27,8 +27,11 @@ struct PicturePaths {
   std::string timeline_svg;   // when each processor traced each tile
 };
 
+// --timing, --profile, --cost and the pictures, for a render.
 void add_timing_options(boost::program_options::options_description& d, TimingChoice& timing,
                         PicturePaths& pictures);
+// --profile and --cost alone, for the sweep (always in virtual time).
+void add_model_options(boost::program_options::options_description& d, TimingChoice& timing);
 
 // The model of --profile and --cost; UsageError naming the option (or
 // FILE:LINE for a profile file) when either is bad.

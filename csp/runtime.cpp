@@ -29,7 +29,6 @@ struct Failure {
   std::exception_ptr error;
 };
 
-
 // One failure: rethrown as is; several: ProcessesFailed naming the first
 // few and counting the rest.
 [[noreturn]] void rethrow_failures(const std::vector<Failure>& failures) {
@@ -54,21 +53,41 @@ struct Failure {
   throw ProcessesFailed(text, out_of_memory);
 }
 
+// The failures of a group of processes (a Runtime's, or a PAR's children),
+// in the order they ended; the first is the one reported. Its owner guards
+// it with its own lock. note() runs where an exception would end the
+// program (a fiber's end, a runtime thread's loop): with no memory left to
+// record a failure, it counts it as lost instead.
+class Failures {
+ public:
+  void note(const std::string& process, std::exception_ptr error) noexcept {
+    try {
+      recorded_.push_back({process, std::move(error)});
+    } catch (...) {
+      ++lost_;
+    }
+  }
+  bool any() const { return !recorded_.empty() || lost_ > 0; }
+  const std::vector<Failure>& recorded() const { return recorded_; }
+  std::size_t lost() const { return lost_; }
+
+  // After the group has ended: the recorded failures as rethrow_failures
+  // reports them; if none was recorded but `lost` were (this list's, plus
+  // any the caller adds), ProcessesFailed "N" + why_lost, out of memory.
+  void rethrow_if_failed(const std::string& why_lost, std::size_t also_lost = 0) const {
+    if (!recorded_.empty()) rethrow_failures(recorded_);
+    if (const std::size_t lost = lost_ + also_lost; lost > 0)
+      throw ProcessesFailed(std::to_string(lost) + why_lost, true);
+  }
+
+ private:
+  std::vector<Failure> recorded_;
+  std::size_t lost_ = 0;
+};
+
 // What ProcessNotStarted says of one process.
 std::string could_not_start(const std::string& process, const std::exception_ptr& error) {
   return "process '" + process + "' could not start: " + message_of(error);
-}
-
-// Appends a failure; with no memory left to hold it, counts it instead: the
-// callers run where an exception would end the program (a fiber's end, a
-// runtime thread's loop).
-void note_failure(std::vector<Failure>& list, std::size_t& lost, const std::string& process,
-                  std::exception_ptr error) noexcept {
-  try {
-    list.push_back({process, std::move(error)});
-  } catch (...) {
-    ++lost;
-  }
 }
 
 enum class Ending { normal, poisoned, deadlock, failed };
@@ -202,7 +221,6 @@ struct Worker {
 
 }  // namespace detail
 
-using detail::Failure;
 using detail::Process;
 using detail::seconds_of;
 using detail::Spawn;
@@ -262,10 +280,8 @@ struct Runtime::Impl {
   std::vector<ThreadTimes> times;
   detail::Tracker tracker;
   std::mutex failures_mutex;
-  std::vector<Failure> failures;     // guarded by failures_mutex
-  std::vector<Failure> unstarted;    // guarded by failures_mutex
-  std::size_t lost_failures = 0;     // guarded by failures_mutex: failed, no memory to say why
-  std::size_t lost_unstarted = 0;    // guarded by failures_mutex
+  detail::Failures failures;   // guarded by failures_mutex: processes that threw
+  detail::Failures unstarted;  // guarded by failures_mutex: processes that could not start
   bool started = false;
   bool finished = false;  // every thread has exited: nothing can start any more
 };
@@ -363,7 +379,7 @@ void Runtime::Impl::launch_all(std::vector<Spawn>& batch, std::vector<boost::fib
 void Runtime::Impl::not_started(Process& p, std::exception_ptr error) {
   {
     std::lock_guard<std::mutex> lk(failures_mutex);
-    detail::note_failure(unstarted, lost_unstarted, p.name, std::move(error));
+    unstarted.note(p.name, std::move(error));
   }
   tracker.remove(p);
 }
@@ -380,7 +396,7 @@ void Runtime::Impl::run_process(Process& p, const std::function<void()>& body) {
   if (detail::run_body(body, error) == detail::Ending::failed) {
     {
       std::lock_guard<std::mutex> lk(failures_mutex);
-      detail::note_failure(failures, lost_failures, p.name, error);
+      failures.note(p.name, error);
     }
     if (options.on_failure) try {
         options.on_failure(p.name, error);
@@ -441,23 +457,20 @@ void Runtime::run() {
   for (std::thread& t : threads) t.join();
   impl_->finished = true;
 
-  if (impl_->lost_unstarted > 0 && impl_->unstarted.empty())
-    throw ProcessNotStarted(std::to_string(impl_->lost_unstarted) +
-                            " processes could not start, and no memory was left to record which");
-  if (!impl_->unstarted.empty()) {
-    const auto& first = impl_->unstarted.front();
-    const std::size_t more = impl_->unstarted.size() - 1 + impl_->lost_unstarted;
+  // A process that could not start is the cause of what followed.
+  const detail::Failures& unstarted = impl_->unstarted;
+  if (!unstarted.recorded().empty()) {
+    const auto& first = unstarted.recorded().front();
+    const std::size_t more = unstarted.recorded().size() - 1 + unstarted.lost();
     std::string text = detail::could_not_start(first.process, first.error);
     if (more > 0) text += " (and " + std::to_string(more) + " more processes)";
     throw ProcessNotStarted(text);
   }
-  if (impl_->lost_failures > 0 && impl_->failures.empty())
-    throw ProcessesFailed(std::to_string(impl_->lost_failures) +
-                              " processes failed, and no memory was left to record why",
-                          true);
-
+  if (unstarted.any())
+    throw ProcessNotStarted(std::to_string(unstarted.lost()) +
+                            " processes could not start, and no memory was left to record which");
   // Processes left waiting on one that failed deadlock: the failure is the cause.
-  if (!impl_->failures.empty()) detail::rethrow_failures(impl_->failures);
+  impl_->failures.rethrow_if_failed(" processes failed, and no memory was left to record why");
   if (impl_->tracker.aborting()) throw Deadlock(impl_->tracker.deadlock_dump());
 }
 
@@ -466,9 +479,8 @@ struct ParGroup {
   detail::Spinlock lock;
   std::size_t remaining = 0;
   detail::Waiter* parent = nullptr;  // the parent, while parked until remaining == 0
-  std::vector<Failure> failures;     // in the order the children ended
-  std::vector<Failure> poisons;
-  std::size_t lost = 0;              // failed, and no memory was left to record why
+  detail::Failures failures;         // children that threw
+  detail::Failures poisons;          // children ended by poison: the first is rethrown if nothing else failed
   bool deadlock = false;
 };
 
@@ -481,8 +493,8 @@ void run_child(ParGroup& g, Process& child, const std::function<void()>& body) {
   detail::bind_fiber(nullptr);
   {
     detail::ChannelLock lk(g.lock);
-    if (e == detail::Ending::failed) detail::note_failure(g.failures, g.lost, child.name, error);
-    if (e == detail::Ending::poisoned) detail::note_failure(g.poisons, g.lost, child.name, error);
+    if (e == detail::Ending::failed) g.failures.note(child.name, error);
+    if (e == detail::Ending::poisoned) g.poisons.note(child.name, error);
     g.deadlock |= e == detail::Ending::deadlock;
     // Wake the parent before ending, so it is never counted blocked alone.
     if (--g.remaining == 0 && g.parent && detail::try_claim(*g.parent)) {
@@ -555,11 +567,9 @@ void par(std::vector<std::function<void()>> processes) {
   if (not_started)  // the cause of any deadlock below
     throw ProcessNotStarted(detail::could_not_start(child_name(*parent, not_started_child), not_started));
   if (g.deadlock) detail::unwind_deadlock();
-  if (!g.failures.empty()) detail::rethrow_failures(g.failures);
-  if (g.lost > 0)
-    throw ProcessesFailed(std::to_string(g.lost) + " processes of a PAR failed, and no memory was left to record why",
-                          true);
-  if (!g.poisons.empty()) std::rethrow_exception(g.poisons.front().error);
+  // A poison lost for want of memory counts as a failure, as out of memory.
+  g.failures.rethrow_if_failed(" processes of a PAR failed, and no memory was left to record why", g.poisons.lost());
+  if (!g.poisons.recorded().empty()) std::rethrow_exception(g.poisons.recorded().front().error);
 }
 
 void sleep_for(std::chrono::steady_clock::duration d) { boost::this_fiber::sleep_for(d); }

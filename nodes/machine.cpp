@@ -1,5 +1,9 @@
-// The VM_pRAY machine: distribution of the pages, wiring of every process on
-// the network, and the report (see machine.hpp for the protocol).
+// The VM_pRAY machine (see machine.hpp for the protocol). A run is three
+// steps, each a few functions below: build (the pages moved to their owners,
+// the runtime, the network and every process on it), run (the runtime to its
+// end, and what ended it in the machine's terms: ResourceError, RankFailure)
+// and report (the figures, from the state the processes leave). The options
+// are checked once, before the first step (check_options).
 #include "nodes/machine.hpp"
 
 #include <algorithm>
@@ -20,11 +24,6 @@
 namespace nodes {
 
 namespace {
-
-// The hint that ends an error of a machine the memory could not hold.
-std::string needs_more_memory(std::size_t nodes) {
-  return "a machine of " + std::to_string(nodes) + " nodes needs more memory than this process may map (see ulimit -v)";
-}
 
 // Everything one processor holds during a run; addresses stay stable while
 // its processes refer to them.
@@ -54,14 +53,19 @@ std::unique_ptr<NodeState> node_state(const PagePlacement& placement, int n, std
   return state;
 }
 
-void validate(const MachineOptions& options) {
-  if (options.workers_per_node < 1) throw std::invalid_argument("workers_per_node must be at least 1");
-  if (options.grain < 1) throw std::invalid_argument("grain must be at least 1");
-  if (options.buffer_capacity < 1) throw std::invalid_argument("network buffer capacity must be at least 1");
+// The rules of the fields that need no database.
+void check_fields(const MachineOptions& options) {
+  const auto at_least_one = [](const char* field, std::uint64_t value) {
+    if (value < 1) throw OptionError(field, "must be at least 1, got " + std::to_string(value));
+  };
+  at_least_one("workers_per_node", static_cast<std::uint64_t>(std::max(options.workers_per_node, 0)));
+  at_least_one("grain", options.grain);
+  at_least_one("buffer_capacity", options.buffer_capacity);
   if (options.prefetch > max_prefetch(options))
-    throw std::invalid_argument("prefetch must be at most " + std::to_string(max_prefetch(options)) +
-                                " (a worker's answers and a page reply must fit the network buffer of " +
-                                std::to_string(options.buffer_capacity) + " packets)");
+    throw OptionError("prefetch", "must be at most " + std::to_string(max_prefetch(options)) + ", got " +
+                                      std::to_string(options.prefetch) +
+                                      " (a worker's answers and a page reply must fit the network buffer of " +
+                                      std::to_string(options.buffer_capacity) + " packets)");
 }
 
 unsigned thread_count(const MachineOptions& options, std::size_t nodes) {
@@ -228,21 +232,33 @@ std::uint32_t default_cache_pages(const tracer::DatabaseHeader& header) {
   return std::max({std::uint32_t{1}, header.page_count / share, std::min(header.page_count, floor_pages)});
 }
 
-std::uint32_t cache_pages_for(const MachineOptions& options, const tracer::DatabaseHeader& header) {
+namespace {
+
+// The cache asked for, in pages of page_size bytes; none when neither field is set.
+std::optional<std::uint32_t> asked_cache_pages(const MachineOptions& options, std::uint32_t page_size) {
   if (options.cache_pages && options.cache_kb)
-    throw std::invalid_argument("cache_pages and cache_kb both set: give one of them");
+    throw OptionError("cache_kb", "given with the cache in pages: give one of them, not both");
   if (options.cache_pages) {
-    if (*options.cache_pages == 0) throw std::invalid_argument("cache_pages must be at least 1");
+    if (*options.cache_pages == 0) throw OptionError("cache_pages", "must be at least 1, got 0");
     return *options.cache_pages;
   }
-  if (options.cache_kb) {
-    const std::uint64_t pages = *options.cache_kb * 1024 / header.page_size;
-    if (pages == 0)
-      throw std::invalid_argument("cache_kb " + std::to_string(*options.cache_kb) + " is less than one page (" +
-                                  std::to_string(header.page_size) + " bytes)");
-    return static_cast<std::uint32_t>(std::min<std::uint64_t>(pages, UINT32_MAX));
-  }
-  return default_cache_pages(header);
+  if (!options.cache_kb) return std::nullopt;
+  const std::uint64_t pages = *options.cache_kb * 1024 / page_size;
+  if (pages == 0)
+    throw OptionError("cache_kb", std::to_string(*options.cache_kb) + " KB is less than one page (" +
+                                      std::to_string(page_size) + " bytes)");
+  return static_cast<std::uint32_t>(std::min<std::uint64_t>(pages, UINT32_MAX));
+}
+
+}  // namespace
+
+void check_options(const MachineOptions& options, std::uint32_t page_size) {
+  check_fields(options);
+  asked_cache_pages(options, page_size);
+}
+
+std::uint32_t cache_pages_for(const MachineOptions& options, const tracer::DatabaseHeader& header) {
+  return asked_cache_pages(options, header.page_size).value_or(default_cache_pages(header));
 }
 
 namespace {
@@ -264,130 +280,155 @@ struct SplitState {
   BridgeCounters bridge;
 };
 
-
 double cpu_seconds() {
   rusage use{};
   getrusage(RUSAGE_SELF, &use);
-  const auto seconds = [](const timeval& t) { return static_cast<double>(t.tv_sec) + 1e-6 * static_cast<double>(t.tv_usec); };
+  const auto seconds = [](const timeval& t) {
+    return static_cast<double>(t.tv_sec) + 1e-6 * static_cast<double>(t.tv_usec);
+  };
   return seconds(use.ru_utime) + seconds(use.ru_stime);
 }
 
-// Runs the runtime, turning what ended it into one line with its hint.
-void run_runtime(csp::Runtime& runtime, std::size_t nodes, SplitState* split, int rank) {
+// ---- Build: the runtime, the network and every process on them ----
+
+// The runtime of this process's nodes. In a split run a process that fails
+// leaves others waiting on it, and the bridge polling the wire keeps the
+// runtime from calling that a deadlock: the failure is noted for the other
+// ranks and the network shut down (once it exists), so the bridge tells
+// them and ends.
+csp::RuntimeOptions runtime_options(const MachineOptions& options, std::size_t local_nodes, const MachineTiming* timing,
+                                    SplitState* split, int rank, Network* const& network) {
+  csp::RuntimeOptions r;
+  r.threads = thread_count(options, local_nodes);
+  r.shared_cores = options.shared_cores;
+  if (timing) r = timing->runtime_options(r.stack_size);
+  if (split)
+    r.on_failure = [split, &network, rank](const std::string& process, std::exception_ptr error) {
+      split->local_failure.set(rank, "process '" + process + "' failed: " + csp::message_of(error));
+      if (network) network->shutdown();
+    };
+  return r;
+}
+
+NetworkOptions network_options(const MachineOptions& options, const MachineTiming* timing, const Share& share,
+                               std::size_t local_nodes, unsigned threads) {
+  NetworkOptions net;
+  net.buffer_capacity = options.buffer_capacity;
+  net.ports_per_node = Ports::count(options.workers_per_node);
+  net.trace_routes = options.trace_routes;
+  net.trace_kinds = options.trace_kinds;
+  if (timing) net.link = timing->model().link_model();
+  net.relay_between_threads = options.relay_between_threads && !timing;
+  if (share.plan) {
+    net.local = [share](NodeId n) { return share.runs(n); };
+    net.placement = [first = share.first_node(), local_nodes, threads](NodeId n) {
+      return Network::block_placement(n - first, local_nodes, threads);
+    };
+  }
+  return net;
+}
+
+// What the farmer hands out: every pixel, or with the SPD procedure every
+// pixel corner, numbered in the pixel order. grid.positions points into
+// positions, so an Items stays where it was made.
+struct Items {
+  std::vector<std::uint32_t> positions;
+  ItemGrid grid;
+  std::uint32_t count = 0;
+
+  Items(const tracer::DatabaseHeader& header, const MachineOptions& options) {
+    const bool corners = options.trace.spd_procedure;
+    const int rows = header.camera.height + (corners ? 1 : 0);
+    grid = {header.camera.width + (corners ? 1 : 0), corners, {}};
+    positions = item_positions(grid.width, rows, options.pixel_order);
+    grid.positions = positions;
+    count = static_cast<std::uint32_t>(grid.width) * static_cast<std::uint32_t>(rows);
+  }
+  Items(const Items&) = delete;
+  Items& operator=(const Items&) = delete;
+};
+
+// Spawns the processes of every node this process runs, node 0's farmer and
+// collector if it runs node 0, and a split run's bridge.
+void spawn_machine(const Wiring& wiring, std::vector<std::unique_ptr<NodeState>>& nodes, const Items& items,
+                   const Share& share, SplitState* split, Host& host, std::unique_ptr<Bridge>& bridge) {
+  for (std::size_t n = 0; n < nodes.size(); ++n)
+    if (nodes[n]) spawn_node(wiring, static_cast<NodeId>(n), *nodes[n]);
+  if (share.runs(0)) {
+    const MachineOptions& options = wiring.options;
+    host.plan = std::make_unique<WorkPlan>(items.count, options.grain, options.schedule,
+                                           static_cast<int>(wiring.net.topology().size()), options.workers_per_node);
+    host.frame = std::make_unique<FrameAssembler>(items.count, items.grid.positions);
+    host.owners.assign(items.count, 0);
+    spawn_host(wiring, host);
+  }
+  if (share.plan) {
+    bridge = std::make_unique<Bridge>(*share.transport, *share.plan, wiring.net, split->local_failure,
+                                      split->remote_failure, split->bridge);
+    wiring.runtime.spawn("bridge", wiring.net.thread_of(share.first_node()), [&bridge] { bridge->run(); });
+  }
+}
+
+// ---- Run: the runtime to its end, its failures in the machine's terms ----
+
+// Runs the runtime. What the system would not give becomes a ResourceError
+// sized by the machine; in a split run every failure becomes a RankFailure,
+// this rank's own first (what else ended here followed from it).
+void run_and_translate(csp::Runtime& runtime, std::size_t nodes, SplitState* split, int rank) {
+  using Resource = ResourceError::Resource;
+  const auto shortage = [&](const std::string& line, Resource resource) {
+    return ResourceError(line, resource, nodes, runtime.threads());
+  };
   try {
     try {
       runtime.run();
     } catch (const csp::ThreadNotStarted& e) {
-      throw csp::ThreadNotStarted(std::string(e.what()) + "; try fewer threads (" + std::to_string(runtime.threads()) +
-                                  " here), or see ulimit -v and ulimit -u");
+      throw shortage(e.what(), Resource::thread);
     } catch (const csp::ProcessNotStarted& e) {
-      throw csp::ProcessNotStarted(std::string(e.what()) + "; " + needs_more_memory(nodes));
+      throw shortage(e.what(), Resource::memory);
     } catch (const std::bad_alloc&) {
-      throw std::runtime_error("a process of the machine ran out of memory; " + needs_more_memory(nodes));
+      throw shortage("a process of the machine ran out of memory", Resource::memory);
     } catch (const csp::ProcessesFailed& e) {
       if (!e.out_of_memory()) throw;
-      throw csp::ProcessesFailed(std::string(e.what()) + "; " + needs_more_memory(nodes), true);
+      throw shortage(e.what(), Resource::memory);
     }
   } catch (const std::exception& e) {
     if (split == nullptr) throw;
-    // This rank's own failure goes first; what else ended here followed from it.
     if (const auto local = split->local_failure.get()) throw RankFailure(local->first, local->second);
     if (const auto remote = split->remote_failure.get()) throw RankFailure(remote->first, remote->second);
+    if (const auto* resource = dynamic_cast<const ResourceError*>(&e)) throw RankFailure(rank, *resource);
     throw RankFailure(rank, e.what());
   }
   if (split == nullptr) return;
   if (const auto remote = split->remote_failure.get()) throw RankFailure(remote->first, remote->second);
 }
 
+// ---- Report: what the run did, from the state it leaves ----
+
 struct Executed {
   MachineResult result;
   std::vector<RouterCounters> routers;  // split runs only: index = node, zero for other ranks' nodes
 };
 
-// The run of this process's share of the machine. nodes[n] is null for the
-// nodes another process runs; the result's per_node entries for those stay
-// empty and its image is empty unless this process runs node 0.
-Executed execute(const tracer::DatabaseHeader& header, const topology::Topology& topology,
-                      const PagePlacement& placement, std::uint32_t cache_pages,
-                      std::vector<std::unique_ptr<NodeState>>& nodes, const MachineOptions& options,
-                      const Share& share) {
-  const auto started = std::chrono::steady_clock::now();
-  const double cpu_started = cpu_seconds();
-  std::optional<MachineTiming> timing;
-  if (options.timing) timing.emplace(*options.timing, static_cast<int>(topology.size()));
-  const std::size_t local_nodes = share.node_count(topology.size());
-  csp::RuntimeOptions runtime_options;
-  runtime_options.threads = thread_count(options, local_nodes);
-  runtime_options.shared_cores = options.shared_cores;
-  if (timing) runtime_options = timing->runtime_options(runtime_options.stack_size);
-  std::optional<SplitState> split;
-  Network* network = nullptr;
-  if (share.plan) {
-    split.emplace();
-    // A process that fails leaves others waiting on it, and the bridge
-    // polling the wire keeps the runtime from calling that a deadlock: shut
-    // the network down, so the bridge tells the other ranks and ends.
-    runtime_options.on_failure = [&split, &network, rank = share.rank](const std::string& process,
-                                                                        std::exception_ptr error) {
-      split->local_failure.set(rank, "process '" + process + "' failed: " + csp::message_of(error));
-      if (network) network->shutdown();
-    };
-  }
-  csp::Runtime runtime(std::move(runtime_options));
-  NetworkOptions net_options;
-  net_options.buffer_capacity = options.buffer_capacity;
-  net_options.ports_per_node = Ports::count(options.workers_per_node);
-  net_options.trace_routes = options.trace_routes;
-  net_options.trace_kinds = options.trace_kinds;
-  if (timing) net_options.link = timing->model().link_model();
-  net_options.relay_between_threads = options.relay_between_threads && !timing;
-  if (share.plan) {
-    net_options.local = [share](NodeId n) { return share.runs(n); };
-    net_options.placement = [first = share.first_node(), local_nodes, threads = runtime.threads()](NodeId n) {
-      return Network::block_placement(n - first, local_nodes, threads);
-    };
-  }
-  Network net(runtime, topology, net_options);
-  network = &net;
-
-  const bool corners = options.trace.spd_procedure;
-  const int rows = header.camera.height + (corners ? 1 : 0);
-  ItemGrid grid{header.camera.width + (corners ? 1 : 0), corners, {}};
-  const std::vector<std::uint32_t> positions = item_positions(grid.width, rows, options.pixel_order);
-  grid.positions = positions;
-  const auto items = static_cast<std::uint32_t>(grid.width) * static_cast<std::uint32_t>(rows);
-  const Wiring wiring{runtime,
-                      net,
-                      placement,
-                      header,
-                      options,
-                      grid,
-                      topology.size() * net_options.ports_per_node,
-                      timing ? &*timing : nullptr,
-                      options.record_tiles ? run_clock(started, timing.has_value()) : RunClock{},
-                      share.plan != nullptr};
-  Host host;
-  for (std::size_t n = 0; n < nodes.size(); ++n)
-    if (nodes[n]) spawn_node(wiring, static_cast<NodeId>(n), *nodes[n]);
-  if (share.runs(0)) {
-    host.plan = std::make_unique<WorkPlan>(items, options.grain, options.schedule, static_cast<int>(topology.size()),
-                                           options.workers_per_node);
-    host.frame = std::make_unique<FrameAssembler>(items, grid.positions);
-    host.owners.assign(items, 0);
-    spawn_host(wiring, host);
-  }
-  std::unique_ptr<Bridge> bridge;
-  if (share.plan) {
-    bridge = std::make_unique<Bridge>(*share.transport, *share.plan, net, split->local_failure,
-                                      split->remote_failure, split->bridge);
-    runtime.spawn("bridge", net.thread_of(share.first_node()), [&bridge] { bridge->run(); });
-  }
-  run_runtime(runtime, topology.size(), split ? &*split : nullptr, share.rank);
-
-  Executed executed;
-  MachineResult& result = executed.result;
-  MachineReport& report = result.report;
-  report.wall_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
+// The figures of the machine as this process ran it; per_node entries of
+// nodes it did not run stay empty.
+MachineReport machine_report(const csp::Runtime& runtime, const Network& net, const MachineTiming* timing,
+                             const tracer::DatabaseHeader& header, const MachineOptions& options,
+                             std::uint32_t cache_pages, std::uint32_t items,
+                             const std::vector<std::unique_ptr<NodeState>>& nodes) {
+  MachineReport report;
+  report.topology = net.topology().spec();
+  report.nodes = static_cast<int>(net.topology().size());
+  report.threads = runtime.threads();
+  report.workers_per_node = options.workers_per_node;
+  report.prefetch = options.prefetch;
+  report.schedule = options.schedule;
+  report.pixel_order = options.pixel_order;
+  report.grain = options.grain;
+  report.cache_pages = cache_pages;
+  report.page_size = header.page_size;
+  report.page_count = header.page_count;
+  report.items = items;
   report.host_threads = runtime.thread_use();
   report.relayed_links = net.relayed_links();
   if (report.relayed_links > 0)
@@ -397,34 +438,76 @@ Executed execute(const tracer::DatabaseHeader& header, const topology::Topology&
     report.predicted_seconds = timing->predicted_seconds();
     report.compute_seconds = timing->compute_seconds();
   }
-  report.topology = topology.spec();
-  report.nodes = static_cast<int>(topology.size());
-  report.threads = runtime.threads();
-  report.workers_per_node = options.workers_per_node;
-  report.prefetch = options.prefetch;
-  report.cache_pages = cache_pages;
-  report.page_size = header.page_size;
-  report.page_count = header.page_count;
-  report.items = items;
   report.per_node.resize(nodes.size());
   for (std::size_t n = 0; n < nodes.size(); ++n)
     if (nodes[n]) report.per_node[n] = node_report(*nodes[n]);
-  report.schedule = options.schedule;
-  report.pixel_order = options.pixel_order;
-  report.grain = options.grain;
   report.network = net.stats();
-  if (share.plan) {
-    RankReport rank;
-    rank.rank = share.rank;
-    rank.first_node = share.first_node();
-    rank.node_count = static_cast<std::uint32_t>(local_nodes);
-    rank.threads = runtime.threads();
-    rank.bridge = split->bridge;
-    rank.wall_seconds = report.wall_seconds;
-    rank.cpu_seconds = cpu_seconds() - cpu_started;
-    for (std::size_t n = 0; n < nodes.size(); ++n)
-      if (nodes[n]) rank.peak_scene_bytes += report.per_node[n].peak_resident_bytes;
-    report.ranks.push_back(rank);
+  return report;
+}
+
+// A split run's rank: what it ran and what crossed its wire.
+RankReport rank_report(const Share& share, std::size_t local_nodes, unsigned threads, const SplitState& split,
+                       const MachineReport& report, double cpu_seconds_used) {
+  RankReport rank;
+  rank.rank = share.rank;
+  rank.first_node = share.first_node();
+  rank.node_count = static_cast<std::uint32_t>(local_nodes);
+  rank.threads = threads;
+  rank.bridge = split.bridge;
+  rank.wall_seconds = report.wall_seconds;
+  rank.cpu_seconds = cpu_seconds_used;
+  for (NodeId n = share.first_node(); n < share.first_node() + local_nodes; ++n)
+    rank.peak_scene_bytes += report.per_node[n].peak_resident_bytes;
+  return rank;
+}
+
+// The run of this process's share of the machine: build, run, report.
+// nodes[n] is null for the nodes another process runs; the result's
+// per_node entries for those stay empty and its image is empty unless this
+// process runs node 0.
+Executed execute(const tracer::DatabaseHeader& header, const topology::Topology& topology,
+                 const PagePlacement& placement, std::uint32_t cache_pages,
+                 std::vector<std::unique_ptr<NodeState>>& nodes, const MachineOptions& options, const Share& share) {
+  const auto started = std::chrono::steady_clock::now();
+  const double cpu_started = cpu_seconds();
+  std::optional<MachineTiming> virtual_time;
+  if (options.timing) virtual_time.emplace(*options.timing, static_cast<int>(topology.size()));
+  MachineTiming* const timing = virtual_time ? &*virtual_time : nullptr;
+  const std::size_t local_nodes = share.node_count(topology.size());
+  std::optional<SplitState> split_state;
+  if (share.plan) split_state.emplace();
+  SplitState* const split = split_state ? &*split_state : nullptr;
+
+  Network* network = nullptr;  // for the runtime's failure handler, once it exists
+  csp::Runtime runtime(runtime_options(options, local_nodes, timing, split, share.rank, network));
+  Network net(runtime, topology, network_options(options, timing, share, local_nodes, runtime.threads()));
+  network = &net;
+  const Items items(header, options);
+  const Wiring wiring{runtime,
+                      net,
+                      placement,
+                      header,
+                      options,
+                      items.grid,
+                      topology.size() * Ports::count(options.workers_per_node),
+                      timing,
+                      options.record_tiles ? run_clock(started, timing != nullptr) : RunClock{},
+                      split != nullptr};
+  Host host;
+  std::unique_ptr<Bridge> bridge;
+  spawn_machine(wiring, nodes, items, share, split, host, bridge);
+
+  run_and_translate(runtime, topology.size(), split, share.rank);
+  const double wall_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
+
+  Executed executed;
+  MachineResult& result = executed.result;
+  MachineReport& report = result.report;
+  report = machine_report(runtime, net, timing, header, options, cache_pages, items.count, nodes);
+  report.wall_seconds = wall_seconds;
+  if (split) {
+    report.ranks.push_back(
+        rank_report(share, local_nodes, runtime.threads(), *split, report, cpu_seconds() - cpu_started));
     report.cut_links = share.plan->cut_links();
     // The routers' counters travel to rank 0 with the node reports.
     executed.routers.resize(nodes.size());
@@ -436,7 +519,7 @@ Executed execute(const tracer::DatabaseHeader& header, const topology::Topology&
     report.farmer.steals = host.plan->steals();
     report.collected = host.frame->received();
     report.owners = std::move(host.owners);
-    result.image = assemble_image(header, grid, host.frame->colors());
+    result.image = assemble_image(header, items.grid, host.frame->colors());
   }
   return executed;
 }
@@ -444,7 +527,7 @@ Executed execute(const tracer::DatabaseHeader& header, const topology::Topology&
 }  // namespace
 
 MachineResult run_machine(tracer::Database db, const MachineOptions& options) {
-  validate(options);
+  check_options(options, db.header.page_size);
   const auto topology = topology::parse_topology(options.topology, options.nodes);
   const std::uint32_t cache_pages = cache_pages_for(options, db.header);
   const PagePlacement placement(options.distribution, static_cast<int>(topology.size()), db.header.page_count);
@@ -549,9 +632,9 @@ std::optional<MachineResult> run_machine_rank(std::optional<tracer::Database> db
   if ((rank == 0) != db.has_value())
     throw std::logic_error("run_machine_rank: rank 0, and only rank 0, holds the database");
   // The same options on every rank: these fail on all of them alike.
-  validate(options);
+  check_fields(options);
   if (options.timing)
-    throw std::invalid_argument("timing: virtual time cannot run over several processes (one clock orders the machine)");
+    throw OptionError("timing", "virtual time cannot run over several processes (one clock orders the machine)");
   const auto topology = topology::parse_topology(options.topology, options.nodes);
   const RankPlan plan(topology, transport.size());
   std::vector<std::unique_ptr<NodeState>> nodes(topology.size());

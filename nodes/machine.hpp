@@ -162,6 +162,45 @@ struct MachineResult {
   MachineReport report;
 };
 
+// A MachineOptions field the machine cannot run with: field() is its name
+// in MachineOptions ("grain", "cache_kb", ...), reason() what is wrong with
+// its value; what() is "FIELD: REASON", one line. A caller with other names
+// for the fields (command-line options) says reason() under its own.
+class OptionError : public std::invalid_argument {
+ public:
+  OptionError(const std::string& field, const std::string& reason)
+      : std::invalid_argument(field + ": " + reason), field_(field), reason_(reason) {}
+  const std::string& field() const { return field_; }
+  const std::string& reason() const { return reason_; }
+
+ private:
+  std::string field_, reason_;
+};
+
+// What the system would not give a machine: memory (for a process, its
+// stack or the record of one) or an OS thread. what() is the runtime's own
+// line; nodes() and threads() say how large the machine was, so a caller
+// can say what to change.
+class ResourceError : public std::runtime_error {
+ public:
+  enum class Resource : std::uint8_t { memory, thread };
+  ResourceError(const std::string& line, Resource resource, std::size_t nodes, unsigned threads)
+      : std::runtime_error(line), resource_(resource), nodes_(nodes), threads_(threads) {}
+  Resource resource() const { return resource_; }
+  std::size_t nodes() const { return nodes_; }
+  unsigned threads() const { return threads_; }
+
+ private:
+  Resource resource_;
+  std::size_t nodes_;
+  unsigned threads_;
+};
+
+// Every rule of the options alone, and of the cache against pages of
+// page_size bytes: OptionError naming the first field that breaks one.
+// run_machine checks them before any work; a caller may check them sooner.
+void check_options(const MachineOptions& options, std::uint32_t page_size);
+
 // The cache a node gets when no size is given: 1/8 of the database, a modest
 // share as in the paper's experiments, but at least 64 pages (or the whole
 // database if smaller). A cache smaller than the pages one ray visits, as
@@ -169,13 +208,14 @@ struct MachineResult {
 // such a cache can still be asked for by size.
 std::uint32_t default_cache_pages(const tracer::DatabaseHeader& header);
 
-// Cache size in pages from the options: std::invalid_argument naming the
-// option for 0 pages, less than a page of KB, or both options given.
+// Cache size in pages from the options: OptionError naming the field for 0
+// pages, less than a page of KB, or both fields set.
 std::uint32_t cache_pages_for(const MachineOptions& options, const tracer::DatabaseHeader& header);
 
 // Renders db's frame on the machine; consumes db (its pages move to their
-// owners). Throws std::invalid_argument for bad options (one line, naming
-// the option) and whatever a process throws.
+// owners). Throws OptionError for bad options, topology::parse_topology's
+// std::invalid_argument for a bad topology, ResourceError when the system
+// has no memory or thread to give, and whatever a process throws.
 MachineResult run_machine(tracer::Database db, const MachineOptions& options);
 
 // ---- The machine split over the ranks of a Transport ----
@@ -185,17 +225,22 @@ MachineResult run_machine(tracer::Database db, const MachineOptions& options);
 // holding only its own nodes' pages (rank 0 sends them) and caches; after
 // the run every rank sends its reports to rank 0, whose result equals the
 // one-process run's. Virtual time cannot be split (one clock orders the
-// whole machine): std::invalid_argument, before any work. A failure on any
-// rank ends every rank's call with RankFailure, within the time it takes
-// the others to notice (they poll the wire at least every millisecond).
+// whole machine): OptionError for timing, before any work. A failure on
+// any rank ends every rank's call with RankFailure, within the time it takes
+// the others to notice (they poll the wire at least every millisecond); a
+// rank that could not get memory or threads says so with resource().
 class RankFailure : public std::runtime_error {
  public:
   RankFailure(int rank, const std::string& line)
       : std::runtime_error("rank " + std::to_string(rank) + ": " + line), rank_(rank) {}
+  RankFailure(int rank, const ResourceError& shortage) : RankFailure(rank, shortage.what()) { resource_ = shortage; }
   int rank() const { return rank_; }
+  // This rank's own shortage, if that is what ended it.
+  const ResourceError* resource() const { return resource_ ? &*resource_ : nullptr; }
 
  private:
   int rank_;
+  std::optional<ResourceError> resource_;
 };
 
 std::optional<MachineResult> run_machine_rank(std::optional<tracer::Database> db, const MachineOptions& options,
