@@ -100,6 +100,7 @@ struct Wiring {
   std::uint64_t processes;  // sending processes, for packet ids
   MachineTiming* timing;    // null unless in virtual time
   RunClock tile_clock;      // empty unless tiles are recorded
+  Recorder* recorder;       // null unless the run is recorded for its replay
   bool split = false;       // other processes run the other nodes (a bridge serves the wire)
 
   Outbox outbox(NodeId n, std::uint16_t port) const {
@@ -107,6 +108,16 @@ struct Wiring {
     return Outbox(net.injector(n, port), n * ports + port, processes);
   }
 };
+
+// The miss path with each wait for a page logged on the node.
+PageFetch recording_fetch(Recorder& recorder, NodeId n, int worker, PageFetch inner) {
+  return [&recorder, n, worker, inner = std::move(inner)](std::uint32_t page) {
+    const double start = recorder.now();
+    auto bytes = inner(page);
+    recorder.log(n).fetches.push_back({start, recorder.now(), page, static_cast<std::uint16_t>(worker)});
+    return bytes;
+  };
+}
 
 void spawn_node(const Wiring& w, NodeId n, NodeState& node) {
   const unsigned thread = w.net.thread_of(n);
@@ -116,9 +127,11 @@ void spawn_node(const Wiring& w, NodeId n, NodeState& node) {
   w.runtime.spawn(name + " page mailbox", thread,
                   [mb = node.mailbox.get(), in = w.net.port(n, Ports::page_server)] { mb->forward(in); });
   std::function<void()> serve_hook = w.timing ? w.timing->serve_hook(static_cast<int>(n)) : nullptr;
-  w.runtime.spawn(name + " page server", thread, [n, &node, out = w.outbox(n, Ports::page_server), serve_hook] {
-    PageServer(n, node.svm->memory(), node.mailbox->reader(), out, node.served, serve_hook).run();
-  });
+  w.runtime.spawn(
+      name + " page server", thread,
+      [n, &node, out = w.outbox(n, Ports::page_server), serve_hook, recorder = w.recorder] {
+        PageServer(n, node.svm->memory(), node.mailbox->reader(), out, node.served, serve_hook, recorder).run();
+      });
   node.work.resize(static_cast<std::size_t>(k));
   for (int i = 0; i < k; ++i) {
     const auto port = static_cast<std::uint16_t>(Ports::first_worker + i);
@@ -128,6 +141,8 @@ void spawn_node(const Wiring& w, NodeId n, NodeState& node) {
     WorkerPort& in = *node.worker_in.back();
     auto& counters = node.work[static_cast<std::size_t>(i)];
     PageFetch fetch = make_page_fetch(w.placement, port, in, out);
+    // Inside the charge: the wait starts as the request leaves.
+    if (w.recorder) fetch = recording_fetch(*w.recorder, n, i, std::move(fetch));
     std::function<void()> charge;
     if (w.timing) {
       ComputeMeter& meter = w.timing->add_meter(static_cast<int>(n), counters.rays);
@@ -334,11 +349,17 @@ Executed execute(const tracer::DatabaseHeader& header, const topology::Topology&
     };
   }
   csp::Runtime runtime(std::move(runtime_options));
+  std::unique_ptr<Recorder> recorder;
+  if (options.record) {
+    if (share.plan) throw std::invalid_argument("record: a run over several processes cannot be recorded");
+    recorder = std::make_unique<Recorder>(topology.size(), options.record_packets, timing.has_value(), started);
+  }
   NetworkOptions net_options;
   net_options.buffer_capacity = options.buffer_capacity;
   net_options.ports_per_node = Ports::count(options.workers_per_node);
   net_options.trace_routes = options.trace_routes;
   net_options.trace_kinds = options.trace_kinds;
+  net_options.recorder = recorder.get();
   if (timing) net_options.link = timing->model().link_model();
   net_options.relay_between_threads = options.relay_between_threads && !timing;
   if (share.plan) {
@@ -364,7 +385,8 @@ Executed execute(const tracer::DatabaseHeader& header, const topology::Topology&
                       grid,
                       topology.size() * net_options.ports_per_node,
                       timing ? &*timing : nullptr,
-                      options.record_tiles ? run_clock(started, timing.has_value()) : RunClock{},
+                      options.record_tiles || options.record ? run_clock(started, timing.has_value()) : RunClock{},
+                      recorder.get(),
                       share.plan != nullptr};
   Host host;
   for (std::size_t n = 0; n < nodes.size(); ++n)
@@ -413,6 +435,11 @@ Executed execute(const tracer::DatabaseHeader& header, const topology::Topology&
   report.pixel_order = options.pixel_order;
   report.grain = options.grain;
   report.network = net.stats();
+  if (recorder) {
+    std::vector<std::vector<TileSpan>> tiles;
+    for (const NodeReport& n : report.per_node) tiles.push_back(n.work.spans);
+    report.recording = std::make_shared<const Recording>(merge_recording(*recorder, topology, std::move(tiles)));
+  }
   if (share.plan) {
     RankReport rank;
     rank.rank = share.rank;
