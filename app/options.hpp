@@ -44,6 +44,7 @@ struct Options {
   nodes::MachineOptions machine;
   PicturePaths pictures;  // written after a machine render (timing_options.hpp)
   std::string tiles_csv;  // the machine's tile timeline (machine_report.hpp), none when empty
+  std::string replay_html;  // the replay page of the run (replay.hpp), none when empty
 };
 
 // v as a T when lo <= v <= hi; else UsageError "OPTION: expected lo..hi, got v".
