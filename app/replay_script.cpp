@@ -135,7 +135,8 @@ function format(ticks) {
   if (s >= 60) return Math.floor(s / 60) + " min " + (s % 60).toFixed(1) + " s";
   if (s >= 1) return s.toFixed(3) + " s";
   if (s >= 1e-3) return (s * 1e3).toFixed(3) + " ms";
-  return (s * 1e6).toFixed(1) + " \u00b5s";
+  if (s >= 1e-6) return (s * 1e6).toFixed(1) + " \u00b5s";
+  return (s * 1e9).toFixed(0) + " ns";
 }
 
 // ---- The machine ----
@@ -225,9 +226,12 @@ function drawMachine() {
       y = py + Math.sin(a) * pr * 0.6;
     }
     g.fillStyle = KIND_COLOURS[P.kind[i]] || "#000";
+    g.strokeStyle = "#ffffff";
+    g.lineWidth = 1.2;
     g.beginPath();
-    g.arc(x, y, 3.2, 0, 2 * Math.PI);
+    g.arc(x, y, 4.5, 0, 2 * Math.PI);
     g.fill();
+    g.stroke();
     dots.push([x, y, i]);
   }
 }
@@ -318,10 +322,12 @@ function previous() {
 $("step").onclick = next;
 $("back").onclick = previous;
 $("end").onclick = () => seek(END);
-for (const s of [0.02, 0.05, 0.1, 0.25, 0.5, 1, 2, 4, 10]) {
+// Speed 1 plays the run in 30 s; the slowest ones show single hops, which
+// in virtual time take a fraction of a millisecond of a run of minutes.
+for (const s of [1e-6, 1e-5, 1e-4, 1e-3, 0.01, 0.1, 0.25, 0.5, 1, 2, 4]) {
   const o = document.createElement("option");
   o.value = String(s);
-  o.textContent = s + "\u00d7";
+  o.textContent = format((END / 30) * s) + " a second";
   if (s === 1) o.selected = true;
   $("speed").appendChild(o);
 }
