@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <map>
 #include <numeric>
 #include <stdexcept>
 
@@ -71,7 +72,7 @@ std::vector<TileRow> tiles_by_end(const nodes::Recording& rec) {
 
 Json tiles_json(const std::vector<TileRow>& rows, const Ticks& ticks) {
   Json node = Json::array(), worker = Json::array(), first = Json::array(), count = Json::array(),
-       start = Json::array(), end = Json::array(), hits = Json::array(), misses = Json::array();
+       start = Json::array(), end = Json::array(), misses = Json::array();
   for (const TileRow& r : rows) {
     node.push_back(r.node);
     worker.push_back(r.span->worker);
@@ -79,11 +80,25 @@ Json tiles_json(const std::vector<TileRow>& rows, const Ticks& ticks) {
     count.push_back(r.span->tile.count);
     start.push_back(ticks(r.span->start));
     end.push_back(ticks(r.span->end));
-    hits.push_back(r.span->page_hits);
     misses.push_back(r.span->page_requests);
   }
-  return {{"node", node},   {"worker", worker}, {"first", first}, {"count", count},
-          {"start", start}, {"end", end},       {"hits", hits},   {"misses", misses}};
+  return {{"node", node},   {"worker", worker}, {"first", first},  {"count", count},
+          {"start", start}, {"end", end},       {"misses", misses}};
+}
+
+// Page hits per tile: each sample's rise over its worker's previous one.
+Json hits_json(const nodes::Recording& rec, const Ticks& ticks) {
+  Json node = Json::array(), time = Json::array(), hits = Json::array();
+  for (std::size_t n = 0; n < rec.nodes.size(); ++n) {
+    std::map<std::uint16_t, std::uint64_t> before;
+    for (const nodes::HitSample& h : rec.nodes[n].hits) {
+      node.push_back(n);
+      time.push_back(ticks(h.time));
+      hits.push_back(h.hits - before[h.worker]);
+      before[h.worker] = h.hits;
+    }
+  }
+  return {{"node", node}, {"time", time}, {"hits", hits}};
 }
 
 Json fetches_json(const nodes::Recording& rec, const Ticks& ticks) {
@@ -195,6 +210,7 @@ Json replay_data(const ReplaySource& source) {
           {"tiles", tiles_json(rows, ticks)},
           {"fetches", fetches_json(rec, ticks)},
           {"serves", serves_json(rec, ticks)},
+          {"hits", hits_json(rec, ticks)},
           {"maxPackets", rec.max_packets},
           {"unrecorded",
            {{"packets", rec.unrecorded_packets}, {"hops", rec.unrecorded_hops}, {"byKind", unrecorded_by_kind}}},

@@ -350,7 +350,7 @@ function packetDetails(i) {
 function nodeDetails(n) {
   const buckets = 48, hits = new Float64Array(buckets), miss = new Float64Array(buckets);
   const at = (ticks) => Math.min(buckets - 1, Math.floor((ticks / Math.max(1, END)) * buckets));
-  D.tiles.node.forEach((m, k) => { if (m === n) hits[at(D.tiles.end[k])] += D.tiles.hits[k]; });
+  D.hits.node.forEach((m, k) => { if (m === n) hits[at(D.hits.time[k])] += D.hits.hits[k]; });
   D.fetches.node.forEach((m, k) => { if (m === n) miss[at(D.fetches.start[k])] += 1; });
   const served = new Map();
   let servedCount = 0;

@@ -150,6 +150,14 @@ void spawn_node(const Wiring& w, NodeId n, NodeState& node) {
       charge = [&meter] { meter.charge(); };
     }
     SvmSource& source = node.svm->add_worker(std::move(fetch));
+    // After each tile (its work charged): the page calls the cache and the
+    // own pages have answered so far.
+    if (w.recorder)
+      charge = [charge, &source, recorder = w.recorder, n, worker = static_cast<std::uint16_t>(i)] {
+        if (charge) charge();
+        const SvmStats s = source.stats();
+        recorder->log(n).hits.push_back({recorder->now(), s.own_hits + s.cache_hits, worker});
+      };
     // On the one thread of a whole machine nobody waits across threads or
     // processes, and first-in first-out order lets a router take more
     // packets per wake-up; under virtual time the scheduler orders by clock.

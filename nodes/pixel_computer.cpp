@@ -68,15 +68,13 @@ void PixelComputer::run() {
     const Tile tile = decode_tile(answer.payload);
     const double start = clock_ ? clock_() : 0.0;
     const std::uint64_t requests_before = source_.stats().misses;
-    const std::uint64_t hits_before = source_.stats().own_hits + source_.stats().cache_hits;
     const std::uint64_t rays_before = counters_.rays.rays();
     compute(tile);
     source_.release();  // before the hook too: it may suspend this fiber
     if (after_tile_) after_tile_();
     if (clock_)
       counters_.spans.push_back({port_ - Ports::first_worker, tile, start, clock_(),
-                                 source_.stats().misses - requests_before, counters_.rays.rays() - rays_before,
-                                 source_.stats().own_hits + source_.stats().cache_hits - hits_before});
+                                 source_.stats().misses - requests_before, counters_.rays.rays() - rays_before});
     out_.send(make_packet(0, Ports::farmer, MessageKind::result, encode_result(port_, tile, colors_)));
     ++owed;
   }

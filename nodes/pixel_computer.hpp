@@ -55,7 +55,6 @@ struct TileSpan {
   double end = 0;
   std::uint64_t page_requests = 0;
   std::uint64_t rays = 0;
-  std::uint64_t page_hits = 0;  // page calls answered by own pages or the cache
 };
 
 struct WorkerCounters {

@@ -159,6 +159,7 @@ Recording merge_recording(const Recorder& recorder, const topology::Topology& to
     NodeTrace& t = r.nodes[n];
     t.fetches = recorder.log(n).fetches;
     t.serves = recorder.log(n).serves;
+    t.hits = recorder.log(n).hits;
     t.tiles = std::move(tiles[n]);
     for (const FetchEvent& e : t.fetches) r.end = std::max(r.end, e.end);
     for (const ServeEvent& e : t.serves) r.end = std::max(r.end, e.end);

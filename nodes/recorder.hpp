@@ -78,12 +78,21 @@ struct ServeEvent {
   NodeId to = 0;
 };
 
+// What a pixel computer's page calls found at hand so far (own pages and
+// cache hits), after each tile: the cache over time.
+struct HitSample {
+  double time = 0;
+  std::uint64_t hits = 0;  // since the run began
+  std::uint16_t worker = 0;
+};
+
 struct NodeLog {
   std::vector<InjectEvent> injected;
   std::vector<HopEvent> departed, arrived;
   std::vector<DeliverEvent> delivered;
   std::vector<FetchEvent> fetches;
   std::vector<ServeEvent> serves;
+  std::vector<HitSample> hits;
   std::array<std::uint64_t, 256> unrecorded{};  // delivered here without a record, by kind
   std::uint64_t unrecorded_hops = 0;
 };
@@ -134,6 +143,7 @@ struct PacketTrace {
 struct NodeTrace {
   std::vector<FetchEvent> fetches;  // in the order each worker made them
   std::vector<ServeEvent> serves;   // in order
+  std::vector<HitSample> hits;      // in the order each worker took them
   std::vector<TileSpan> tiles;      // as the machine recorded them (record_tiles)
 };
 

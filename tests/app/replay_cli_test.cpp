@@ -64,6 +64,8 @@ void expect_totals_match(const Json& data, const Json& machine) {
             totals.at("hops").get<std::uint64_t>());
   EXPECT_EQ(data.at("fetches").at("start").size(), totals.at("misses").get<std::uint64_t>());
   EXPECT_EQ(sum(data.at("tiles").at("count")), pixels);
+  EXPECT_EQ(sum(data.at("hits").at("hits")), machine.at("svm").at("local_hits").get<std::uint64_t>() +
+                                                 machine.at("svm").at("cache_hits").get<std::uint64_t>());
   // Each packet: hops + 1 route nodes, two times a node.
   EXPECT_EQ(p.at("route").size(), sum(p.at("hops")) + p.at("kind").size());
   EXPECT_EQ(p.at("times").size(), 2 * p.at("route").size());

@@ -1,7 +1,8 @@
 // The recorder's invariants on whole machine runs: every recorded hop crosses
 // a link of the topology along the route topology::next_hop gives, no packet
 // arrives before it left, the packets recorded and counted are the routers'
-// own per kind, the pages waited for and served match the node reports, and
+// own per kind, the pages waited for and served and the page hits match the
+// node reports, and
 // a bound records the first packets hop by hop and only counts the rest.
 #include "nodes/recorder.hpp"
 
@@ -78,6 +79,16 @@ void expect_consistent(const RecordedRun& run) {
     for (const auto& f : node.fetches) EXPECT_LE(f.start, f.end);
     for (const auto& s : node.serves) EXPECT_LE(s.start, s.end);
     for (const auto& t : node.tiles) items += t.tile.count;
+    // Every page call falls in a tile: each worker's last sample is its total.
+    std::map<std::uint16_t, std::uint64_t> last;
+    for (const auto& h : node.hits) {
+      EXPECT_GE(h.hits, last[h.worker]);
+      last[h.worker] = h.hits;
+    }
+    std::uint64_t hits = 0;
+    for (const auto& [worker, h] : last) hits += h;
+    EXPECT_EQ(hits, report.per_node[n].svm.own_hits + report.per_node[n].svm.cache_hits) << "node " << n;
+    EXPECT_EQ(node.hits.size(), node.tiles.size());
   }
   EXPECT_EQ(items, report.items_computed());
 }
