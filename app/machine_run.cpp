@@ -49,6 +49,7 @@ SerialComparison run_serial(const tracer::Database& db, const nodes::MachineOpti
   one.topology = "complete";
   one.nodes = 1;
   one.trace_routes = 0;
+  one.record = false;
   const nodes::MachineResult r = run_with_progress(db, one, o, " (1 node)");
   return {machine.timing ? r.report.predicted_seconds : r.report.wall_seconds, r.report.threads};
 }

@@ -22,13 +22,14 @@
 #include <utility>
 #include <vector>
 
-#include "app/machine_run.hpp"
 #include "app/machine_pictures.hpp"
+#include "app/machine_run.hpp"
 #include "app/memory_check.hpp"
 #include "app/options.hpp"
 #include "app/output_check.hpp"
 #include "app/output_files.hpp"
 #include "app/ranks.hpp"
+#include "app/replay.hpp"
 #include "app/report.hpp"
 #include "app/scene_input.hpp"
 #include "app/single.hpp"
@@ -52,6 +53,7 @@ void check_distinct_outputs(const app::Options& o) {
   std::vector<std::pair<std::string, std::filesystem::path>> outputs{{"--output", o.output}};
   if (!o.stats_path.empty()) outputs.emplace_back("--stats", o.stats_path);
   if (!o.tiles_csv.empty()) outputs.emplace_back("--tiles", o.tiles_csv);
+  if (!o.replay_html.empty()) outputs.emplace_back("--replay", o.replay_html);
   for (auto& output : app::picture_outputs(picture_files(o))) outputs.push_back(std::move(output));
   for (std::size_t i = 0; i < outputs.size(); ++i)
     for (std::size_t j = 0; j < i; ++j)
@@ -91,6 +93,12 @@ int run(const app::Options& o, const std::vector<std::string>& command_line, nod
   if (result.report.machine) app::print_routes(report_out, result.report.machine->report);
   if (result.report.machine && !o.tiles_csv.empty())
     outputs.write_text(o.tiles_csv, app::tiles_csv(result.report.machine->report));
+  if (result.report.machine && !o.replay_html.empty())
+    outputs.write_text(o.replay_html, app::replay_page({.title = result.report.scene,
+                                                        .made_by = "vmpray " VMPRAY_VERSION,
+                                                        .command_line = command_line,
+                                                        .report = &result.report.machine->report,
+                                                        .image = &result.image}));
   if (result.report.machine)  // removes what it wrote if it fails; the image is written and not needed again
     for (const auto& path : app::write_machine_pictures(
              picture_files(o),

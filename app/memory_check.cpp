@@ -81,7 +81,7 @@ std::uint64_t largest_tile(const nodes::MachineOptions& m, std::uint64_t items, 
 
 // The tiles of a dynamic run whose tiles are recorded; 0 otherwise.
 std::uint64_t recorded_tiles(const nodes::MachineOptions& m, std::uint64_t items) {
-  if (!m.record_tiles || m.schedule != nodes::Schedule::dynamic) return 0;
+  if ((!m.record_tiles && !m.record) || m.schedule != nodes::Schedule::dynamic) return 0;
   return (items + m.grain - 1) / m.grain;
 }
 

@@ -24,7 +24,8 @@ struct Raw {
   SharedChoice shared;  // the options a sweep takes too
   std::int64_t max_depth = 0, width = 0, height = 0, tessellate = 0;
   std::string topology, distribution, trace_kind;
-  std::int64_t nodes = 0, threads = 0, cache_pages = 0, cache_kb = 0, workers = 0, trace_routes = 0;
+  std::int64_t nodes = 0, threads = 0, cache_pages = 0, cache_kb = 0, workers = 0, trace_routes = 0,
+               replay_packets = 0;
   TimingChoice timing;
 };
 
@@ -86,6 +87,11 @@ po::options_description describe_machine(Options& o, Raw& raw) {
       ("tiles", po::value(&o.tiles_csv),
        "write a CSV row per tile: node, worker, first item, items, start and end seconds (wall, or virtual "
        "with --timing virtual), page requests and rays")
+      ("replay", po::value(&o.replay_html),
+       "write one self-contained HTML page that replays the run: nodes at work, packets hop by hop, the image "
+       "filling in (not over mpirun)")
+      ("replay-packets", po::value(&raw.replay_packets)->default_value(100000),
+       "with --replay: packets recorded hop by hop, 0..4194304; later ones are only counted (the page says so)")
       ("compare-serial", po::bool_switch(&o.compare_serial),
        "also run the 1-node machine; report speedup and efficiency T1/(N*TN)");
   add_timing_options(d, raw.timing, o.pictures);
@@ -154,6 +160,10 @@ void check_machine(Options& o, const Raw& raw, const po::variables_map& vm) {
     throw UsageError("--compare-serial: a virtual-time run always reports speedup against the 1-node machine");
   // The tile CSV, the timeline and the report (which shows the timeline) need the tiles.
   m.record_tiles = !o.tiles_csv.empty() || !o.pictures.timeline_svg.empty() || !o.pictures.report_html.empty();
+  m.record = !o.replay_html.empty();
+  m.record_packets = in_range<std::uint64_t>(raw.replay_packets, 0, 1 << 22, "--replay-packets");
+  if (!vm["replay-packets"].defaulted() && !m.record)
+    throw UsageError("--replay-packets: bounds what --replay records; give that too");
   // The machine's own rules, now rather than after the scene is read.
   try {
     nodes::check_options(m, o.page_size);
@@ -189,6 +199,7 @@ void check_output_names(const Options& o, const po::variables_map& vm) {
       {"ownership", o.pictures.ownership_png, {".png", ".ppm"}},
       {"timeline", o.pictures.timeline_svg, {".svg"}},
       {"report", o.pictures.report_html, {".html", ".htm"}},
+      {"replay", o.replay_html, {".html", ".htm"}},
   };
   for (const Named& n : outputs) {
     if (!vm.count(n.option)) continue;

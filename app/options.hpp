@@ -46,6 +46,7 @@ struct Options {
   nodes::MachineOptions machine;
   PicturePaths pictures;  // written after a machine render (timing_options.hpp)
   std::string tiles_csv;  // the machine's tile timeline (machine_report.hpp), none when empty
+  std::string replay_html;  // the replay page of the run (replay.hpp), none when empty
 };
 
 // ---- Options a render and a sweep share ----

@@ -63,6 +63,7 @@ void check_output_paths(const Options& o) {
   check_writable_file("--output", o.output);
   if (!o.stats_path.empty() && o.stats_path != "-") check_writable_file("--stats", o.stats_path);
   if (!o.tiles_csv.empty()) check_writable_file("--tiles", o.tiles_csv);
+  if (!o.replay_html.empty()) check_writable_file("--replay", o.replay_html);
   const PictureFiles pictures{o.pictures.machine_svg, o.pictures.ownership_png, o.pictures.report_html,
                               o.pictures.timeline_svg};
   // The page before its images, so that a bad --report is named as such.

@@ -104,6 +104,7 @@ struct Wiring {
   std::uint64_t processes;  // sending processes, for packet ids
   MachineTiming* timing;    // null unless in virtual time
   RunClock tile_clock;      // empty unless tiles are recorded
+  Recorder* recorder;       // null unless the run is recorded for its replay
   bool split = false;       // other processes run the other nodes (a bridge serves the wire)
 
   Outbox outbox(NodeId n, std::uint16_t port) const {
@@ -111,6 +112,16 @@ struct Wiring {
     return Outbox(net.injector(n, port), n * ports + port, processes);
   }
 };
+
+// The miss path with each wait for a page logged on the node.
+PageFetch recording_fetch(Recorder& recorder, NodeId n, int worker, PageFetch inner) {
+  return [&recorder, n, worker, inner = std::move(inner)](std::uint32_t page) {
+    const double start = recorder.now();
+    auto bytes = inner(page);
+    recorder.log(n).fetches.push_back({start, recorder.now(), page, static_cast<std::uint16_t>(worker)});
+    return bytes;
+  };
+}
 
 void spawn_node(const Wiring& w, NodeId n, NodeState& node) {
   const unsigned thread = w.net.thread_of(n);
@@ -120,9 +131,11 @@ void spawn_node(const Wiring& w, NodeId n, NodeState& node) {
   w.runtime.spawn(name + " page mailbox", thread,
                   [mb = node.mailbox.get(), in = w.net.port(n, Ports::page_server)] { mb->forward(in); });
   std::function<void()> serve_hook = w.timing ? w.timing->serve_hook(static_cast<int>(n)) : nullptr;
-  w.runtime.spawn(name + " page server", thread, [n, &node, out = w.outbox(n, Ports::page_server), serve_hook] {
-    PageServer(n, node.svm->memory(), node.mailbox->reader(), out, node.served, serve_hook).run();
-  });
+  w.runtime.spawn(
+      name + " page server", thread,
+      [n, &node, out = w.outbox(n, Ports::page_server), serve_hook, recorder = w.recorder] {
+        PageServer(n, node.svm->memory(), node.mailbox->reader(), out, node.served, serve_hook, recorder).run();
+      });
   node.work.resize(static_cast<std::size_t>(k));
   for (int i = 0; i < k; ++i) {
     const auto port = static_cast<std::uint16_t>(Ports::first_worker + i);
@@ -132,6 +145,8 @@ void spawn_node(const Wiring& w, NodeId n, NodeState& node) {
     WorkerPort& in = *node.worker_in.back();
     auto& counters = node.work[static_cast<std::size_t>(i)];
     PageFetch fetch = make_page_fetch(w.placement, port, in, out);
+    // Inside the charge: the wait starts as the request leaves.
+    if (w.recorder) fetch = recording_fetch(*w.recorder, n, i, std::move(fetch));
     std::function<void()> charge;
     if (w.timing) {
       ComputeMeter& meter = w.timing->add_meter(static_cast<int>(n), counters.rays);
@@ -139,6 +154,14 @@ void spawn_node(const Wiring& w, NodeId n, NodeState& node) {
       charge = [&meter] { meter.charge(); };
     }
     SvmSource& source = node.svm->add_worker(std::move(fetch));
+    // After each tile (its work charged): the page calls the cache and the
+    // own pages have answered so far.
+    if (w.recorder)
+      charge = [charge, &source, recorder = w.recorder, n, worker = static_cast<std::uint16_t>(i)] {
+        if (charge) charge();
+        const SvmStats s = source.stats();
+        recorder->log(n).hits.push_back({recorder->now(), s.own_hits + s.cache_hits, worker});
+      };
     // On the one thread of a whole machine nobody waits across threads or
     // processes, and first-in first-out order lets a router take more
     // packets per wake-up; under virtual time the scheduler orders by clock.
@@ -311,12 +334,13 @@ csp::RuntimeOptions runtime_options(const MachineOptions& options, std::size_t l
 }
 
 NetworkOptions network_options(const MachineOptions& options, const MachineTiming* timing, const Share& share,
-                               std::size_t local_nodes, unsigned threads) {
+                               std::size_t local_nodes, unsigned threads, Recorder* recorder) {
   NetworkOptions net;
   net.buffer_capacity = options.buffer_capacity;
   net.ports_per_node = Ports::count(options.workers_per_node);
   net.trace_routes = options.trace_routes;
   net.trace_kinds = options.trace_kinds;
+  net.recorder = recorder;
   if (timing) net.link = timing->model().link_model();
   net.relay_between_threads = options.relay_between_threads && !timing;
   if (share.plan) {
@@ -480,7 +504,13 @@ Executed execute(const tracer::DatabaseHeader& header, const topology::Topology&
 
   Network* network = nullptr;  // for the runtime's failure handler, once it exists
   csp::Runtime runtime(runtime_options(options, local_nodes, timing, split, share.rank, network));
-  Network net(runtime, topology, network_options(options, timing, share, local_nodes, runtime.threads()));
+  std::unique_ptr<Recorder> recorder;
+  if (options.record) {
+    if (share.plan) throw std::invalid_argument("record: a run over several processes cannot be recorded");
+    recorder = std::make_unique<Recorder>(topology.size(), options.record_packets, timing != nullptr, started);
+  }
+  Network net(runtime, topology,
+              network_options(options, timing, share, local_nodes, runtime.threads(), recorder.get()));
   network = &net;
   const Items items(header, options);
   const Wiring wiring{runtime,
@@ -491,7 +521,8 @@ Executed execute(const tracer::DatabaseHeader& header, const topology::Topology&
                       items.grid,
                       topology.size() * Ports::count(options.workers_per_node),
                       timing,
-                      options.record_tiles ? run_clock(started, timing != nullptr) : RunClock{},
+                      options.record_tiles || options.record ? run_clock(started, timing != nullptr) : RunClock{},
+                      recorder.get(),
                       split != nullptr};
   Host host;
   std::unique_ptr<Bridge> bridge;
@@ -505,6 +536,11 @@ Executed execute(const tracer::DatabaseHeader& header, const topology::Topology&
   MachineReport& report = result.report;
   report = machine_report(runtime, net, timing, header, options, cache_pages, items.count, nodes);
   report.wall_seconds = wall_seconds;
+  if (recorder) {
+    std::vector<std::vector<TileSpan>> tiles;
+    for (const NodeReport& n : report.per_node) tiles.push_back(n.work.spans);
+    report.recording = std::make_shared<const Recording>(merge_recording(*recorder, topology, std::move(tiles)));
+  }
   if (split) {
     report.ranks.push_back(
         rank_report(share, local_nodes, runtime.threads(), *split, report, cpu_seconds() - cpu_started));

@@ -40,6 +40,7 @@
 #pragma once
 
 #include <cstdint>
+#include <memory>
 #include <optional>
 #include <stdexcept>
 #include <string>
@@ -51,9 +52,10 @@
 #include "nodes/network.hpp"
 #include "nodes/node_memory.hpp"
 #include "nodes/page_server.hpp"
-#include "nodes/pixel_order.hpp"
 #include "nodes/pixel_computer.hpp"
+#include "nodes/pixel_order.hpp"
 #include "nodes/rank_plan.hpp"
+#include "nodes/recorder.hpp"
 #include "nodes/svm.hpp"
 #include "nodes/timing.hpp"
 #include "nodes/transport.hpp"
@@ -83,6 +85,8 @@ struct MachineOptions {
   std::uint64_t trace_routes = 0;      // record the routes of the first N packets
   std::vector<std::uint8_t> trace_kinds;  // of these MessageKinds only (empty: every kind)
   bool record_tiles = false;           // a TileSpan per tile in each NodeReport's work.spans
+  bool record = false;                 // a Recording of the run for its replay (recorder.hpp); implies record_tiles
+  std::uint64_t record_packets = 100000;  // with record: packets recorded hop by hop, the rest only counted
   std::size_t buffer_capacity = 4;     // packets per network queue
   tracer::TraceOptions trace;
   std::optional<CostModel> timing;     // virtual time under this model (the run takes one thread)
@@ -144,6 +148,7 @@ struct MachineReport {
   NetworkStats network;
   std::vector<RankReport> ranks;  // empty unless the machine ran over several processes
   std::size_t cut_links = 0;      // links whose ends ran in different processes
+  std::shared_ptr<const Recording> recording;  // with MachineOptions::record; null otherwise
 
   SvmStats svm() const;
   ServerCounters served() const;

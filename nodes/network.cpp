@@ -98,7 +98,7 @@ void Network::wire_node(csp::Runtime& runtime, NodeId node) {
   for (unsigned j = 0; j < options_.ports_per_node; ++j)
     ends.outputs.push_back(output_queue(runtime, node, ports_[node][j]));
   RouterConfig config{options_.trace_routes > 0 ? &routes_to_trace_ : nullptr,
-                      options_.trace_kinds.empty() ? nullptr : &kinds_to_trace_};
+                      options_.trace_kinds.empty() ? nullptr : &kinds_to_trace_, options_.recorder};
   auto router = std::make_shared<Router>(topology_, node, std::move(ends), config,
                                          *router_counters_[node]);
   runtime.spawn("router " + std::to_string(node), thread_of(node), [router] { router->run(); });

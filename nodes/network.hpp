@@ -62,6 +62,7 @@ struct NetworkOptions {
   unsigned ports_per_node = 1;      // local ports per node
   std::uint64_t trace_routes = 0;   // record the routes of the first this many packets injected
   std::vector<std::uint8_t> trace_kinds;  // of these kinds only (empty: every kind)
+  Recorder* recorder = nullptr;           // every router records its hops here (recorder.hpp); null: none
   LinkModel link;                   // optional per-hop latency and bandwidth
   std::function<unsigned(NodeId)> placement;  // thread of node n; default block
   std::function<bool(NodeId)> local;          // nodes this process runs; default all

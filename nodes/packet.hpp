@@ -25,6 +25,7 @@ struct Packet {
   std::uint16_t port = 0;  // local port on the destination
   std::uint16_t hops = 0;  // links crossed, counted by the routers
   bool traced = false;     // record the route (or the network decides: trace_routes)
+  bool recorded = false;   // its hops go into the run's Recorder (set at injection)
   std::uint64_t id = 0;    // application-defined sequence number
   std::vector<std::byte> payload;
   std::vector<NodeId> route;  // visited nodes, for traced packets only

@@ -9,13 +9,14 @@
 namespace nodes {
 
 PageServer::PageServer(NodeId node, const NodeMemory& memory, csp::In<Packet> requests, Outbox out,
-                       ServerCounters& counters, std::function<void()> before_reply)
+                       ServerCounters& counters, std::function<void()> before_reply, Recorder* recorder)
     : node_(node),
       memory_(memory),
       requests_(std::move(requests)),
       out_(std::move(out)),
       counters_(counters),
-      before_reply_(std::move(before_reply)) {}
+      before_reply_(std::move(before_reply)),
+      recorder_(recorder) {}
 
 void PageServer::run() {
   for (;;) {
@@ -34,6 +35,7 @@ void PageServer::run() {
 }
 
 void PageServer::serve(const Packet& request) {
+  const double start = recorder_ ? recorder_->now() : 0.0;
   const PageRequest r = decode_page_request(request.payload);
   const std::int32_t entry = memory_.entry(r.page);
   if (entry < 0)
@@ -44,6 +46,7 @@ void PageServer::serve(const Packet& request) {
   out_.send(make_packet(request.source, r.reply_port, MessageKind::page_reply, encode_page_reply(r.page, bytes)));
   ++counters_.pages_served;
   counters_.bytes_served += bytes.size();
+  if (recorder_) recorder_->log(node_).serves.push_back({start, recorder_->now(), r.page, request.source});
 }
 
 }  // namespace nodes

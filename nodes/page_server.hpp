@@ -18,6 +18,7 @@
 #include "nodes/messages.hpp"
 #include "nodes/node_memory.hpp"
 #include "nodes/packet.hpp"
+#include "nodes/recorder.hpp"
 
 namespace nodes {
 
@@ -28,8 +29,8 @@ struct ServerCounters {
 
 class PageServer {
  public:
-  PageServer(NodeId node, const NodeMemory& memory, csp::In<Packet> requests, Outbox out,
-             ServerCounters& counters, std::function<void()> before_reply = {});
+  PageServer(NodeId node, const NodeMemory& memory, csp::In<Packet> requests, Outbox out, ServerCounters& counters,
+             std::function<void()> before_reply = {}, Recorder* recorder = nullptr);
   void run();
 
  private:
@@ -41,6 +42,7 @@ class PageServer {
   Outbox out_;
   ServerCounters& counters_;
   std::function<void()> before_reply_;  // virtual time charges the handler here
+  Recorder* recorder_;                  // set: each request served goes into the node's log
 };
 
 }  // namespace nodes

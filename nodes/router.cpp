@@ -21,13 +21,13 @@ void HopSummary::merge(const HopSummary& other) {
   max_hops = std::max(max_hops, other.max_hops);
 }
 
-Router::Router(topology::Topology topology, NodeId self, RouterEnds ends, RouterConfig config,
-               RouterCounters& counters)
+Router::Router(topology::Topology topology, NodeId self, RouterEnds ends, RouterConfig config, RouterCounters& counters)
     : topology_(std::move(topology)),
       self_(self),
       ends_(std::move(ends)),
       config_(config),
       counters_(counters),
+      log_(config.recorder ? &config.recorder->log(self) : nullptr),
       link_queues_(ends_.inputs.size()),
       pending_(ends_.inputs.size() + ends_.injections.size()),
       held_for_(ends_.outputs.size(), 0) {
@@ -67,6 +67,7 @@ void Router::receive(std::size_t source, Packet packet) {
   } else {
     ++packet.hops;
     if (packet.traced) packet.route.push_back(self_);
+    if (log_ && packet.recorded) log_->arrived.push_back({packet.id, config_.recorder->now(), 0, packet.hops});
   }
   const std::size_t queue = output_queue(packet);
   // Packets already held back for this output go first.
@@ -86,6 +87,10 @@ void Router::accept_injection(Packet& packet) const {
   packet.traced = packet.traced || take_route_to_trace(packet.kind);
   packet.route.clear();
   if (packet.traced) packet.route.push_back(self_);
+  packet.recorded = log_ && config_.recorder->admit();
+  if (packet.recorded)
+    log_->injected.push_back({packet.id, config_.recorder->now(), packet.destination,
+                              static_cast<std::uint32_t>(packet.payload.size()), packet.kind});
 }
 
 bool Router::take_route_to_trace(std::uint8_t kind) const {
@@ -110,11 +115,16 @@ bool Router::try_send(std::size_t queue, Packet& packet) {
   const bool delivery = queue >= link_queues_;
   const std::uint32_t hops = packet.hops;
   const std::uint8_t kind = packet.kind;
+  const bool recorded = packet.recorded;
+  const std::uint64_t id = packet.id;
+  // Before the write: on another thread the next router may read it at once.
+  const double left_at = log_ && recorded ? config_.recorder->now() : 0.0;
   std::optional<RouteRecord> route;
   if (delivery && packet.traced) route = RouteRecord{packet.id, packet.kind, packet.route};
   if (!ends_.outputs[queue].try_write(packet)) return false;
   ++counters_.sent[queue].packets;
   counters_.sent[queue].bytes += bytes;
+  if (log_) record_sent(recorded, id, static_cast<std::uint16_t>(hops), kind, queue, left_at);
   if (!delivery) {
     ++counters_.forwarded;
     return true;
@@ -124,6 +134,23 @@ bool Router::try_send(std::size_t queue, Packet& packet) {
   counters_.hops_by_kind[kind].add(hops);
   if (route) counters_.routes.push_back(std::move(*route));
   return true;
+}
+
+// Off the hot path: only a recorded run calls it.
+void Router::record_sent(bool recorded, std::uint64_t id, std::uint16_t hops, std::uint8_t kind, std::size_t queue,
+                         double time) {
+  const bool delivery = queue >= link_queues_;
+  if (!recorded) {
+    if (delivery) {
+      ++log_->unrecorded[kind];
+      log_->unrecorded_hops += hops;
+    }
+    return;
+  }
+  if (delivery)
+    log_->delivered.push_back({id, time, hops});
+  else
+    log_->departed.push_back({id, time, static_cast<std::uint32_t>(queue), hops});
 }
 
 void Router::hold(std::size_t source, Packet packet, std::size_t queue) {

@@ -33,8 +33,8 @@
 // cycle through the network with its own injection.
 #pragma once
 
-#include <atomic>
 #include <array>
+#include <atomic>
 #include <cstdint>
 #include <optional>
 #include <vector>
@@ -42,6 +42,7 @@
 #include "csp/csp.hpp"
 #include "nodes/link.hpp"
 #include "nodes/packet.hpp"
+#include "nodes/recorder.hpp"
 #include "topology/topology.hpp"
 
 namespace nodes {
@@ -88,6 +89,9 @@ struct RouterConfig {
   // The packet kinds traced, by kind; null: every kind. Packets of other
   // kinds take no route from routes_to_trace.
   const std::array<bool, 256>* kinds_to_trace = nullptr;
+  // The run's recorder (recorder.hpp), whose log of this node only this
+  // router writes; null: nothing recorded, one branch per packet.
+  Recorder* recorder = nullptr;
 };
 
 class Router {
@@ -105,6 +109,8 @@ class Router {
   void build_alt();
   void receive(std::size_t source, Packet packet);
   void accept_injection(Packet& packet) const;
+  void record_sent(bool recorded, std::uint64_t id, std::uint16_t hops, std::uint8_t kind, std::size_t queue,
+                   double time);
   bool take_route_to_trace(std::uint8_t kind) const;
   bool try_send(std::size_t queue, Packet& packet);
   void hold(std::size_t source, Packet packet, std::size_t queue);
@@ -116,6 +122,7 @@ class Router {
   RouterEnds ends_;
   RouterConfig config_;
   RouterCounters& counters_;
+  NodeLog* log_ = nullptr;   // this node's log when the run is recorded
   std::size_t link_queues_;  // degree * classes; delivery queues follow
   std::vector<std::optional<Pending>> pending_;  // per input, then per injection
   std::vector<std::uint32_t> held_for_;          // per output: pending packets waiting for it

@@ -1,9 +1,11 @@
 #!/usr/bin/env bash
-# Opens the HTML pages vmpray writes (a render's --report page and a sweep's
-# page) in headless Chromium with the network cut off, and fails unless each
+# Opens the HTML pages vmpray writes (a render's --report page, a sweep's
+# page and a --replay page) in headless Chromium with the network cut off, and fails unless each
 # page loads, fetches nothing (no resource but data: URLs), shows every image
 # decoded and not blank, has its tables and SVG figures, raises no script
-# error, and screenshots to something that is not blank.
+# error, and screenshots to something that is not blank. The replay page
+# must also step, and its counters at its end must equal the same run's
+# --stats (packets, hops, page misses, pixels).
 #
 # The page is opened inside a checking page (scripts/browser-check.html)
 # whose script inspects it once it has loaded and writes one line, PASS or
@@ -28,11 +30,13 @@ run_browser() {
     --enable-logging=stderr --v=0 --user-data-dir="$work/profile" "$@"
 }
 
-# check PAGE IMAGES SVGS TABLES: the page and the least it must hold.
+# check PAGE IMAGES SVGS TABLES [REPLAY]: the page and the least it must
+# hold; REPLAY: the counters a replay page must end with.
 check() {
-  local page=$1 images=$2 svgs=$3 tables=$4 name
+  local page=$1 images=$2 svgs=$3 tables=$4 replay=${5:-} name
   name=$(basename "$page" .html)
   local query="page=$(basename "$page")&images=$images&svgs=$svgs&tables=$tables"
+  [[ -n "$replay" ]] && query+="&replay=$replay"
   cp "$here/browser-check.html" "$(dirname "$page")/check-$name.html"
   run_browser --virtual-time-budget=10000 --dump-dom "file://$(dirname "$page")/check-$name.html?$query" \
     >"$work/$name.dom" 2>"$work/$name.log" || true
@@ -53,21 +57,35 @@ check() {
 cd "$work"
 "$vmpray" teapot --width 128 --height 128 --topology mesh:4x4 -q -o teapot.png --report "$work/run.html"
 "$vmpray" sweep nodes --scene teapot:2 --size 16 --nodes 1,2,4 --topology hypercube,ring -q --out "$work/sweep"
+"$vmpray" teapot --width 96 --height 96 --topology torus:4x2 --timing virtual -q -o replay.png \
+  --replay "$work/replay.html" --stats "$work/replay.json"
+# The run's own figures, as the page's counters must end: packets, hops, misses, pixels.
+replay_stats=$(python3 -c '
+import json, sys
+m = json.load(open(sys.argv[1]))["machine"]
+n = m["network"]
+print(",".join(str(v) for v in (n["packets"], round(n["packets"] * n["mean_hops"]), m["svm"]["misses"],
+                                sum(x["pixels"] for x in m["per_node"]))))' "$work/replay.json")
 
 status=0
 check "$work/run.html" 2 2 3 || status=1
 check "$work/sweep/nodes.html" 0 1 1 || status=1
+check "$work/replay.html" 0 0 0 "$replay_stats" || status=1
 
 # The check itself must catch what it is for: each of these pages fails it.
 mkdir "$work/bad"
 sed 's|<img src="[^"]*"|<img src="http://example.invalid/x.png"|' "$work/run.html" >"$work/bad/fetches.html"
 sed 's|</body>|<script>undefined_function();</script></body>|' "$work/run.html" >"$work/bad/throws.html"
 printf '<!DOCTYPE html><html><head><title>x</title></head><body><p> </p></body></html>\n' >"$work/bad/blank.html"
-for bad in fetches throws blank; do
-  if check "$work/bad/$bad.html" 2 2 3 2>/dev/null; then
+# So must a replay whose counters end one packet short of the stats it is held to.
+cp "$work/replay.html" "$work/bad/miscounts.html"
+for bad in fetches throws blank miscounts; do
+  least=(2 2 3) expect=""
+  [[ $bad == miscounts ]] && least=(0 0 0) expect=$(awk -F, -v OFS=, '{ $1 += 1; print }' <<<"$replay_stats")
+  if check "$work/bad/$bad.html" "${least[@]}" "$expect" 2>/dev/null; then
     echo "browser-check: the page that $bad passed the check" >&2
     status=1
   fi
 done
-((status == 0)) && echo "browser-check: the check fails a page that fetches, throws or is blank"
+((status == 0)) && echo "browser-check: the check fails a page that fetches, throws, is blank or miscounts"
 exit $status

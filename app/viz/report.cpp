@@ -158,6 +158,8 @@ std::string html_report(const Report& report) {
   return std::move(page.out);
 }
 
+std::string png_data_url(const tracer::Image& image) { return "data:image/png;base64," + base64(image.png_bytes()); }
+
 std::string shell_quoted(const std::vector<std::string>& words) {
   std::string out;
   for (const std::string& w : words) {

@@ -68,6 +68,9 @@ struct Report {
 // <svg> document, std::runtime_error if an image cannot be encoded.
 std::string html_report(const Report& report);
 
+// The image as a data: URL of its PNG bytes, for pages that stand alone.
+std::string png_data_url(const tracer::Image& image);
+
 // Words as a POSIX shell would need them typed: each word that holds
 // anything but letters, digits and -_./=:,+@% in single quotes.
 std::string shell_quoted(const std::vector<std::string>& words);

@@ -10,7 +10,8 @@
 // with the paper's ask-when-idle protocol (prefetch 0), with every cache
 // holding the whole database (no page traffic), with tiles of 256 pixels
 // (little farming traffic), and with other schedules and pixel orders, down
-// to the paper's farming (dynamic, in scanline order).
+// to the paper's farming (dynamic, in scanline order), and recorded hop by
+// hop for a replay.
 //
 // Every configuration runs REPEATS times, the runs of a comparison
 // interleaved so that load from other work falls on both sides alike; a
@@ -165,8 +166,7 @@ int main(int argc, char** argv) {
   const std::vector<Line> variants{
       {"  as above (affinity, hilbert, grain 16)", {}},
       {"  BVH nodes in depth-first layout", {}, {.bvh_layout = tracer::BvhLayout::depth_first}},
-      {"  prefetch 0 (ask when idle)",
-       [](nodes::MachineOptions& o, const tracer::DatabaseHeader&) { o.prefetch = 0; }},
+      {"  prefetch 0 (ask when idle)", [](nodes::MachineOptions& o, const tracer::DatabaseHeader&) { o.prefetch = 0; }},
       {"  cache = whole database (first-touch misses)",
        [](nodes::MachineOptions& o, const tracer::DatabaseHeader& h) { o.cache_pages = h.page_count; }},
       {"  grain 256", [](nodes::MachineOptions& o, const tracer::DatabaseHeader&) { o.grain = 256; }},
@@ -181,6 +181,8 @@ int main(int argc, char** argv) {
        }},
       {"  static schedule (no farming, no balancing)",
        [](nodes::MachineOptions& o, const tracer::DatabaseHeader&) { o.schedule = nodes::Schedule::static_split; }},
+      {"  recorded for a replay (--replay)",
+       [](nodes::MachineOptions& o, const tracer::DatabaseHeader&) { o.record = true; }},
   };
   std::vector<MachineRun> runs(variants.size());
   for (int r = 0; r < repeats; ++r)
