@@ -223,7 +223,7 @@ Database build_database(const Scene& scene, const BuildOptions& opt) {
     db.stats.bvh_references = refs.prim.size();
     sec[int(Section::bvh_nodes)] = packer.add(bvh.nodes, "BVH node");
   } else {
-    GridBuild g = build_grid(f.bounds, h.bounds, opt.grid_density);
+    GridBuild g = build_grid(f.prims, f.bounds, h.bounds, opt.grid_density);
     reorder(f, g.order);
     db.stats.accel_seconds = seconds_since(t0);
     t0 = Clock::now();

@@ -13,7 +13,8 @@
 //    (`order`), so the primitives of a cell lie side by side in their pages.
 //  - A cell's box is grid_cell_box(parent box, parent dims, its coordinates),
 //    the same float arithmetic in the builder and the tracer; a primitive is
-//    listed in every cell of a level that its box overlaps by grid_cell_range.
+//    listed in every cell of a level that its box overlaps by grid_cell_range
+//    and that the primitive itself may overlap (a conservative test).
 //  - The build is sequential and depends only on its inputs.
 #pragma once
 
@@ -27,7 +28,7 @@ namespace tracer {
 
 inline constexpr std::uint32_t kSubgridThreshold = 8;  // primitives a top cell holds before it is cut
 inline constexpr int kMaxSubgridDim = 64;              // subgrid cells per axis at most
-inline constexpr float kSubgridDensity = 0.5f;         // subgrid cells per primitive of its top cell
+inline constexpr float kSubgridDensity = 1.0f;         // subgrid cells per primitive of its top cell
 
 struct GridBuild {
   int dims[3] = {1, 1, 1};
@@ -39,7 +40,9 @@ struct GridBuild {
 
 // About `density` top cells per primitive, shaped to the box, cut into
 // subgrids where dense; bounds must contain every primitive box.
-GridBuild build_grid(const std::vector<Box3f>& prim_bounds, const Box3f& bounds, float density);
+// prims[i] has box prim_bounds[i].
+GridBuild build_grid(const std::vector<PrimRecord>& prims, const std::vector<Box3f>& prim_bounds, const Box3f& bounds,
+                     float density);
 
 // The cell index range [lo, hi] along each axis overlapped by box b.
 void grid_cell_range(const Box3f& bounds, const int dims[3], const Box3f& b, int lo[3], int hi[3]);
