@@ -531,19 +531,12 @@ bool Tracer::walk_grid(const Box3f& box, const int dims[3], std::uint64_t base, 
                        const RayInverse& inv, std::uint64_t ray_tag, float t_min, float& t_max, Hit* hit,
                        RayStats& stats) {
   GridWalk w = start_walk(box, dims, ray, inv, t_enter);
-  const PageId cells_first_page = header_.section(Section::grid_cells).first_page;
   bool found = false;
   for (;;) {
     ++stats.box_tests;
     const GridCell cell = read<GridCell>(Section::grid_cells, base + static_cast<std::uint64_t>(w.index), stats);
     const int axis =
         w.t_next[0] < w.t_next[1] ? (w.t_next[0] < w.t_next[2] ? 0 : 2) : (w.t_next[1] < w.t_next[2] ? 1 : 2);
-    // The next cell's record is most often in the page just read (cells are
-    // 8 bytes): ask the memory for it now, so that its load waits less once
-    // this cell's primitives are tested. Only a hint, and no page() call.
-    const std::uint64_t next_byte = (base + static_cast<std::uint64_t>(w.index + w.stride[axis])) * sizeof(GridCell);
-    if (cells_first_page + static_cast<PageId>(next_byte >> header_.page_shift) == last_page_)
-      __builtin_prefetch(last_ptr_ + (next_byte & (header_.page_size - 1)));
     if constexpr (Top) {
       if (cell.count & kGridSubgridFlag) {
         int sub[3];
