@@ -223,14 +223,14 @@ Database build_database(const Scene& scene, const BuildOptions& opt) {
     db.stats.bvh_references = refs.prim.size();
     sec[int(Section::bvh_nodes)] = packer.add(bvh.nodes, "BVH node");
   } else {
-    GridBuild g = build_grid(f.bounds, h.bounds, opt.grid_density);
-    if (g.lists.size() >= std::numeric_limits<std::uint32_t>::max())
-      throw DatabaseError("grid too large: more than 2^32 cell references");
+    GridBuild g = build_grid(f.prims, f.bounds, h.bounds, opt.grid_density);
+    reorder(f, g.order);
     db.stats.accel_seconds = seconds_since(t0);
     t0 = Clock::now();
     std::copy(g.dims, g.dims + 3, h.grid_dims);
     db.stats.grid_cells = g.cells.size();
     db.stats.grid_references = g.lists.size();
+    db.stats.grid_subgrids = g.subgrids;
     sec[int(Section::grid_cells)] = packer.add(g.cells, "grid cell");
     sec[int(Section::grid_lists)] = packer.add(g.lists, "grid list");
   }

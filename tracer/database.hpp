@@ -68,7 +68,7 @@ struct BuildOptions {
   std::uint32_t page_size = 1024;  // bytes; a power of two in [256, 65536]
   int bvh_max_leaf = 4;            // primitives per BVH leaf at most
   int bvh_split_depth = 3;         // large triangles split into <= 2^depth references (0: none)
-  float grid_density = 2.0f;       // grid cells per primitive (approximately)
+  float grid_density = 0.25f;      // top grid cells per primitive (approximately; grid.hpp)
   unsigned threads = 1;            // OS threads the build may use (0, 1: the caller's only)
 };
 
@@ -118,12 +118,23 @@ struct BvhNode {
 };
 static_assert(sizeof(BvhNode) == 128);
 
-// A grid cell: `count` primitive ids starting at `first` in the cell-list section.
+// A grid cell: `count` primitive ids starting at `first` in the cell-list
+// section; or, for a top cell with kGridSubgridFlag set in `count`, a subgrid
+// over the cell's box whose cells start at record `first` of the cell section,
+// its dimensions (1..256 each) in count's bits 0-7, 8-15 and 16-23, less one.
 struct GridCell {
   std::uint32_t first;
   std::uint32_t count;
 };
 static_assert(sizeof(GridCell) == 8);
+inline constexpr std::uint32_t kGridSubgridFlag = 1u << 31;
+inline std::uint32_t encode_subgrid(const int dims[3]) {
+  return kGridSubgridFlag | std::uint32_t(dims[0] - 1) | std::uint32_t(dims[1] - 1) << 8 |
+         std::uint32_t(dims[2] - 1) << 16;
+}
+inline void decode_subgrid(std::uint32_t count, int dims[3]) {
+  for (int a = 0; a < 3; ++a) dims[a] = int(count >> (8 * a) & 0xff) + 1;
+}
 
 enum class Section : int { prims, normals, materials, bvh_nodes, grid_cells, grid_lists, count };
 
@@ -170,6 +181,7 @@ struct BuildStats {
   std::uint64_t bvh_references = 0;  // primitive copies in BVH leaves (>= primitives)
   std::uint64_t grid_cells = 0;
   std::uint64_t grid_references = 0;
+  std::uint64_t grid_subgrids = 0;  // top cells cut into a grid of their own
   std::uint64_t payload_bytes = 0;  // record bytes, without page padding
 };
 

@@ -11,13 +11,19 @@
 #include <limits>
 #include <memory>
 
+#include "tracer/grid.hpp"
 #include "tracer/parallel.hpp"
 
 namespace tracer {
 
 Tracer::Tracer(const DatabaseHeader& header, PageSource& pages, TraceOptions options)
-    : header_(header), pages_(pages), options_(options), camera_(header.camera),
-      page_stamp_(header.page_count, 0), stack_(3 * std::size_t{header.bvh_depth} + 4) {}
+    : header_(header),
+      pages_(pages),
+      options_(options),
+      camera_(header.camera),
+      page_stamp_(header.page_count, 0),
+      stack_(3 * std::size_t{header.bvh_depth} + 4),
+      mailbox_(header.accel == Accel::grid ? kMailboxSlots : 0, 0) {}
 
 // ---- Paged reads ----
 
@@ -72,7 +78,12 @@ void Tracer::end_sample(RayStats& stats) {
 template <bool Any>
 bool Tracer::test_prim(std::uint32_t index, const Ray& ray, float t_min, float& t_max, Hit* hit,
                        RayStats& stats) {
-  const PrimRecord p = read<PrimRecord>(Section::prims, index, stats);
+  return test_record<Any>(read<PrimRecord>(Section::prims, index, stats), index, ray, t_min, t_max, hit, stats);
+}
+
+template <bool Any>
+bool Tracer::test_record(const PrimRecord& p, std::uint32_t index, const Ray& ray, float t_min, float& t_max, Hit* hit,
+                         RayStats& stats) {
   ++stats.prim_tests;
   float t = 0, u = 0, v = 0;
   switch (p.kind) {
@@ -366,71 +377,204 @@ bool Tracer::traverse_bvh(const Ray& ray, float t_min, float& t_max_io, Hit* hit
 }
 
 namespace {
-// 3-D DDA state (Amanatides & Woo) for the uniform grid.
+// 3-D DDA state (Amanatides & Woo) for the uniform grid: the cell, its index
+// in the cell section, and per axis the step, the index stride of one step
+// (signed), the distance at which the ray leaves the cell and the distance
+// between two boundaries. All divisions happen here, none in the walk.
 struct GridWalk {
   int cell[3], step[3];
+  std::int64_t index, stride[3];
   float t_next[3], t_delta[3];
 };
 
-GridWalk start_walk(const DatabaseHeader& h, const Ray& ray, const RayInverse& inv, float t) {
+// The walk of a grid of `dims` cells over `box` from the point at distance t.
+GridWalk start_walk(const Box3f& box, const int dims[3], const Ray& ray, const RayInverse& inv, float t) {
   GridWalk w{};
   const Vec3f p = ray.origin + ray.dir * t;
+  const std::int64_t strides[3] = {1, dims[0], std::int64_t{dims[0]} * dims[1]};
+  w.index = 0;
   for (int a = 0; a < 3; ++a) {
-    const float size = (h.bounds.hi[a] - h.bounds.lo[a]) / h.grid_dims[a];
-    const float rel = size > 0 ? (p[a] - h.bounds.lo[a]) / size : 0.0f;
-    w.cell[a] = clamped_int(rel, 0, h.grid_dims[a] - 1);
+    const float size = (box.hi[a] - box.lo[a]) / dims[a];
+    const float rel = size > 0 ? (p[a] - box.lo[a]) / size : 0.0f;
+    w.cell[a] = clamped_int(rel, 0, dims[a] - 1);
+    w.index += w.cell[a] * strides[a];
     const float inf = std::numeric_limits<float>::infinity();
     if (ray.dir[a] > 0) {
       w.step[a] = 1;
-      w.t_next[a] = (h.bounds.lo[a] + (w.cell[a] + 1) * size - ray.origin[a]) * inv.inv_dir[a];
+      w.t_next[a] = (box.lo[a] + (w.cell[a] + 1) * size - ray.origin[a]) * inv.inv_dir[a];
       w.t_delta[a] = size * inv.inv_dir[a];
     } else if (ray.dir[a] < 0) {
       w.step[a] = -1;
-      w.t_next[a] = (h.bounds.lo[a] + w.cell[a] * size - ray.origin[a]) * inv.inv_dir[a];
+      w.t_next[a] = (box.lo[a] + w.cell[a] * size - ray.origin[a]) * inv.inv_dir[a];
       w.t_delta[a] = -size * inv.inv_dir[a];
     } else {
       w.step[a] = 0;
       w.t_next[a] = inf;
       w.t_delta[a] = inf;
     }
+    w.stride[a] = w.step[a] * strides[a];
   }
   return w;
 }
 }  // namespace
 
+inline std::uint64_t Tracer::next_ray_tag() {
+  if (++ray_id_ == 0) {  // wrapped: no slot may still hold a tag of this id
+    std::fill(mailbox_.begin(), mailbox_.end(), 0);
+    ray_id_ = 1;
+  }
+  return std::uint64_t{ray_id_} << 32;
+}
+
+// A cell's primitives, read from the cell-list section in runs that lie in
+// one page (copied out before the primitives' pages are read), each skipped
+// if the mailbox says this ray tested it already, triangles tested four at a
+// time from records copied out of their pages. The order of the tests is the
+// list's, so among hits at equal distance the first listed wins, as when
+// testing one by one.
 template <bool Any>
-bool Tracer::traverse_grid(const Ray& ray, float t_min, float& t_max, Hit* hit, RayStats& stats) {
-  const RayInverse inv(ray);
-  const auto entry = intersect_box(ray, inv, header_.bounds, t_min, t_max);
-  if (!entry) return false;
-  GridWalk w = start_walk(header_, ray, inv, *entry);
-  const int* dims = header_.grid_dims;
-  for (;;) {
-    ++stats.box_tests;
-    const std::uint64_t index =
-        w.cell[0] + std::uint64_t(dims[0]) * (w.cell[1] + std::uint64_t(dims[1]) * w.cell[2]);
-    const GridCell cell = read<GridCell>(Section::grid_cells, index, stats);
-    const int axis = w.t_next[0] < w.t_next[1] ? (w.t_next[0] < w.t_next[2] ? 0 : 2)
-                                               : (w.t_next[1] < w.t_next[2] ? 1 : 2);
-    // Only hits inside this cell count: a later cell may hold a nearer one.
-    float limit = std::min(t_max, w.t_next[axis]);
-    bool found = false;
-    for (std::uint32_t k = 0; k < cell.count; ++k) {
-      const auto prim = read<std::uint32_t>(Section::grid_lists, cell.first + std::uint64_t{k}, stats);
-      if (test_prim<Any>(prim, ray, t_min, limit, hit, stats)) {
+bool Tracer::test_cell(const GridCell& cell, std::uint64_t ray_tag, const Ray& ray, float t_min, float& t_max, Hit* hit,
+                       RayStats& stats) {
+  const SectionLayout& lists = header_.section(Section::grid_lists);
+  const SectionLayout& prims = header_.section(Section::prims);
+  const std::uint32_t page_shift = header_.page_shift;
+  const std::uint64_t offset_mask = header_.page_size - 1;
+  constexpr std::size_t kRun = 64;
+  std::uint32_t ids[kRun];
+  // Up to four triangles copied out of their pages, 16-byte aligned for the
+  // four-wide test's row loads.
+  alignas(16) std::byte batch[4][sizeof(PrimRecord)];
+  std::uint32_t batch_ids[4];
+  std::uint32_t in_batch = 0;
+  bool found = false;
+  const auto flush = [&]() -> bool {
+    if (in_batch == 0) return false;
+    const std::byte* lane[4];
+    for (std::uint32_t k = 0; k < 4; ++k) lane[k] = batch[std::min(k, in_batch - 1)];
+    Float4 t, u, v;
+    const unsigned mask = triangles4(lane, in_batch, ray, t_min, t_max, t, u, v);
+    const std::uint32_t count = in_batch;
+    in_batch = 0;
+    if (Any) {
+      stats.prim_tests += mask ? std::countr_zero(mask) + 1 : count;
+      return mask != 0;
+    }
+    stats.prim_tests += count;
+    if (!mask) return false;
+    int best = std::countr_zero(mask);
+    for (unsigned m = mask & (mask - 1); m; m &= m - 1) {
+      const int l = std::countr_zero(m);
+      if (t[l] < t[best]) best = l;
+    }
+    t_max = t[best];
+    hit->t = t[best], hit->u = u[best], hit->v = v[best];
+    hit->prim_index = batch_ids[best];
+    std::memcpy(&hit->prim, batch[best], sizeof(PrimRecord));
+    return true;
+  };
+  for (std::uint32_t k = 0; k < cell.count;) {
+    const std::uint64_t byte = (std::uint64_t{cell.first} + k) * sizeof(std::uint32_t);
+    const std::size_t run = std::min<std::uint64_t>(
+        {cell.count - k, kRun, (header_.page_size - (byte & offset_mask)) / sizeof(std::uint32_t)});
+    std::memcpy(ids, fetch(lists.first_page + static_cast<PageId>(byte >> page_shift), stats) + (byte & offset_mask),
+                run * sizeof(std::uint32_t));
+    stats.record_reads += run;
+    k += static_cast<std::uint32_t>(run);
+    for (std::size_t i = 0; i < run; ++i) {
+      const std::uint32_t id = ids[i];
+      std::uint64_t& slot = mailbox_[id & (kMailboxSlots - 1)];
+      if (slot == (ray_tag | id)) continue;  // tested by this ray in an earlier cell
+      slot = ray_tag | id;
+      const std::uint64_t at = std::uint64_t{id} * sizeof(PrimRecord);
+      const std::byte* rec =
+          fetch(prims.first_page + static_cast<PageId>(at >> page_shift), stats) + (at & offset_mask);
+      ++stats.record_reads;
+      std::uint32_t kind;
+      std::memcpy(&kind, rec + offsetof(PrimRecord, kind), sizeof kind);
+      if (kind <= std::uint32_t(PrimKind::smooth_triangle)) {
+        std::memcpy(batch[in_batch], rec, sizeof(PrimRecord));
+        batch_ids[in_batch++] = id;
+        if (in_batch < 4) continue;
+        if (flush()) {
+          if (Any) return true;
+          found = true;
+        }
+        continue;
+      }
+      PrimRecord p;
+      std::memcpy(&p, rec, sizeof p);
+      if (flush()) {  // the triangles listed before it go first
+        if (Any) return true;
+        found = true;
+      }
+      if (test_record<Any>(p, id, ray, t_min, t_max, hit, stats)) {
         if (Any) return true;
         found = true;
       }
     }
-    if (found) {
-      t_max = limit;
-      return true;
+  }
+  if (flush()) {
+    if (Any) return true;
+    found = true;
+  }
+  return found;
+}
+
+// The walk keeps the nearest hit of the cells met so far and stops at the
+// first cell the ray leaves beyond it: a primitive spans several cells, so a
+// hit found in one cell may lie in a later one, where a primitive met there
+// could be nearer; with the mailbox each primitive is tested once a ray. A
+// top cell holding a subgrid is walked the same way from where the ray
+// enters it (Top = false: a subgrid holds no subgrid).
+template <bool Any, bool Top>
+bool Tracer::walk_grid(const Box3f& box, const int dims[3], std::uint64_t base, float t_enter, const Ray& ray,
+                       const RayInverse& inv, std::uint64_t ray_tag, float t_min, float& t_max, Hit* hit,
+                       RayStats& stats) {
+  GridWalk w = start_walk(box, dims, ray, inv, t_enter);
+  bool found = false;
+  for (;;) {
+    ++stats.box_tests;
+    const GridCell cell = read<GridCell>(Section::grid_cells, base + static_cast<std::uint64_t>(w.index), stats);
+    const int axis =
+        w.t_next[0] < w.t_next[1] ? (w.t_next[0] < w.t_next[2] ? 0 : 2) : (w.t_next[1] < w.t_next[2] ? 1 : 2);
+    if constexpr (Top) {
+      if (cell.count & kGridSubgridFlag) {
+        int sub[3];
+        decode_subgrid(cell.count, sub);
+        if (walk_grid<Any, false>(grid_cell_box(box, dims, w.cell), sub, cell.first, t_enter, ray, inv, ray_tag, t_min,
+                                  t_max, hit, stats)) {
+          found = true;
+          if (Any) return true;
+        }
+      } else if (cell.count != 0 && test_cell<Any>(cell, ray_tag, ray, t_min, t_max, hit, stats)) {
+        found = true;
+        if (Any) return true;
+      }
+    } else if (cell.count != 0 && test_cell<Any>(cell, ray_tag, ray, t_min, t_max, hit, stats)) {
+      found = true;
+      if (Any) return true;
     }
-    if (w.t_next[axis] > t_max) return false;
+    // Every later cell begins at t_next[axis] or beyond, and a hit must be
+    // nearer than t_max.
+    if (w.t_next[axis] >= t_max) return found;
     w.cell[axis] += w.step[axis];
-    if (w.cell[axis] < 0 || w.cell[axis] >= dims[axis]) return false;
+    if (w.cell[axis] < 0 || w.cell[axis] >= dims[axis]) return found;
+    w.index += w.stride[axis];
+    t_enter = w.t_next[axis];
     w.t_next[axis] += w.t_delta[axis];
   }
+}
+
+template <bool Any>
+bool Tracer::traverse_grid(const Ray& ray, float t_min, float& t_max_io, Hit* hit, RayStats& stats) {
+  const RayInverse inv(ray);
+  const auto entry = intersect_box(ray, inv, header_.bounds, t_min, t_max_io);
+  if (!entry) return false;
+  float t_max = t_max_io;
+  const bool found = walk_grid<Any, true>(header_.bounds, header_.grid_dims, 0, *entry, ray, inv, next_ray_tag(), t_min,
+                                          t_max, hit, stats);
+  if (found) t_max_io = t_max;
+  return found;
 }
 
 std::optional<Hit> Tracer::closest_hit(const Ray& ray, float t_min, float t_max, RayStats& stats) {

@@ -84,6 +84,17 @@ class Tracer {
   template <bool Any> bool test_run(std::uint32_t first, std::uint32_t count, const Ray& ray, float t_min,
                                      float& t_max, Hit* hit, RayStats& stats);
   template <bool Any> bool test_prim(std::uint32_t index, const Ray& ray, float t_min, float& t_max, Hit* hit, RayStats& stats);
+  template <bool Any>
+  bool test_record(const PrimRecord& p, std::uint32_t index, const Ray& ray, float t_min, float& t_max, Hit* hit,
+                   RayStats& stats);
+  // A grid cell's primitives, each tested at most once per ray (the mailbox).
+  template <bool Any>
+  bool test_cell(const GridCell& cell, std::uint64_t ray_tag, const Ray& ray, float t_min, float& t_max, Hit* hit,
+                 RayStats& stats);
+  template <bool Any, bool Top>
+  bool walk_grid(const Box3f& box, const int dims[3], std::uint64_t base, float t_enter, const Ray& ray,
+                 const RayInverse& inv, std::uint64_t ray_tag, float t_min, float& t_max, Hit* hit, RayStats& stats);
+  std::uint64_t next_ray_tag();
 
   // Shading (shading.cpp).
   Color shade(const Ray& ray, int depth, float weight, RayStats& stats);
@@ -106,6 +117,13 @@ class Tracer {
     float t;
   };
   std::vector<StackEntry> stack_;
+  // Grid mailbox: slot (id mod kMailboxSlots) holds (ray id << 32 | id) of the
+  // last primitive put there, so a ray tests a primitive listed in several
+  // cells once (a collision only costs a second test). Per tracer, never in
+  // the shared pages; empty for a BVH database.
+  static constexpr std::size_t kMailboxSlots = 1024;
+  std::vector<std::uint64_t> mailbox_;
+  std::uint32_t ray_id_ = 0;
 };
 
 // Renders a whole frame sequentially into row-major pixels (y = 0 at the top);

@@ -8,6 +8,9 @@
 //  - the paging overhead: the 1 KB paged render against direct access, the
 //    database as one contiguous array with 64 KB pages (page() is then one add,
 //    with no table, and is called least often), same rays, checked same image.
+//  - the paper's uniform grid on the same rays, primary + shadow and Whitted,
+//    its runs alternating with the BVH's, and the grid's time over the BVH's
+//    (checked same image); `--grid` runs this comparison alone.
 // Then the time to triangulate concave polygons (toothed wheels) of growing
 // size.
 // Times are thread CPU seconds, so other processes on the machine skew them less.
@@ -171,13 +174,53 @@ Workload embree_primary_shadow(const tracer::Database& db) {
 }
 #endif
 
-void bench_scene(const std::string& spec) {
+// The grid against the BVH on the same rays: each workload's fastest of
+// kRepeats runs, the two structures alternating.
+float grid_density = tracer::BuildOptions{}.grid_density;  // --density D
+
+void bench_grid(const tracer::Scene& scene, const tracer::Database& bvh) {
+  const tracer::Database grid =
+      build_database(scene, {.accel = tracer::Accel::grid, .page_size = 1024, .grid_density = grid_density});
+  const int* dims = grid.header.grid_dims;
+  std::printf(
+      "  grid %dx%dx%d top cells, %llu subgrids, %llu cells, %.2f references per primitive, build %.3f s, "
+      "%u pages (%.0f KB)\n",
+      dims[0], dims[1], dims[2], static_cast<unsigned long long>(grid.stats.grid_subgrids),
+      static_cast<unsigned long long>(grid.stats.grid_cells),
+      double(grid.stats.grid_references) / double(grid.header.primitive_count), grid.stats.accel_seconds,
+      grid.header.page_count, grid.header.bytes() / 1024.0);
+  Workload bvh_ps, grid_ps, bvh_w, grid_w;
+  std::vector<tracer::Color> bvh_image, grid_image;
+  for (int rep = 0; rep < kRepeats; ++rep) {
+    bvh_ps = faster(bvh_ps, vmpray_primary_shadow(bvh));
+    grid_ps = faster(grid_ps, vmpray_primary_shadow(grid));
+    bvh_w = faster(bvh_w, vmpray_whitted(bvh, nullptr, &bvh_image));
+    grid_w = faster(grid_w, vmpray_whitted(grid, nullptr, &grid_image));
+  }
+  std::printf("  grid vs BVH     primary+shadow grid %6.2f  BVH %6.2f Mrays/s  time grid/BVH %.2f\n", grid_ps.mrays(),
+              bvh_ps.mrays(), grid_ps.seconds / bvh_ps.seconds);
+  std::printf("                  whitted        grid %6.2f  BVH %6.2f Mrays/s  time grid/BVH %.2f  %s\n",
+              grid_w.mrays(), bvh_w.mrays(), grid_w.seconds / bvh_w.seconds,
+              grid_image == bvh_image ? "same image" : "IMAGES DIFFER");
+  for (const tracer::Database* db : {&grid, &bvh}) {
+    tracer::InMemoryPageSource pages(*db);
+    tracer::RayStats stats;
+    tracer::render_frame(db->header, pages, {}, stats);
+    const double rays = double(stats.rays());
+    std::printf("                  %s per ray: %.1f %s, %.1f primitive tests, %.1f page() calls\n",
+                db == &grid ? "grid" : "BVH ", double(stats.box_tests) / rays, db == &grid ? "cells" : "boxes",
+                double(stats.prim_tests) / rays, double(stats.page_calls) / rays);
+  }
+}
+
+void bench_scene(const std::string& spec, bool grid_only) {
   tracer::Scene scene = tracer::generate_scene(spec);
   scene.camera.width = scene.camera.height = 512;
   const tracer::Database db = build_database(scene, {.page_size = 1024});
   std::printf("%-9s %8llu prims  BVH build %.3f s  %6u pages (%.0f KB)\n", spec.c_str(),
               static_cast<unsigned long long>(db.header.primitive_count), db.stats.accel_seconds,
               db.header.page_count, db.header.bytes() / 1024.0);
+  if (grid_only) return bench_grid(scene, db);
   // Alternate the two tracers and keep each one's fastest run, so a burst of
   // load from other processes skews one side less.
   Workload ours;
@@ -218,6 +261,7 @@ void bench_scene(const std::string& spec) {
   std::printf("  whitted direct  vmpray %6.2f Mrays/s  paging overhead (1 KB paged / direct time) %.3f  %s\n",
               d.mrays(), whitted.seconds / d.seconds,
               direct_image == paged_image ? "same image" : "IMAGES DIFFER");
+  bench_grid(scene, db);
 }
 
 // A wheel of `teeth` trapezoid teeth (radii 1 and 0.8), counter-clockwise
@@ -254,8 +298,18 @@ void bench_triangulation() {
 }  // namespace
 
 int main(int argc, char** argv) {
-  std::vector<std::string> scenes = {"teapot", "mountain", "rings4", "tetra9"};
-  if (argc > 1) scenes.assign(argv + 1, argv + argc);
-  for (const auto& s : scenes) bench_scene(s);
-  bench_triangulation();
+  // tracer_bench [--grid] [--density CELLS_PER_PRIMITIVE] [SCENE...]
+  std::vector<std::string> scenes;
+  bool grid_only = false;
+  for (int i = 1; i < argc; ++i) {
+    if (std::string(argv[i]) == "--grid")
+      grid_only = true;
+    else if (std::string(argv[i]) == "--density" && i + 1 < argc)
+      grid_density = std::stof(argv[++i]);
+    else
+      scenes.push_back(argv[i]);
+  }
+  if (scenes.empty()) scenes = {"teapot", "mountain", "rings4", "tetra9"};
+  for (const auto& s : scenes) bench_scene(s, grid_only);
+  if (!grid_only) bench_triangulation();
 }

@@ -53,11 +53,25 @@ void expect_consistent(const Database& db) {
   } else {
     const auto& cells = h.section(Section::grid_cells);
     const auto& lists = h.section(Section::grid_lists);
-    EXPECT_EQ(cells.record_count, std::uint32_t(h.grid_dims[0] * h.grid_dims[1] * h.grid_dims[2]));
+    // The top cells, then each subgrid's cells once, right after the cells before it.
+    const std::uint32_t top = std::uint32_t(h.grid_dims[0] * h.grid_dims[1] * h.grid_dims[2]);
+    std::uint64_t next_subgrid = top;
     for (std::uint32_t i = 0; i < cells.record_count; ++i) {
       const auto c = record<GridCell>(db, Section::grid_cells, i);
+      if (c.count & kGridSubgridFlag) {
+        ASSERT_LT(i, top) << "a subgrid inside a subgrid";
+        int dims[3];
+        decode_subgrid(c.count, dims);
+        EXPECT_EQ(c.first, next_subgrid);
+        next_subgrid += std::uint64_t(dims[0]) * dims[1] * dims[2];
+        continue;
+      }
       EXPECT_LE(std::uint64_t{c.first} + c.count, lists.record_count);
+      for (std::uint32_t k = 1; k < c.count; ++k)
+        EXPECT_LT(record<std::uint32_t>(db, Section::grid_lists, c.first + k - 1),
+                  record<std::uint32_t>(db, Section::grid_lists, c.first + k));
     }
+    EXPECT_EQ(next_subgrid, cells.record_count);
     for (std::uint32_t i = 0; i < lists.record_count; ++i)
       EXPECT_LT(record<std::uint32_t>(db, Section::grid_lists, i), prims.record_count);
   }

@@ -6,14 +6,16 @@
 #include <gtest/gtest.h>
 #include <zlib.h>
 
+#include <charconv>
 #include <cmath>
 #include <cstdint>
 #include <istream>
 #include <ostream>
-#include <streambuf>
 #include <sstream>
+#include <streambuf>
 #include <string>
 #include <utility>
+#include <vector>
 
 #include "scene_stats.hpp"
 
@@ -363,6 +365,56 @@ TEST(NffError, ATokenLongerThan1024BytesNamesItsLine) {
   } catch (const SceneError& e) {
     EXPECT_EQ(std::string(e.what()).rfind("t.nff:2: expected a token of at most 1024 bytes, got '1111", 0), 0u)
         << e.what();
+  }
+}
+
+// Plain decimals are read by a shortcut of their own; every number must come
+// out as std::from_chars reads it, bit for bit, on both sides of the
+// shortcut's limits (15 significant digits, a point with digits on both sides).
+TEST(Nff, NumbersAreReadAsFromCharsReadsThem) {
+  const std::vector<std::string> numbers = {"-0.996094",
+                                            "0.1",
+                                            "1",
+                                            "-0",
+                                            "0.000000000000001",
+                                            "123456789012345",
+                                            "1234567890123456",
+                                            "9007199254740993",
+                                            "0.30000000000000004",
+                                            "5.",
+                                            ".5",
+                                            "-.5",
+                                            "1e3",
+                                            "2.5E-3",
+                                            "00000000000000000001.5",
+                                            "3.141592653589793",
+                                            "-999999999999999.9",
+                                            "0.123456789012345"};
+  for (const std::string& n : numbers) {
+    const Scene s = parse_nff("s " + n + " 0 0 1\n", "t.nff");
+    const double got = std::get<Sphere>(s.objects[0].shape).center.x;
+    double want = 0;
+    const std::string_view digits = n;
+    std::from_chars(digits.data(), digits.data() + digits.size(), want);
+    EXPECT_EQ(std::signbit(got), std::signbit(want)) << n;
+    EXPECT_EQ(got, want) << n;
+  }
+}
+
+// The input is read in chunks of 256 KB: a token cut by a chunk's end, at
+// every offset across it, reads as the whole token.
+TEST(NffStream, TokensCutByAChunkEndReadWhole) {
+  constexpr std::size_t kChunk = std::size_t{1} << 18;
+  const std::string sphere = "s 0.125 -2.5 3.75 1.0625\n";
+  for (std::size_t back = 1; back <= sphere.size(); ++back) {
+    const std::string text = std::string(kChunk - back, ' ') + sphere;
+    const Scene s = parse_nff(text, "t.nff");
+    ASSERT_EQ(s.objects.size(), 1u) << back;
+    const Sphere& got = std::get<Sphere>(s.objects[0].shape);
+    EXPECT_EQ(got.center.x, 0.125) << back;
+    EXPECT_EQ(got.center.y, -2.5) << back;
+    EXPECT_EQ(got.center.z, 3.75) << back;
+    EXPECT_EQ(got.radius, 1.0625) << back;
   }
 }
 
