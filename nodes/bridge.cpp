@@ -159,20 +159,42 @@ void Bridge::carry() {
     alt_.enable(timeout_guards_[level_], true);
     const std::size_t guard = alt_.select();
     if (guard >= guard_owner_.size()) continue;  // a timeout: poll the wire
-    const auto [is_outgoing, index] = guard_owner_[guard];
-    if (!is_outgoing) continue;  // room in a local input: delivered at the top
     try {
-      take_outgoing(outgoing_[index]);
-      last_active_ = std::chrono::steady_clock::now();
+      if (take(guard)) {
+        take_ready();
+        // Sent now rather than after the next select: the receiver may be idle.
+        send_frames();
+        transport_.progress();
+        last_active_ = std::chrono::steady_clock::now();
+      }
     } catch (const csp::Poisoned&) {
       stop();
     }
   }
 }
 
+// What a ready guard offers: the packets of an outgoing link (true), or room
+// in a local input, into which the staged packets go at once.
+bool Bridge::take(std::size_t guard) {
+  const auto [is_outgoing, index] = guard_owner_[guard];
+  if (!is_outgoing) {
+    deliver_staged();
+    return false;
+  }
+  take_outgoing(outgoing_[index]);
+  return true;
+}
+
+// Everything else ready after a wake, so that the packets of several links
+// that became ready together leave in one message per rank, not one each.
+void Bridge::take_ready() {
+  while (const std::optional<std::size_t> guard = alt_.poll())
+    if (*guard < guard_owner_.size()) take(*guard);
+}
+
 // Reads what the guard found and whatever else the link holds, while the
 // credits last, into the frame for the link's rank.
-bool Bridge::take_outgoing(Outgoing& out) {
+void Bridge::take_outgoing(Outgoing& out) {
   WireWriter& w = frame(out.peer);
   std::optional<Packet> packet = out.queue.read();
   while (packet) {
@@ -189,10 +211,6 @@ bool Bridge::take_outgoing(Outgoing& out) {
     }
     packet = out.queue.try_read();
   }
-  // Sent now rather than after the next select: the receiver may be idle.
-  send_frames();
-  transport_.progress();
-  return true;
 }
 
 bool Bridge::receive_all() {

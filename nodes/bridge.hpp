@@ -28,6 +28,8 @@
 // tens of microseconds, not a sleep. Once all is quiet it waits twice as
 // long each time, up to 1 ms, so a rank with nothing to do sleeps instead
 // of spinning a core; any packet sent toward another rank wakes it at once.
+// A wake takes everything then ready on every link (Alt::poll) before it
+// sends, so the packets and credits of one wake reach a rank as one message.
 //
 // Orderly end: the machine's protocol ends with nothing in flight, and then
 // rank 0 shuts its network down. A bridge that sees its network shut down,
@@ -109,7 +111,9 @@ class Bridge {
   bool receive_all();
   void receive(int from, const Bytes& frame);
   bool deliver_staged();
-  bool take_outgoing(Outgoing& out);
+  bool take(std::size_t guard);
+  void take_ready();
+  void take_outgoing(Outgoing& out);
   void queue_credits();
   void post_frame(int peer);
   void send_frames();
