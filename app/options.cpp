@@ -145,7 +145,7 @@ void check_machine(Options& o, const Raw& raw, const po::variables_map& vm) {
   m.prefetch = farming.prefetch;
   m.schedule = farming.schedule;
   m.pixel_order = farming.pixel_order;
-  m.workers_per_node = in_range<int>(raw.workers, 1, 64, "--workers-per-node");
+  m.workers_per_node = as_field<int>(raw.workers, "--workers-per-node");
   m.trace_routes = in_range<std::uint64_t>(raw.trace_routes, 0, 1 << 20, "--trace-routes");
   if (vm.count("trace-kind")) {
     if (m.trace_routes == 0) throw UsageError("--trace-kind: chooses the packets --trace-routes N traces; give that too");
@@ -256,8 +256,9 @@ DatabaseChoice parse_database(const SharedChoice& c) {
 
 FarmingChoice parse_farming(const SharedChoice& c, const po::variables_map& vm) {
   FarmingChoice f;
-  f.grain = in_range<std::uint32_t>(c.grain, 1, 1 << 20, "--grain");
-  f.prefetch = in_range<std::uint16_t>(c.prefetch, 0, nodes::max_prefetch(nodes::MachineOptions{}), "--prefetch");
+  // Their bounds are the machine's (nodes::check_options, called by the parsers).
+  f.grain = as_field<std::uint32_t>(c.grain, "--grain");
+  f.prefetch = as_field<std::uint16_t>(c.prefetch, "--prefetch");
   f.schedule = parse_schedule(c.schedule);
   f.pixel_order = parse_pixel_order(c.pixel_order);
   check_grain(f.schedule, vm.count("grain") && !vm["grain"].defaulted());

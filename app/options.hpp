@@ -6,7 +6,9 @@
 
 #include <boost/program_options/options_description.hpp>
 #include <boost/program_options/variables_map.hpp>
+#include <algorithm>
 #include <cstdint>
+#include <limits>
 #include <stdexcept>
 #include <string>
 
@@ -87,6 +89,18 @@ T in_range(std::int64_t v, std::int64_t lo, std::int64_t hi, const char* option)
   if (v < lo || v > hi)
     throw UsageError(std::string(option) + ": expected " + std::to_string(lo) + ".." + std::to_string(hi) +
                      ", got " + std::to_string(v));
+  return static_cast<T>(v);
+}
+
+// v as a T when a T can hold it, for a field whose bounds the library below
+// checks (nodes::check_options); else UsageError "OPTION: must not be
+// negative, got v" (or "is too large").
+template <class T>
+T as_field(std::int64_t v, const char* option) {
+  if (v < static_cast<std::int64_t>(std::numeric_limits<T>::min()))
+    throw UsageError(std::string(option) + ": must not be negative, got " + std::to_string(v));
+  if (static_cast<std::uint64_t>(v) > static_cast<std::uint64_t>(std::numeric_limits<T>::max()))
+    throw UsageError(std::string(option) + ": is too large, got " + std::to_string(v));
   return static_cast<T>(v);
 }
 

@@ -13,6 +13,7 @@
 #include <thread>
 
 #include "app/cpu_count.hpp"
+#include "app/machine_run.hpp"
 #include "app/memory_check.hpp"
 #include "app/output_check.hpp"
 #include "app/options.hpp"
@@ -132,6 +133,17 @@ void check_sweep(SweepOptions& o, const RawSweep& raw, const po::variables_map& 
       }
       check_grid_shape(topology, n);
     }
+  // The machine's own rules for what every run shares, before the first run.
+  nodes::MachineOptions machine;
+  machine.grain = o.grain;
+  machine.prefetch = o.prefetch;
+  machine.schedule = o.schedule;
+  machine.pixel_order = o.pixel_order;
+  try {
+    nodes::check_options(machine, o.page_size);
+  } catch (const nodes::OptionError& e) {
+    throw usage_error(e);
+  }
   o.out_dir = raw.out.empty() ? "sweep-" + raw.kind : raw.out;
   // Found out now rather than after the runs, when the tables are written.
   check_writable_directory("--out", o.out_dir);

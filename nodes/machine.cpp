@@ -55,12 +55,14 @@ std::unique_ptr<NodeState> node_state(const PagePlacement& placement, int n, std
 
 // The rules of the fields that need no database.
 void check_fields(const MachineOptions& options) {
-  const auto at_least_one = [](const char* field, std::uint64_t value) {
+  const auto within = [](const char* field, std::int64_t value, std::int64_t hi) {
     if (value < 1) throw OptionError(field, "must be at least 1, got " + std::to_string(value));
+    if (value > hi) throw OptionError(field, "must be at most " + std::to_string(hi) + ", got " + std::to_string(value));
   };
-  at_least_one("workers_per_node", static_cast<std::uint64_t>(std::max(options.workers_per_node, 0)));
-  at_least_one("grain", options.grain);
-  at_least_one("buffer_capacity", options.buffer_capacity);
+  within("workers_per_node", options.workers_per_node, max_workers_per_node);
+  within("grain", options.grain, max_grain);
+  within("buffer_capacity", static_cast<std::int64_t>(std::min<std::size_t>(options.buffer_capacity, INT64_MAX)),
+         INT64_MAX);
   if (options.prefetch > max_prefetch(options))
     throw OptionError("prefetch", "must be at most " + std::to_string(max_prefetch(options)) + ", got " +
                                       std::to_string(options.prefetch) +

@@ -74,13 +74,13 @@ struct MachineOptions {
   bool shared_cores = false;           // other processes share the cores (csp::RuntimeOptions::shared_cores)
   std::optional<std::uint32_t> cache_pages;  // remote pages cached per node
   std::optional<std::uint64_t> cache_kb;     // the same in KB; default (neither): default_cache_pages()
-  std::uint32_t grain = 16;            // items per tile: balance vs farming traffic
+  std::uint32_t grain = 16;            // items per tile (1..max_grain): balance vs farming traffic
   // Each processor's own compact patch first: the fewest page misses and
   // farming messages (the paper: dynamic, scanline).
   Schedule schedule = Schedule::affinity;
   PixelOrder pixel_order = PixelOrder::hilbert;  // how items are numbered, so where a tile lies
-  int workers_per_node = 1;
-  std::uint16_t prefetch = 1;          // tiles a worker has asked for beyond the one it traces
+  int workers_per_node = 1;            // 1..max_workers_per_node
+  std::uint16_t prefetch = 1;          // tiles a worker has asked for beyond the one it traces (..max_prefetch)
   Distribution distribution = Distribution::modulo;
   std::uint64_t trace_routes = 0;      // record the routes of the first N packets
   std::vector<std::uint8_t> trace_kinds;  // of these MessageKinds only (empty: every kind)
@@ -92,6 +92,12 @@ struct MachineOptions {
   std::optional<CostModel> timing;     // virtual time under this model (the run takes one thread)
   Progress progress;                   // called by the collector (on its thread): at 0 as it starts, then per result
 };
+
+// The bounds check_options() holds the fields to: a tile of at most a
+// million pixels, and at most 64 pixel computers on one node (each is a
+// process with its own stack and port).
+constexpr std::uint32_t max_grain = 1u << 20;
+constexpr int max_workers_per_node = 64;
 
 // The most tiles a worker may keep asked for ahead: its answers and a page
 // reply must fit the network's delivery buffer (see the buffer bounds above).

@@ -100,6 +100,21 @@ TEST(Options, AnExplicitZeroSizeOrTessellationIsAnError) {
   EXPECT_EQ(o.tessellate, 64);
 }
 
+// The machine's bounds are its own (nodes::check_options); the parser only
+// refuses what the field's type cannot hold, and names the option either way.
+TEST(Options, TheMachinesBoundsAreCheckedByTheMachine) {
+  EXPECT_EQ(error_of({"--grain", "0"}), "--grain: must be at least 1, got 0");
+  EXPECT_EQ(error_of({"--grain", "-3"}), "--grain: must not be negative, got -3");
+  EXPECT_EQ(error_of({"--workers-per-node", "0"}), "--workers-per-node: must be at least 1, got 0");
+  EXPECT_EQ(error_of({"--workers-per-node", "65"}), "--workers-per-node: must be at most 64, got 65");
+  EXPECT_EQ(error_of({"--workers-per-node", "3000000000"}), "--workers-per-node: is too large, got 3000000000");
+  EXPECT_EQ(error_of({"--prefetch", "4"}).rfind("--prefetch: must be at most 3, got 4", 0), 0u);
+  const Options o = parse({"--grain", "1048576", "--workers-per-node", "64", "--prefetch", "3"});
+  EXPECT_EQ(o.machine.grain, nodes::max_grain);
+  EXPECT_EQ(o.machine.workers_per_node, nodes::max_workers_per_node);
+  EXPECT_EQ(o.machine.prefetch, 3);
+}
+
 // --single has no machine to give these to; ignoring them would mislead.
 TEST(Options, MachineOptionsWithSingleAreErrors) {
   for (const char* option : {"--nodes", "--cache-pages", "--grain", "--trace-routes"})

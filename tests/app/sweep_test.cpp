@@ -84,8 +84,12 @@ TEST(SweepOptions, BadValuesNameTheOption) {
       {{"nodes", "--schedule", "guided"}, "--schedule"},
       {{"nodes", "--pixel-order", "zorder"}, "--pixel-order"},
       // Negative numbers must not wrap around into huge unsigned values.
-      {{"nodes", "--grain", "-1"}, "--grain: expected 1..1048576, got -1"},
-      {{"nodes", "--prefetch", "-1"}, "--prefetch: expected 0..3, got -1"},
+      {{"nodes", "--grain", "-1"}, "--grain: must not be negative, got -1"},
+      {{"nodes", "--prefetch", "-1"}, "--prefetch: must not be negative, got -1"},
+      // The machine's bounds, checked by the machine's own rules.
+      {{"nodes", "--grain", "0"}, "--grain: must be at least 1, got 0"},
+      {{"nodes", "--grain", "1048577"}, "--grain: must be at most 1048576, got 1048577"},
+      {{"nodes", "--prefetch", "70000"}, "--prefetch: is too large, got 70000"},
       {{"nodes", "--page-size", "-1"}, "--page-size: page size -1"},
       {{"nodes", "--jobs", "-1"}, "--jobs: expected 0..1024, got -1"},
       {{"nodes", "--page-size", "1000"}, "--page-size: page size 1000"},

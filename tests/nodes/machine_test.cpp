@@ -428,9 +428,13 @@ TEST(Machine, BadOptionsFailWithOneLineNamingTheField) {
   MachineOptions workers;
   workers.workers_per_node = 0;
   expect_error(c, workers, "workers_per_node");
+  workers.workers_per_node = nodes::max_workers_per_node + 1;
+  expect_error(c, workers, "workers_per_node: must be at most 64, got 65");
   MachineOptions grain;
   grain.grain = 0;
   expect_error(c, grain, "grain");
+  grain.grain = nodes::max_grain + 1;
+  expect_error(c, grain, "grain: must be at most 1048576");
   MachineOptions prefetch;
   prefetch.prefetch = 4;  // the network buffers 4 packets per queue
   expect_error(c, prefetch, "prefetch");
