@@ -12,6 +12,7 @@
 
 #include "csp/csp.hpp"
 #include "nodes/pixel_computer.hpp"
+#include "tests/nodes/test_database.hpp"
 
 namespace {
 
@@ -21,11 +22,7 @@ using nodes::Ports;
 
 constexpr std::size_t page_size = 256;
 
-std::vector<std::byte> page_bytes(std::uint32_t page) {
-  std::vector<std::byte> bytes(page_size);
-  for (std::size_t i = 0; i < page_size; ++i) bytes[i] = static_cast<std::byte>((page * 17 + i) & 0xff);
-  return bytes;
-}
+std::vector<std::byte> page_bytes(std::uint32_t page) { return test::page_bytes(page, page_size); }
 
 bool holds_page(const std::byte* bytes, std::uint32_t page) {
   const auto expected = page_bytes(page);
