@@ -1,6 +1,8 @@
 #!/usr/bin/env bash
 # Installs, with apt-get, exactly the Debian packages vmpray needs that are
 # missing. Idempotent: a second run installs nothing. Run as root.
+# --dev adds the developer tools (sanitizer runtime, fuzzer, browser,
+# ccache); --ccache installs only ccache.
 set -euo pipefail
 packages=(
   cmake ninja-build g++ pkg-config
@@ -10,9 +12,14 @@ packages=(
   libopenmpi-dev openmpi-bin
   nlohmann-json3-dev libcairo2-dev fonts-dejavu-core
 )
-if [[ "${1:-}" == "--dev" ]]; then   # sanitizers' clang runtime, the fuzzer, the browser checks
-  packages+=(clang-14 libclang-rt-14-dev chromium python3)
-fi
+case "${1:-}" in
+  --dev) # sanitizers' clang runtime, the fuzzer, the browser checks, ccache
+    packages+=(clang-14 libclang-rt-14-dev chromium python3 ccache) ;;
+  --ccache) # only the compiler cache every preset uses when installed
+    packages=(ccache) ;;
+  "") ;;
+  *) echo "usage: scripts/install-deps.sh [--dev | --ccache]" >&2; exit 2 ;;
+esac
 missing=()
 for p in "${packages[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
