@@ -15,8 +15,8 @@
 #include <string>
 #include <vector>
 
-#include "nodes/machine.hpp"
-#include "nodes/timing.hpp"
+#include "nodes/machine/machine.hpp"
+#include "nodes/machine/timing.hpp"
 #include "tracer/database.hpp"
 #include "tracer/render.hpp"
 

@@ -10,7 +10,7 @@
 #include "app/machine_report.hpp"
 #include "app/output_files.hpp"
 #include "app/viz/ownership.hpp"
-#include "nodes/messages.hpp"
+#include "nodes/machine/messages.hpp"
 #include "topology/spec.hpp"
 
 namespace app {

@@ -13,7 +13,7 @@
 #include "app/viz/machine.hpp"
 #include "app/viz/report.hpp"
 #include "app/viz/timeline.hpp"
-#include "nodes/machine.hpp"
+#include "nodes/machine/machine.hpp"
 #include "tracer/image.hpp"
 
 namespace app {

@@ -11,7 +11,7 @@
 #include "app/options.hpp"
 #include "app/report.hpp"
 #include "app/wording.hpp"
-#include "nodes/messages.hpp"
+#include "nodes/machine/messages.hpp"
 #include "topology/spec.hpp"
 
 namespace app {

@@ -13,7 +13,7 @@
 #include <string>
 #include <vector>
 
-#include "nodes/machine.hpp"
+#include "nodes/machine/machine.hpp"
 
 namespace app {
 

@@ -49,8 +49,8 @@
 #include <string>
 #include <string_view>
 
-#include "nodes/pixel_computer.hpp"
-#include "nodes/work_plan.hpp"
+#include "nodes/machine/pixel_computer.hpp"
+#include "nodes/machine/work_plan.hpp"
 #include "topology/spec.hpp"
 #include "tracer/tessellate.hpp"
 #include "tracer/vec.hpp"

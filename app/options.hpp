@@ -13,7 +13,7 @@
 #include <string>
 
 #include "app/timing_options.hpp"
-#include "nodes/machine.hpp"
+#include "nodes/machine/machine.hpp"
 #include "tracer/database.hpp"
 
 namespace app {

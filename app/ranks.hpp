@@ -6,7 +6,7 @@
 #pragma once
 
 #include "app/options.hpp"
-#include "nodes/transport.hpp"
+#include "nodes/ranks/transport.hpp"
 
 namespace app {
 

@@ -14,8 +14,8 @@
 #include "app/viz/machine.hpp"
 #include "app/viz/report.hpp"
 #include "app/viz/svg.hpp"
-#include "nodes/messages.hpp"
-#include "nodes/pixel_order.hpp"
+#include "nodes/machine/messages.hpp"
+#include "nodes/machine/pixel_order.hpp"
 
 namespace app {
 namespace {

@@ -19,7 +19,7 @@
 #include <vector>
 
 #include "app/machine_report.hpp"
-#include "nodes/machine.hpp"
+#include "nodes/machine/machine.hpp"
 #include "tracer/image.hpp"
 
 namespace app {

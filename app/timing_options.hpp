@@ -9,7 +9,7 @@
 
 #include <boost/program_options/options_description.hpp>
 
-#include "nodes/timing.hpp"
+#include "nodes/machine/timing.hpp"
 
 namespace app {
 

@@ -26,7 +26,7 @@
 #include <string>
 #include <vector>
 
-#include "nodes/transport.hpp"
+#include "nodes/ranks/transport.hpp"
 
 namespace vmpi {
 

@@ -27,7 +27,7 @@
 #include <string>
 #include <vector>
 
-#include "nodes/machine.hpp"
+#include "nodes/machine/machine.hpp"
 #include "tracer/generators.hpp"
 #include "tracer/render.hpp"
 

@@ -9,7 +9,7 @@
 #include <cstdlib>
 #include <string>
 
-#include "nodes/traffic.hpp"
+#include "nodes/net/traffic.hpp"
 #include "topology/spec.hpp"
 
 int main(int argc, char** argv) {

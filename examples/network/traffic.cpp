@@ -11,7 +11,7 @@
 #include <optional>
 #include <string>
 
-#include "nodes/traffic.hpp"
+#include "nodes/net/traffic.hpp"
 #include "topology/deadlock.hpp"
 #include "topology/spec.hpp"
 

@@ -1,0 +1,246 @@
+// The VM_pRAY machine: N processors on a topology, the scene database spread
+// over them as object pages in a shared virtual memory, pixels farmed out on
+// demand, everything carried by the store-and-forward network.
+//
+// Processes of processor n, all on the OS thread of n's router:
+//   page server (+ its mailbox)      Ports::page_server
+//   pixel computers w = 0..k-1       Ports::first_worker + w
+// and on node 0 only:
+//   farmer (+ its mailbox)           Ports::farmer
+//   frame collector                  fed by the farmer over a local channel
+// The host's copy of the database is moved into the owners before the run:
+// page p lives only on its owner and in caches.
+//
+// Work (pixel_computer.hpp): a worker asks for P + 1 tiles at start (P =
+// prefetch) and each result it sends asks for one more, so it always has the
+// next tile coming while it traces: two messages per tile, plus one request
+// per worker.
+//
+// Orderly end (no message lost, none left in flight, no fiber blocked):
+//  1. The farmer answers every tile asked for with work until the plan is
+//     exhausted, then with stop, and passes each result to the collector.
+//  2. A worker ends once all P + 1 answers it is owed are in; by then its
+//     results are sent and all its page requests answered. It sends
+//     worker_done, which reaches the farmer after its results (packets
+//     between two processes keep their order).
+//  3. After the last worker_done no page request exists anywhere, so the
+//     farmer sends server_stop to every page server; each answers
+//     server_done and ends.
+//  4. With N*k worker_done and N server_done received, every packet sent
+//     has been read and every result passed on: the farmer checks that the
+//     results cover the frame and calls Network::shutdown(), which ends
+//     routers, links and the mailboxes; the collector ends with the frame.
+// Buffer bounds: each packet of a worker not yet read by the farmer carries
+// a tile still owed to it, so at most P + 1 per worker and one per page
+// server are outstanding for the farmer (N*k*(P+1) + N); at most N*k page
+// requests for a page server (one per worker, plus its server_stop), which
+// sizes their mailboxes. Whenever a worker does not read its port (it traces,
+// or sends), at most P answers and one page reply are on their way to it,
+// which must fit the network's delivery buffer (so P < buffer capacity).
+#pragma once
+
+#include <cstdint>
+#include <memory>
+#include <optional>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "nodes/machine/collector.hpp"
+#include "nodes/machine/farmer.hpp"
+#include "nodes/machine/node_memory.hpp"
+#include "nodes/machine/node_report.hpp"
+#include "nodes/machine/page_server.hpp"
+#include "nodes/machine/pixel_computer.hpp"
+#include "nodes/machine/pixel_order.hpp"
+#include "nodes/machine/recorder.hpp"
+#include "nodes/machine/svm.hpp"
+#include "nodes/machine/timing.hpp"
+#include "nodes/machine/work_plan.hpp"
+#include "nodes/net/network.hpp"
+#include "nodes/ranks/bridge.hpp"
+#include "nodes/ranks/rank_plan.hpp"
+#include "nodes/ranks/transport.hpp"
+#include "tracer/database.hpp"
+#include "tracer/image.hpp"
+#include "tracer/render.hpp"
+
+namespace nodes {
+
+struct MachineOptions {
+  std::string topology = "hypercube";  // a kind, or a full spec such as "hypercube:4"
+  std::optional<std::size_t> nodes = 16;  // with a bare kind; must agree with a full spec
+  unsigned threads = 0;                // 0: hardware cores; never more than the nodes
+  bool relay_between_threads = true;   // links between threads through relays (NetworkOptions)
+  bool shared_cores = false;           // other processes share the cores (csp::RuntimeOptions::shared_cores)
+  std::optional<std::uint32_t> cache_pages;  // remote pages cached per node
+  std::optional<std::uint64_t> cache_kb;     // the same in KB; default (neither): default_cache_pages()
+  std::uint32_t grain = 16;            // items per tile (1..max_grain): balance vs farming traffic
+  // Each processor's own compact patch first: the fewest page misses and
+  // farming messages (the paper: dynamic, scanline).
+  Schedule schedule = Schedule::affinity;
+  PixelOrder pixel_order = PixelOrder::hilbert;  // how items are numbered, so where a tile lies
+  int workers_per_node = 1;            // 1..max_workers_per_node
+  std::uint16_t prefetch = 1;          // tiles a worker has asked for beyond the one it traces (..max_prefetch)
+  Distribution distribution = Distribution::modulo;
+  std::uint64_t trace_routes = 0;      // record the routes of the first N packets
+  std::vector<std::uint8_t> trace_kinds;  // of these MessageKinds only (empty: every kind)
+  bool record_tiles = false;           // a TileSpan per tile in each NodeReport's work.spans
+  bool record = false;                 // a Recording of the run for its replay (recorder.hpp); implies record_tiles
+  std::uint64_t record_packets = 100000;  // with record: packets recorded hop by hop, the rest only counted
+  std::size_t buffer_capacity = 4;     // packets per network queue
+  tracer::TraceOptions trace;
+  std::optional<CostModel> timing;     // virtual time under this model (the run takes one thread)
+  Progress progress;                   // called by the collector (on its thread): at 0 as it starts, then per result
+};
+
+// The bounds check_options() holds the fields to: a tile of at most a
+// million pixels, and at most 64 pixel computers on one node (each is a
+// process with its own stack and port).
+constexpr std::uint32_t max_grain = 1u << 20;
+constexpr int max_workers_per_node = 64;
+
+// The most tiles a worker may keep asked for ahead: its answers and a page
+// reply must fit the network's delivery buffer (see the buffer bounds above).
+inline std::uint16_t max_prefetch(const MachineOptions& options) {
+  return static_cast<std::uint16_t>(options.buffer_capacity - 1);
+}
+
+struct MachineReport {
+  std::string topology;  // canonical spec
+  int nodes = 0;
+  unsigned threads = 0;
+  int workers_per_node = 0;
+  std::uint16_t prefetch = 0;
+  Schedule schedule = Schedule::dynamic;
+  PixelOrder pixel_order = PixelOrder::scanline;
+  std::uint32_t grain = 0;
+  std::uint32_t cache_pages = 0;  // requested per node (before capping at remote pages)
+  std::uint32_t page_size = 0;
+  std::uint32_t page_count = 0;
+  std::uint64_t items = 0;  // pixels, or SPD corner samples
+  double wall_seconds = 0;
+  std::vector<csp::ThreadUse> host_threads;  // how each OS thread spent the run
+  std::size_t relayed_links = 0;             // links between threads carried by thread relays
+  std::vector<RelayCounters> relays;         // per thread, what its relay carried (empty without relays)
+  std::optional<CostModel> model;            // the virtual-time model; none in real time
+  double predicted_seconds = 0;    // virtual time at the end of the run
+  double compute_seconds = 0;      // virtual compute time summed over the pixel computers
+  std::vector<std::uint16_t> owners;  // per pixel (or corner sample), in scanline order: the node that computed it
+  std::vector<NodeReport> per_node;
+  FarmerCounters farmer;
+  std::uint64_t collected = 0;
+  NetworkStats network;
+  std::vector<RankReport> ranks;  // empty unless the machine ran over several processes
+  std::size_t cut_links = 0;      // links whose ends ran in different processes
+  std::shared_ptr<const Recording> recording;  // with MachineOptions::record; null otherwise
+
+  SvmStats svm() const;
+  ServerCounters served() const;
+  tracer::RayStats rays() const;
+  std::uint64_t items_computed() const;
+  // max / mean over nodes of the items and of the rays each computed.
+  double item_imbalance() const;
+  double ray_imbalance() const;
+  // Time the OS threads waited with no process ready, over their time (wall
+  // time only: the virtual-time scheduler does not measure it).
+  double idle_share() const;
+};
+
+struct MachineResult {
+  tracer::Image image;
+  MachineReport report;
+};
+
+// A MachineOptions field the machine cannot run with: field() is its name
+// in MachineOptions ("grain", "cache_kb", ...), reason() what is wrong with
+// its value; what() is "FIELD: REASON", one line. A caller with other names
+// for the fields (command-line options) says reason() under its own.
+class OptionError : public std::invalid_argument {
+ public:
+  OptionError(const std::string& field, const std::string& reason)
+      : std::invalid_argument(field + ": " + reason), field_(field), reason_(reason) {}
+  const std::string& field() const { return field_; }
+  const std::string& reason() const { return reason_; }
+
+ private:
+  std::string field_, reason_;
+};
+
+// What the system would not give a machine: memory (for a process, its
+// stack or the record of one) or an OS thread. what() is the runtime's own
+// line; nodes() and threads() say how large the machine was, so a caller
+// can say what to change.
+class ResourceError : public std::runtime_error {
+ public:
+  enum class Resource : std::uint8_t { memory, thread };
+  ResourceError(const std::string& line, Resource resource, std::size_t nodes, unsigned threads)
+      : std::runtime_error(line), resource_(resource), nodes_(nodes), threads_(threads) {}
+  Resource resource() const { return resource_; }
+  std::size_t nodes() const { return nodes_; }
+  unsigned threads() const { return threads_; }
+
+ private:
+  Resource resource_;
+  std::size_t nodes_;
+  unsigned threads_;
+};
+
+// Every rule of the options alone, and of the cache against pages of
+// page_size bytes: OptionError naming the first field that breaks one.
+// run_machine checks them before any work; a caller may check them sooner.
+void check_options(const MachineOptions& options, std::uint32_t page_size);
+
+// The cache a node gets when no size is given: 1/8 of the database, a modest
+// share as in the paper's experiments, but at least 64 pages (or the whole
+// database if smaller). A cache smaller than the pages one ray visits, as
+// an eighth of a tiny database would be, makes nearly every access miss;
+// such a cache can still be asked for by size.
+std::uint32_t default_cache_pages(const tracer::DatabaseHeader& header);
+
+// Cache size in pages from the options: OptionError naming the field for 0
+// pages, less than a page of KB, or both fields set.
+std::uint32_t cache_pages_for(const MachineOptions& options, const tracer::DatabaseHeader& header);
+
+// Renders db's frame on the machine; consumes db (its pages move to their
+// owners). Throws OptionError for bad options, topology::parse_topology's
+// std::invalid_argument for a bad topology, ResourceError when the system
+// has no memory or thread to give, and whatever a process throws.
+MachineResult run_machine(tracer::Database db, const MachineOptions& options);
+
+// ---- The machine split over the ranks of a Transport ----
+// Every rank calls run_machine_rank with the same options; rank 0 (the
+// host) passes the database and gets the result, every other rank passes
+// none and gets none. Rank r runs the nodes RankPlan gives it, each rank
+// holding only its own nodes' pages (rank 0 sends them) and caches; after
+// the run every rank sends its reports to rank 0, whose result equals the
+// one-process run's. Virtual time cannot be split (one clock orders the
+// whole machine): OptionError for timing, before any work. A failure on
+// any rank ends every rank's call with RankFailure, within the time it takes
+// the others to notice (they poll the wire at least every millisecond); a
+// rank that could not get memory or threads says so with resource().
+class RankFailure : public std::runtime_error {
+ public:
+  RankFailure(int rank, const std::string& line)
+      : std::runtime_error("rank " + std::to_string(rank) + ": " + line), rank_(rank) {}
+  RankFailure(int rank, const ResourceError& shortage) : RankFailure(rank, shortage.what()) { resource_ = shortage; }
+  int rank() const { return rank_; }
+  // This rank's own shortage, if that is what ended it.
+  const ResourceError* resource() const { return resource_ ? &*resource_ : nullptr; }
+
+ private:
+  int rank_;
+  std::optional<ResourceError> resource_;
+};
+
+std::optional<MachineResult> run_machine_rank(std::optional<tracer::Database> db, const MachineOptions& options,
+                                              Transport& transport);
+
+// Rank 0, when it cannot make the database: the other ranks, waiting in
+// run_machine_rank for their pages, end with RankFailure(0, why).
+void abandon_machine(Transport& transport, const std::string& why);
+
+// Route trace lines and the network summary, with the machine's kind names.
+std::string format_routes(const MachineReport& report);
+
+}  // namespace nodes

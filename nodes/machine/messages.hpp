@@ -1,0 +1,130 @@
+// The application's messages on the machine network: packet kinds, the local
+// ports of a processor, and the byte encoding of each payload.
+//
+// Every message travels as a nodes::Packet by value (processors share
+// nothing); the payload is a flat little-endian-as-host byte string written
+// and read here only, so a processor could run unchanged in another process.
+// Decoding checks sizes and throws std::runtime_error on a malformed payload
+// rather than reading out of bounds.
+//
+// Who sends what (see machine.hpp for the whole protocol):
+//   worker    -> farmer     work_request {reply port, tiles}   (once, at start)
+//   farmer    -> worker     work {first, count} | stop {}      (one per tile asked)
+//   worker    -> farmer     result {reply port, first, count, count x RGB
+//                           floats}: the colours, and a request for one tile
+//   worker    -> owner's page server  page_request {page, reply port}
+//   page srv  -> worker     page_reply {page, page bytes}
+//   worker    -> farmer     worker_done {}
+//   farmer    -> page srv   server_stop {}
+//   page srv  -> farmer     server_done {}
+// The farmer hands each result on to the frame collector over a local
+// channel of node 0 (not the network).
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <span>
+#include <string_view>
+#include <utility>
+#include <vector>
+
+#include "csp/csp.hpp"
+#include "nodes/net/packet.hpp"
+#include "tracer/vec.hpp"
+
+namespace nodes {
+
+enum class MessageKind : std::uint8_t {
+  work_request = 1,
+  work,
+  stop,
+  result,
+  page_request,
+  page_reply,
+  worker_done,
+  server_stop,
+  server_done,
+};
+inline constexpr int message_kind_count = 10;  // one past the last kind
+
+// Name for reports and route traces ("page_reply" etc.).
+std::string_view message_kind_name(std::uint8_t kind);
+
+// Local ports of a processor. The farmer exists on node 0 only; worker w of
+// a node listens on first_worker + w.
+struct Ports {
+  static constexpr std::uint16_t page_server = 0;
+  static constexpr std::uint16_t farmer = 1;
+  static constexpr std::uint16_t first_worker = 2;
+  static constexpr std::uint16_t count(int workers_per_node) {
+    return static_cast<std::uint16_t>(first_worker + workers_per_node);
+  }
+};
+
+// A contiguous run of work items (pixels or SPD corner samples) in the
+// machine's pixel order: items first .. first + count - 1.
+struct Tile {
+  std::uint32_t first = 0;
+  std::uint32_t count = 0;
+  bool operator==(const Tile&) const = default;
+};
+
+struct PageRequest {
+  std::uint32_t page = 0;
+  std::uint16_t reply_port = 0;
+};
+
+// A worker's first message: send `tiles` answers (work or stop) to reply_port.
+struct WorkRequest {
+  std::uint16_t reply_port = 0;
+  std::uint16_t tiles = 0;
+};
+
+struct ResultView {
+  std::uint16_t reply_port = 0;  // where the answer to the request it carries goes
+  Tile tile;
+  std::span<const std::byte> rgb;  // tile.count x 3 floats, bit-exact
+  tracer::Color color(std::uint32_t i) const;
+};
+
+std::vector<std::byte> encode_work_request(WorkRequest request);
+WorkRequest decode_work_request(std::span<const std::byte> payload);
+
+std::vector<std::byte> encode_tile(Tile tile);
+Tile decode_tile(std::span<const std::byte> payload);
+
+std::vector<std::byte> encode_result(std::uint16_t reply_port, Tile tile, std::span<const tracer::Color> colors);
+ResultView decode_result(std::span<const std::byte> payload);
+
+std::vector<std::byte> encode_page_request(PageRequest request);
+PageRequest decode_page_request(std::span<const std::byte> payload);
+
+// A packet to (destination, port); the network stamps the source.
+Packet make_packet(NodeId destination, std::uint16_t port, MessageKind kind, std::vector<std::byte> payload = {});
+
+// A process's injection end that numbers its packets: ids interleave over
+// all sending processes (first id = the process's index, step = their
+// count), so ids below K cover the first packets of every process, which is
+// what route tracing (NetworkOptions::trace_routes) selects.
+class Outbox {
+ public:
+  Outbox(csp::Out<Packet> out, std::uint64_t index, std::uint64_t processes)
+      : out_(std::move(out)), next_id_(index), step_(processes) {}
+  void send(Packet packet) {
+    packet.id = next_id_;
+    next_id_ += step_;
+    out_.write(std::move(packet));
+  }
+
+ private:
+  csp::Out<Packet> out_;
+  std::uint64_t next_id_;
+  std::uint64_t step_;
+};
+
+// The page id leads the bytes so a reply names what it carries.
+std::vector<std::byte> encode_page_reply(std::uint32_t page, std::span<const std::byte> bytes);
+std::uint32_t page_reply_id(std::span<const std::byte> payload);
+std::span<const std::byte> page_reply_bytes(std::span<const std::byte> payload);
+
+}  // namespace nodes

@@ -1,0 +1,111 @@
+// Own pages and LRU cache of one processor (see node_memory.hpp).
+#include "nodes/machine/node_memory.hpp"
+
+#include <algorithm>
+#include <cstring>
+#include <limits>
+#include <stdexcept>
+#include <string>
+
+namespace nodes {
+
+PagePlacement::PagePlacement(Distribution distribution, int nodes, std::uint32_t page_count)
+    : distribution_(distribution), nodes_(nodes), page_count_(page_count) {
+  if (nodes < 1) throw std::invalid_argument("page placement needs at least one node");
+}
+
+std::uint32_t PagePlacement::block_first(int node) const {
+  return static_cast<std::uint32_t>(std::uint64_t{page_count_} * static_cast<std::uint64_t>(node) /
+                                    static_cast<std::uint64_t>(nodes_));
+}
+
+int PagePlacement::owner(std::uint32_t page) const {
+  if (distribution_ == Distribution::modulo) return static_cast<int>(page % static_cast<std::uint32_t>(nodes_));
+  // The guess is within one of the owner because block_first is a floor.
+  int n = static_cast<int>(std::uint64_t{page} * static_cast<std::uint64_t>(nodes_) / page_count_);
+  while (n + 1 < nodes_ && block_first(n + 1) <= page) ++n;
+  while (n > 0 && block_first(n) > page) --n;
+  return n;
+}
+
+std::uint32_t PagePlacement::own_index(std::uint32_t page) const {
+  if (distribution_ == Distribution::modulo) return page / static_cast<std::uint32_t>(nodes_);
+  return page - block_first(owner(page));
+}
+
+std::uint32_t PagePlacement::page_of(int node, std::uint32_t index) const {
+  if (distribution_ == Distribution::modulo)
+    return index * static_cast<std::uint32_t>(nodes_) + static_cast<std::uint32_t>(node);
+  return block_first(node) + index;
+}
+
+std::uint32_t PagePlacement::own_count(int node) const {
+  if (distribution_ == Distribution::block) return block_first(node + 1) - block_first(node);
+  const auto n = static_cast<std::uint32_t>(nodes_);
+  const auto k = static_cast<std::uint32_t>(node);
+  return page_count_ / n + (k < page_count_ % n ? 1 : 0);
+}
+
+NodeMemory::NodeMemory(const PagePlacement& placement, int node, std::size_t page_size,
+                       std::vector<std::vector<std::byte>> own_pages, std::uint32_t cache_pages)
+    : page_size_(page_size),
+      own_count_(placement.own_count(node)),
+      own_(std::make_unique<std::byte[]>(own_count_ * page_size)),
+      entry_(placement.page_count(), -1) {
+  if (own_pages.size() != own_count_)
+    throw std::logic_error("node " + std::to_string(node) + " given the wrong number of own pages");
+  for (std::size_t i = 0; i < own_count_; ++i) {
+    if (own_pages[i].size() != page_size) throw std::logic_error("own page of the wrong size");
+    std::memcpy(own_.get() + i * page_size, own_pages[i].data(), page_size);
+    std::vector<std::byte>().swap(own_pages[i]);
+    entry_[placement.page_of(node, static_cast<std::uint32_t>(i))] = static_cast<std::int32_t>(i);
+  }
+  // More slots than remote pages could never be filled.
+  capacity_ = std::min(cache_pages, placement.page_count() - static_cast<std::uint32_t>(own_count_));
+  slots_.reserve(capacity_);
+}
+
+int NodeMemory::take_slot(std::span<const int> in_use) {
+  if (slots_.size() < capacity_) {
+    slots_.push_back(Slot{std::make_unique<std::byte[]>(page_size_), 0, 0});
+    return static_cast<int>(slots_.size() - 1);
+  }
+  int victim = -1;
+  std::uint64_t oldest = std::numeric_limits<std::uint64_t>::max();
+  for (std::size_t s = 0; s < slots_.size(); ++s)
+    if (slots_[s].last_use < oldest && std::find(in_use.begin(), in_use.end(), static_cast<int>(s)) == in_use.end()) {
+      oldest = slots_[s].last_use;
+      victim = static_cast<int>(s);
+    }
+  if (victim < 0) throw std::logic_error("page cache: every slot is in use");
+  entry_[slots_[static_cast<std::size_t>(victim)].page] = -1;
+  ++evictions_;
+  return victim;
+}
+
+int NodeMemory::install(std::uint32_t page, std::span<const std::byte> bytes, std::span<const int> in_use) {
+  if (bytes.size() != page_size_) throw std::runtime_error("page " + std::to_string(page) + " arrived with a wrong size");
+  if (entry_[page] != -1) throw std::logic_error("page " + std::to_string(page) + " installed twice");
+  if (capacity_ == 0) throw std::logic_error("page cache has no slot for remote page " + std::to_string(page));
+  const int slot = take_slot(in_use);
+  Slot& s = slots_[static_cast<std::size_t>(slot)];
+  std::memcpy(s.bytes.get(), bytes.data(), page_size_);
+  s.page = page;
+  entry_[page] = -2 - slot;
+  use(slot);
+  return slot;
+}
+
+bool NodeMemory::begin_fetch(std::uint32_t page) { return pending_.try_emplace(page).second; }
+
+void NodeMemory::add_waiter(std::uint32_t page, int worker) { pending_.at(page).push_back(worker); }
+
+std::vector<int> NodeMemory::end_fetch(std::uint32_t page) {
+  auto it = pending_.find(page);
+  if (it == pending_.end()) throw std::logic_error("end of a page fetch that never began");
+  auto waiters = std::move(it->second);
+  pending_.erase(it);
+  return waiters;
+}
+
+}  // namespace nodes

@@ -1,0 +1,118 @@
+// A pixel computer: one fiber that asks the farmer for work, traces it
+// through its node's shared virtual memory and sends the colours back. A
+// processor runs one or more (MachineOptions::workers_per_node), so page waits of one
+// overlap with tracing by another.
+//
+// Protocol, on its own local port (Ports::first_worker + w), with prefetch P:
+//   -> farmer     work_request {my port, P + 1 tiles}       (once)
+//   <- farmer     work {first, count}  |  stop              (one per tile asked)
+//   -> farmer     result {my port, first, count, colours}   (after each work;
+//                 it also asks for one more tile)
+//   -> farmer     worker_done                               (once every answer
+//                 is in; then ends)
+// So P + 1 answers are always owed to the worker: with P >= 1 the next tile
+// is already on its way while it traces the current one. The farmer answers
+// in order and never sends work after a stop, so after the first stop only
+// stops follow and every result is sent before worker_done.
+// While tracing, a cache miss sends page_request to the page's owner and
+// reads this same port for the page_reply (make_page_fetch); answers of the
+// farmer that arrive meanwhile are kept, in order, for later. While the
+// worker traces or sends, at most P answers and one page reply are on their
+// way to the port; the machine keeps that within the network's delivery
+// buffer, so the port drains whenever the worker blocks.
+// On several threads the machine runs pixel computers at low priority and
+// the processes that move messages at high priority, as on a transputer,
+// and a pixel computer yields every `timeslice` items, so that a long run of
+// pixels free of misses does not hold up the routers and page servers of its
+// thread while pixel computers on other threads wait for them.
+#pragma once
+
+#include <cstdint>
+#include <deque>
+#include <functional>
+#include <span>
+#include <vector>
+
+#include "csp/csp.hpp"
+#include "nodes/machine/messages.hpp"
+#include "nodes/machine/pixel_order.hpp"
+#include "nodes/machine/svm.hpp"
+#include "tracer/render.hpp"
+
+namespace nodes {
+
+// Seconds since the run began: wall time, or the calling process's virtual
+// clock under virtual time.
+using RunClock = std::function<double()>;
+
+// One tile as its worker traced it, for timelines of the farming: from the
+// tile's first item to its result leaving (virtual time: after its work was
+// charged), and the page requests and rays it took.
+struct TileSpan {
+  int worker = 0;  // on its node
+  Tile tile;
+  double start = 0;
+  double end = 0;
+  std::uint64_t page_requests = 0;
+  std::uint64_t rays = 0;
+};
+
+struct WorkerCounters {
+  std::uint64_t items = 0;  // pixels (or SPD corner samples) computed
+  std::uint64_t tiles = 0;
+  tracer::RayStats rays;
+  std::vector<TileSpan> spans;  // one per tile, in order, when the machine records them
+};
+
+// What a work item is: a pixel (x, y), or an SPD corner sample on the
+// (W+1) x (H+1) grid, numbered in the machine's pixel order.
+struct ItemGrid {
+  int width = 0;  // items per row
+  bool corners = false;
+  std::span<const std::uint32_t> positions;  // item -> scanline position; empty: scanline order
+
+  std::uint32_t position(std::uint32_t item) const { return scanline_position(positions, item); }
+};
+
+// A worker's network port, shared by its two readers: the work loop (work
+// and stop answers) and the miss path (page replies). One fiber uses it.
+class WorkerPort {
+ public:
+  explicit WorkerPort(csp::In<Packet> in) : in_(std::move(in)) {}
+  Packet next_answer();  // work or stop
+  Packet page_reply();   // keeps any answers that arrive first
+
+ private:
+  csp::In<Packet> in_;
+  std::deque<Packet> answers_;  // arrived while waiting for a page
+};
+
+class PixelComputer {
+ public:
+  PixelComputer(std::uint16_t port, std::uint16_t prefetch, SvmSource& source, const tracer::DatabaseHeader& header,
+                tracer::TraceOptions options, ItemGrid grid, WorkerPort& in, Outbox& out, WorkerCounters& counters,
+                std::function<void()> after_tile = {}, std::uint32_t timeslice = 0, RunClock clock = {});
+  void run();
+
+ private:
+  void compute(Tile tile);
+
+  std::uint16_t port_;
+  std::uint16_t prefetch_;
+  SvmSource& source_;
+  tracer::Tracer tracer_;
+  ItemGrid grid_;
+  WorkerPort& in_;
+  Outbox& out_;
+  WorkerCounters& counters_;
+  std::vector<tracer::Color> colors_;
+  std::function<void()> after_tile_;  // before the result is sent: virtual time charges the work here
+  std::uint32_t timeslice_;           // items traced between two csp::yield()s; 0: never yield
+  RunClock clock_;                    // set: record a TileSpan per tile
+};
+
+// The miss path of a worker's SvmSource: page_request to the owner, then
+// wait on the worker's port for the page_reply.
+PageFetch make_page_fetch(const PagePlacement& placement, std::uint16_t port, WorkerPort& in, Outbox& out);
+
+}  // namespace nodes

@@ -1,0 +1,155 @@
+// The recorder's clock and budget, and the merge of its per-node logs into
+// one trace per packet (see recorder.hpp).
+#include "nodes/machine/recorder.hpp"
+
+#include <algorithm>
+#include <limits>
+#include <stdexcept>
+#include <string>
+#include <tuple>
+#include <unordered_map>
+
+namespace nodes {
+
+Recorder::Recorder(std::size_t nodes, std::uint64_t max_packets, bool virtual_time,
+                   std::chrono::steady_clock::time_point started)
+    : RouteRecorder(max_packets, virtual_time, started) {
+  for (std::size_t n = 0; n < nodes; ++n) logs_.push_back(std::make_unique<NodeLog>());
+}
+
+std::uint64_t Recording::recorded_hops() const {
+  std::uint64_t hops = 0;
+  for (const PacketTrace& p : packets) hops += p.hops();
+  return hops;
+}
+
+namespace {
+
+constexpr double unset = -std::numeric_limits<double>::infinity();
+constexpr NodeId no_node = std::numeric_limits<NodeId>::max();
+
+[[noreturn]] void broken(std::uint64_t id, const std::string& what) {
+  throw std::logic_error("recording: packet " + std::to_string(id) + " " + what);
+}
+
+PacketTrace& trace_of(std::unordered_map<std::uint64_t, std::size_t>& index, std::vector<PacketTrace>& packets,
+                      std::uint64_t id) {
+  const auto at = index.find(id);
+  if (at == index.end()) broken(id, "was seen in the network but never injected");
+  return packets[at->second];
+}
+
+void set(PacketTrace& p, std::size_t slot, double time) {
+  if (slot >= p.times.size()) broken(p.id, "crossed more links than it was delivered with");
+  if (p.times[slot] != unset) broken(p.id, "was recorded twice at one step");
+  p.times[slot] = time;
+}
+
+void check(const PacketTrace& p, const topology::Topology& topology, NodeId destination) {
+  for (std::size_t i = 0; i < p.route.size(); ++i)
+    if (p.route[i] == no_node) broken(p.id, "has a hop nobody recorded");
+  if (p.route.back() != destination) broken(p.id, "ended away from its destination");
+  for (std::size_t h = 0; h < p.hops(); ++h) {
+    const auto next = topology.neighbours(p.route[h]);
+    if (std::find(next.begin(), next.end(), p.route[h + 1]) == next.end())
+      broken(p.id, "went from " + std::to_string(p.route[h]) + " to " + std::to_string(p.route[h + 1]) +
+                       ", which are not neighbours");
+  }
+  for (std::size_t i = 0; i < p.times.size(); ++i) {
+    if (p.times[i] == unset) broken(p.id, "misses a time");
+    if (i > 0 && p.times[i] < p.times[i - 1]) broken(p.id, "arrived before it left");
+  }
+}
+
+}  // namespace
+
+Recording merge_recording(const Recorder& recorder, const topology::Topology& topology,
+                          std::vector<std::vector<TileSpan>> tiles) {
+  const std::size_t nodes = recorder.nodes();
+  if (topology.size() != nodes)
+    throw std::invalid_argument("recording: " + std::to_string(nodes) + " node logs for a machine of " +
+                                std::to_string(topology.size()));
+  tiles.resize(nodes);
+  Recording r;
+  r.virtual_time = recorder.virtual_time();
+  r.max_packets = recorder.max_packets();
+  // A packet's length is known where it is delivered; size every trace then.
+  std::unordered_map<std::uint64_t, std::size_t> index;
+  std::vector<NodeId> destination;
+  for (NodeId n = 0; n < nodes; ++n)
+    for (const InjectEvent& e : recorder.log(n).injected) {
+      if (!index.emplace(e.id, r.packets.size()).second) broken(e.id, "was injected twice");
+      PacketTrace p;
+      p.id = e.id;
+      p.kind = e.kind;
+      p.bytes = e.bytes;
+      p.route = {n};
+      p.times = {e.time};
+      r.packets.push_back(std::move(p));
+      destination.push_back(e.destination);
+    }
+  for (NodeId n = 0; n < nodes; ++n)
+    for (const DeliverEvent& e : recorder.log(n).delivered) {
+      PacketTrace& p = trace_of(index, r.packets, e.id);
+      if (p.times.size() != 1) broken(e.id, "was delivered twice");
+      const NodeId source = p.route.front();
+      const double injected = p.times.front();
+      p.route.assign(e.hops + 1u, no_node);
+      p.route.front() = source;
+      p.route.back() = n;
+      p.times.assign(2 * (e.hops + 1u), unset);
+      p.times.front() = injected;
+      p.times.back() = e.time;
+    }
+  const unsigned classes = topology.buffer_classes();
+  for (NodeId n = 0; n < nodes; ++n) {
+    const NodeLog& log = recorder.log(n);
+    const auto neighbours = topology.neighbours(n);
+    for (const HopEvent& e : log.departed) {
+      PacketTrace& p = trace_of(index, r.packets, e.id);
+      if (e.hop >= p.route.size() - 1) broken(e.id, "left a node after its last hop");
+      if (p.route[e.hop] != n && p.route[e.hop] != no_node) broken(e.id, "left from two nodes at one hop");
+      p.route[e.hop] = n;
+      const std::size_t port = e.queue / classes;
+      if (port >= neighbours.size()) broken(e.id, "left node " + std::to_string(n) + " by a port it lacks");
+      if (p.route[e.hop + 1u] != no_node && p.route[e.hop + 1u] != neighbours[port])
+        broken(e.id, "arrived elsewhere than it left for");
+      p.route[e.hop + 1u] = neighbours[port];
+      set(p, 1 + 2 * std::size_t{e.hop}, e.time);
+    }
+    for (const HopEvent& e : log.arrived) {
+      PacketTrace& p = trace_of(index, r.packets, e.id);
+      if (e.hop == 0 || e.hop >= p.route.size()) broken(e.id, "arrived at a hop it never made");
+      if (p.route[e.hop] != n && p.route[e.hop] != no_node) broken(e.id, "arrived elsewhere than it left for");
+      p.route[e.hop] = n;
+      set(p, 2 * std::size_t{e.hop}, e.time);
+    }
+    for (std::size_t kind = 0; kind < log.unrecorded.size(); ++kind) {
+      r.unrecorded[kind] += log.unrecorded[kind];
+      r.unrecorded_packets += log.unrecorded[kind];
+    }
+    r.unrecorded_hops += log.unrecorded_hops;
+  }
+  for (std::size_t i = 0; i < r.packets.size(); ++i) {
+    if (r.packets[i].times.size() != 2 * r.packets[i].route.size()) broken(r.packets[i].id, "was never delivered");
+    check(r.packets[i], topology, destination[i]);
+    r.end = std::max(r.end, r.packets[i].delivered());
+  }
+  std::sort(r.packets.begin(), r.packets.end(), [](const PacketTrace& a, const PacketTrace& b) {
+    return std::tie(a.times.front(), a.id) < std::tie(b.times.front(), b.id);
+  });
+  r.nodes.resize(nodes);
+  for (NodeId n = 0; n < nodes; ++n) {
+    NodeTrace& t = r.nodes[n];
+    t.fetches = recorder.log(n).fetches;
+    t.serves = recorder.log(n).serves;
+    t.hits = recorder.log(n).hits;
+    t.tiles = std::move(tiles[n]);
+    for (const FetchEvent& e : t.fetches) r.end = std::max(r.end, e.end);
+    for (const ServeEvent& e : t.serves) r.end = std::max(r.end, e.end);
+    for (const TileSpan& s : t.tiles) r.end = std::max(r.end, s.end);
+  }
+  return r;
+}
+
+}  // namespace nodes

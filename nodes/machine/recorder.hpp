@@ -1,0 +1,126 @@
+// nodes::Recorder: what a run did over time, for a replay of it: every hop of
+// the first packets injected, the page requests each pixel computer waited
+// on, the pages each page server served, and (from the tile spans) what each
+// pixel computer traced when.
+//
+// Recording: one NodeLog per node, written only by that node's processes
+// (its router through the RouteLog it extends, net/route_log.hpp, its page
+// server and pixel computers, all on the node's thread), so the hot path
+// takes no lock. A process that records nothing pays one branch on a null
+// pointer (the router's log_, the page server's recorder_).
+//
+// Bound: the first max_packets packets injected are recorded hop by hop
+// (under virtual time the first in virtual time; in real time the first
+// each router's thread got to, which on several threads is not quite the
+// order of their times); later packets are only counted, per kind, with
+// their hops, where they are delivered.
+//
+// Invariants of a merged Recording (merge_recording checks them and throws
+// std::logic_error otherwise): each packet's route starts at its source and
+// ends at its destination, consecutive nodes are neighbours, and its times
+// (injected, then a departure and an arrival per hop, then delivered) never
+// decrease. Packets recorded and packets counted together are every packet
+// delivered, which the tests hold against the routers' own counters.
+#pragma once
+
+#include <array>
+#include <atomic>
+#include <chrono>
+#include <cstdint>
+#include <memory>
+#include <vector>
+
+#include "nodes/machine/pixel_computer.hpp"
+#include "nodes/net/packet.hpp"
+#include "nodes/net/route_log.hpp"
+#include "topology/topology.hpp"
+
+namespace nodes {
+
+// A pixel computer waiting for a page it asked for, from request to reply.
+struct FetchEvent {
+  double start = 0;
+  double end = 0;
+  std::uint32_t page = 0;
+  std::uint16_t worker = 0;
+};
+
+// A page server serving one request, from reading it to sending the reply.
+struct ServeEvent {
+  double start = 0;
+  double end = 0;
+  std::uint32_t page = 0;
+  NodeId to = 0;
+};
+
+// What a pixel computer's page calls found at hand so far (own pages and
+// cache hits), after each tile: the cache over time.
+struct HitSample {
+  double time = 0;
+  std::uint64_t hits = 0;  // since the run began
+  std::uint16_t worker = 0;
+};
+
+// A node's log: its router's (route_log.hpp), then its own processes'.
+struct NodeLog : RouteLog {
+  std::vector<FetchEvent> fetches;
+  std::vector<ServeEvent> serves;
+  std::vector<HitSample> hits;
+};
+
+class Recorder final : public RouteRecorder {
+ public:
+  Recorder(std::size_t nodes, std::uint64_t max_packets, bool virtual_time,
+           std::chrono::steady_clock::time_point started = std::chrono::steady_clock::now());
+
+  NodeLog& log(NodeId node) { return *logs_.at(node); }
+  const NodeLog& log(NodeId node) const { return *logs_.at(node); }
+  RouteLog& route_log(NodeId node) override { return log(node); }
+  std::size_t nodes() const { return logs_.size(); }
+
+ private:
+  std::vector<std::unique_ptr<NodeLog>> logs_;
+};
+
+// One recorded packet, merged from the logs of the nodes it crossed.
+struct PacketTrace {
+  std::uint64_t id = 0;
+  std::uint8_t kind = 0;
+  std::uint32_t bytes = 0;
+  std::vector<NodeId> route;  // source first, destination last: hops + 1 nodes
+  // injected, then per hop its departure and arrival, then delivered:
+  // 2 * route.size() times.
+  std::vector<double> times;
+
+  std::size_t hops() const { return route.size() - 1; }
+  double injected() const { return times.front(); }
+  double delivered() const { return times.back(); }
+  double departs(std::size_t hop) const { return times[1 + 2 * hop]; }
+  double arrives(std::size_t hop) const { return times[2 + 2 * hop]; }
+};
+
+struct NodeTrace {
+  std::vector<FetchEvent> fetches;  // in the order each worker made them
+  std::vector<ServeEvent> serves;   // in order
+  std::vector<HitSample> hits;      // in the order each worker took them
+  std::vector<TileSpan> tiles;      // as the machine recorded them (record_tiles)
+};
+
+struct Recording {
+  bool virtual_time = false;
+  std::uint64_t max_packets = 0;
+  std::vector<PacketTrace> packets;             // by injection time, then id
+  std::vector<NodeTrace> nodes;                 // index = node
+  std::array<std::uint64_t, 256> unrecorded{};  // packets delivered but not recorded, by kind
+  std::uint64_t unrecorded_packets = 0;
+  std::uint64_t unrecorded_hops = 0;
+  double end = 0;  // the latest time recorded
+
+  std::uint64_t recorded_hops() const;
+};
+
+// The logs joined packet by packet, with each node's tiles (index = node).
+Recording merge_recording(const Recorder& recorder, const topology::Topology& topology,
+                          std::vector<std::vector<TileSpan>> tiles);
+
+}  // namespace nodes

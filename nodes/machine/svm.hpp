@@ -1,0 +1,110 @@
+// The shared virtual memory of one processor: a tracer::PageSource per
+// pixel-computer fiber over the node's NodeMemory (own pages + LRU cache).
+//
+// An access is answered from the node's own pages, else from the cache, else
+// by a page request to the owner's page server: only the requesting fiber
+// blocks (inside PageFetch, on the network) until the page arrives and is
+// installed in the cache, evicting the least recently used unpinned page.
+// Pages are read-only during rendering: no coherence protocol.
+//
+// Who wakes whom: the first worker of a node to miss on page p fetches it;
+// a second worker missing on p while that fetch is pending does not send
+// another request but waits on its own wake channel (capacity 1), which the
+// fetcher writes once p is installed; the woken worker looks p up again
+// (and fetches it itself if it was evicted in between).
+//
+// Page lifetime: a worker's pin is the cache slot it last returned, so
+// another worker's install never evicts bytes still in use (the page()
+// contract is "valid until the next page() call on this source"): an install
+// passes the node's pinned slots to NodeMemory, which evicts none of them. A
+// worker drops its pin before it blocks — at a miss, and by release() before
+// it talks to the farmer or collector. Since a node's fibers share one OS
+// thread and only the running fiber can hold a pin it is using, an
+// installing worker always finds a slot no one has pinned.
+//
+// A pin is one store into the worker's own source, so a cache hit costs a
+// table load, a stamp of the slot's last use and that store.
+#pragma once
+
+#include <cstdint>
+#include <functional>
+#include <memory>
+#include <span>
+#include <vector>
+
+#include "csp/csp.hpp"
+#include "nodes/machine/node_memory.hpp"
+#include "tracer/database.hpp"
+
+namespace nodes {
+
+// Blocks the calling fiber until the owner's page_reply payload for `page`
+// arrives, and returns it.
+using PageFetch = std::function<std::vector<std::byte>(std::uint32_t page)>;
+
+// Every access ends in exactly one of the four counts.
+struct SvmStats {
+  std::uint64_t own_hits = 0;
+  std::uint64_t cache_hits = 0;
+  std::uint64_t misses = 0;     // page requests sent (page communications)
+  std::uint64_t coalesced = 0;  // misses served by another worker's pending request
+
+  std::uint64_t accesses() const { return own_hits + cache_hits + misses + coalesced; }
+  SvmStats& operator+=(const SvmStats& o);
+  // Accesses not answered by own pages or the cache, over all accesses.
+  double miss_ratio() const;
+};
+
+class NodeSvm;
+
+class SvmSource final : public tracer::PageSource {
+ public:
+  SvmSource(NodeSvm& node, int worker, PageFetch fetch);
+
+  const std::byte* page(tracer::PageId id) override;
+  void release() { pinned_ = -1; }  // drop the pin: call before blocking outside page()
+  const SvmStats& stats() const { return stats_; }
+
+ private:
+  friend class NodeSvm;
+  const std::byte* miss(tracer::PageId id);
+  const std::byte* from_slot(int slot) {
+    pinned_ = slot;
+    return memory_.use(slot);
+  }
+  const std::byte* fetch_and_install(tracer::PageId id);
+
+  NodeSvm& node_;
+  NodeMemory& memory_;
+  int worker_;
+  PageFetch fetch_;
+  int pinned_ = -1;  // slot this source last returned, or -1
+  csp::Channel<int> wake_;
+  SvmStats stats_;
+};
+
+// A processor's memory and its workers' page sources.
+class NodeSvm {
+ public:
+  explicit NodeSvm(NodeMemory memory) : memory_(std::move(memory)) {}
+  NodeSvm(const NodeSvm&) = delete;
+  NodeSvm& operator=(const NodeSvm&) = delete;
+
+  SvmSource& add_worker(PageFetch fetch);  // worker ids are 0, 1, ... in order
+  SvmSource& worker(int w) { return *workers_[static_cast<std::size_t>(w)]; }
+  int worker_count() const { return static_cast<int>(workers_.size()); }
+
+  NodeMemory& memory() { return memory_; }
+  const NodeMemory& memory() const { return memory_; }
+  SvmStats stats() const;  // summed over the workers
+
+ private:
+  friend class SvmSource;
+  // Installs a fetched page where no worker's pin is.
+  int install(std::uint32_t page, std::span<const std::byte> bytes);
+
+  NodeMemory memory_;
+  std::vector<std::unique_ptr<SvmSource>> workers_;
+};
+
+}  // namespace nodes

@@ -1,0 +1,176 @@
+// nodes::Network: the store-and-forward interconnect of the simulated machine,
+// built on a csp::Runtime along a topology::Topology.
+//
+// Per node n (all placed on thread placement(n), block placement by default,
+// so most links join processes of the same thread):
+//   - one Router process (router.hpp), whose output queues are buffered
+//     channels of buffer_capacity packets: one per outgoing link and buffer
+//     class, read by the neighbour's router, and one per local port, which
+//     the application reads through port(n, p);
+//   - with a link model only: one Link process per output queue (link.hpp)
+//     that carries each packet across the modelled wire into the
+//     neighbour's router (or the port) over a rendezvous channel.
+// Every buffer is bounded; deadlock freedom rests on the acyclic channel
+// dependencies of topology::next_hop and on the consumption assumption
+// documented in router.hpp.
+//
+// Use: create the Network before Runtime::run(); local processes write to
+// injector(n, p) and read port(n, p). The local processes of a node share
+// one injection channel into its router, which keeps the router's ALT
+// short: a buffer of buffer_capacity packets, so that a sender goes on as
+// soon as its packet is queued instead of waiting for its router to run,
+// with blocked writers served in FIFO order when it is full. It feeds only
+// the router, so a process blocked on it holds up no packet on its way to
+// any port. Once the application knows nothing is in flight, one of its
+// processes calls shutdown(), which poisons every network channel: routers,
+// link processes and any reader of a port end with csp::Poisoned, so run()
+// returns with no fiber left blocked. Packets still in the network at
+// shutdown are dropped. stats() is valid after run().
+//
+// With relay_between_threads, a link whose routers run on different
+// threads is a pair of channels, each used by one thread only: the output
+// queue of the sending router, read by its thread's relay, and the input of
+// the receiving router, written by its own thread's relay; the relays carry
+// the packets between the threads (thread_relay.hpp).
+//
+// A machine split over OS processes (rank_plan.hpp) builds, on each rank, a
+// Network whose `local` nodes are that rank's: only their routers and ports
+// exist, and each link between a local and a remote node becomes, per
+// buffer class, one end for the rank's bridge (bridge.hpp): the local
+// router's output queue toward the remote node, whose reader is the
+// bridge, and the local router's input from it, whose only writer is the
+// bridge. The routers cannot tell such a link from any other.
+#pragma once
+
+#include <functional>
+#include <map>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "csp/csp.hpp"
+#include "nodes/net/link.hpp"
+#include "nodes/net/packet.hpp"
+#include "nodes/net/router.hpp"
+#include "nodes/net/thread_relay.hpp"
+#include "topology/topology.hpp"
+
+namespace nodes {
+
+struct NetworkOptions {
+  std::size_t buffer_capacity = 4;  // packets per output queue and per injection channel, at least 1
+  unsigned ports_per_node = 1;      // local ports per node
+  std::uint64_t trace_routes = 0;   // record the routes of the first this many packets injected
+  std::vector<std::uint8_t> trace_kinds;  // of these kinds only (empty: every kind)
+  RouteRecorder* recorder = nullptr;      // every router records its hops here (route_log.hpp); null: none
+  LinkModel link;                   // optional per-hop latency and bandwidth
+  std::function<unsigned(NodeId)> placement;  // thread of node n; default block
+  std::function<bool(NodeId)> local;          // nodes this process runs; default all
+  // Links between routers on different threads go through the threads'
+  // relays (thread_relay.hpp) instead of channels shared by two threads.
+  // Real time only (the relays need FifoScheduler); not with a link model.
+  bool relay_between_threads = false;
+};
+
+// One direction and buffer class of a link whose ends run in different processes.
+struct CutLink {
+  NodeId from = 0;
+  NodeId to = 0;
+  unsigned buffer_class = 0;
+};
+
+struct CutEnds {
+  std::vector<std::pair<CutLink, csp::In<Packet>>> outgoing;   // local `from`: its router's output queue
+  std::vector<std::pair<CutLink, csp::Out<Packet>>> incoming;  // local `to`: into its router
+};
+
+struct LinkStats {
+  NodeId from = 0;
+  NodeId to = 0;
+  std::uint64_t packets = 0;
+  std::uint64_t bytes = 0;
+};
+
+struct NetworkStats {
+  std::vector<RouterCounters> routers;  // index = node
+  std::vector<LinkStats> links;         // one per directed link, classes summed
+  HopSummary hops;                      // of all delivered packets
+  std::map<std::uint8_t, HopSummary> hops_by_kind;
+  std::vector<RouteRecord> routes;  // traced packets, by id
+};
+
+using KindNamer = std::function<std::string(std::uint8_t kind)>;
+
+class Network {
+ public:
+  Network(csp::Runtime& runtime, topology::Topology topology, NetworkOptions options = {});
+  Network(const Network&) = delete;
+  Network& operator=(const Network&) = delete;
+
+  const topology::Topology& topology() const { return topology_; }
+  const NetworkOptions& options() const { return options_; }
+
+  csp::Out<Packet> injector(NodeId node, unsigned port = 0) const;
+  csp::In<Packet> port(NodeId node, unsigned port = 0) const;
+  unsigned thread_of(NodeId node) const;
+
+  bool is_local(NodeId node) const { return !options_.local || options_.local(node); }
+  // The links to and from other processes (empty unless `local` is set).
+  const CutEnds& cut_ends() const { return cut_; }
+
+  // Safe from any thread, more than once; after it, shut_down() is true.
+  void shutdown();
+  bool shut_down() const { return shut_down_.load(std::memory_order_acquire); }
+  NetworkStats stats() const;  // after Runtime::run() has returned
+  // Counters of one router (zero for a node this process does not run).
+  const RouterCounters& router_counters(NodeId node) const { return *router_counters_.at(node); }
+
+  // Links carried by thread relays (0 without them), and what each
+  // thread's relay carried (after run()).
+  std::size_t relayed_links() const { return relays_ ? relays_->links() : 0; }
+  RelayCounters relay_counters(unsigned thread) const {
+    return relays_ ? relays_->counters(thread) : RelayCounters{};
+  }
+
+  // Contiguous ranges of nodes per thread: node * threads / nodes.
+  static unsigned block_placement(NodeId node, std::size_t nodes, unsigned threads);
+
+ private:
+  void wire_node(csp::Runtime& runtime, NodeId node);
+  csp::Out<Packet> output_queue(csp::Runtime& runtime, NodeId node, const csp::Channel<Packet>& next);
+  std::size_t queue_capacity() const;
+
+  topology::Topology topology_;
+  NetworkOptions options_;
+  unsigned classes_;
+  unsigned threads_;
+  // Per node, per (port, class): the channel into that node's router.
+  std::vector<std::vector<csp::Channel<Packet>>> link_in_;
+  std::vector<csp::Channel<Packet>> injections_;  // per node
+  std::vector<std::vector<csp::Channel<Packet>>> ports_;
+  std::vector<csp::Channel<Packet>> wires_;  // link model only: router -> link process
+  std::vector<csp::Channel<Packet>> cut_queues_;  // local router -> bridge (toward remote nodes) or relay (other thread)
+  CutEnds cut_;
+  std::unique_ptr<ThreadRelays> relays_;  // with relay_between_threads and several threads
+  std::atomic<bool> shut_down_{false};
+  // Counters live here so they outlive the processes; each is written by
+  // exactly one process and read only after run().
+  std::vector<std::unique_ptr<RouterCounters>> router_counters_;
+  std::atomic<std::uint64_t> routes_to_trace_;  // RouterConfig::routes_to_trace
+  std::array<bool, 256> kinds_to_trace_{};      // RouterConfig::kinds_to_trace, from trace_kinds
+};
+
+// The network's figures from every router's counters (index = node).
+NetworkStats network_stats(const topology::Topology& topology, const std::vector<const RouterCounters*>& routers);
+
+// "page 17: 5 → 4 → 6 → 7 (3 hops)"
+std::string format_route(const RouteRecord& record, const KindNamer& kind_name);
+
+// The link that carried the most packets, or null for a machine without links.
+const LinkStats* busiest_link(const NetworkStats& stats);
+
+// Table: packets, mean/max hops overall and per kind, busiest link, peak buffers.
+std::string format_summary(const NetworkStats& stats, const topology::Topology& topology,
+                           const KindNamer& kind_name);
+
+}  // namespace nodes

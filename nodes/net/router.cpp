@@ -1,0 +1,178 @@
+// Router process: ALT over link inputs, injections and room in the outputs
+// that held-back packets wait for; pending slots that hold back a full route.
+#include "nodes/net/router.hpp"
+
+#include <algorithm>
+#include <stdexcept>
+#include <string>
+#include <utility>
+
+namespace nodes {
+
+void HopSummary::add(std::uint32_t hops) {
+  ++packets;
+  total_hops += hops;
+  max_hops = std::max(max_hops, hops);
+}
+
+void HopSummary::merge(const HopSummary& other) {
+  packets += other.packets;
+  total_hops += other.total_hops;
+  max_hops = std::max(max_hops, other.max_hops);
+}
+
+Router::Router(topology::Topology topology, NodeId self, RouterEnds ends, RouterConfig config, RouterCounters& counters)
+    : topology_(std::move(topology)),
+      self_(self),
+      ends_(std::move(ends)),
+      config_(config),
+      counters_(counters),
+      log_(config.recorder ? &config.recorder->route_log(self) : nullptr),
+      link_queues_(ends_.inputs.size()),
+      pending_(ends_.inputs.size() + ends_.injections.size()),
+      held_for_(ends_.outputs.size(), 0) {
+  counters_.sent.assign(ends_.outputs.size(), LinkCounters{});
+}
+
+void Router::run() {
+  build_alt();
+  for (;;) {
+    const std::size_t guard = alt_.select();
+    if (guard < room_guard_.size()) {
+      admit_pending(guard);
+      continue;
+    }
+    const std::size_t source = guard - room_guard_.size();
+    Packet packet = source < ends_.inputs.size()
+                        ? ends_.inputs[source].read()
+                        : ends_.injections[source - ends_.inputs.size()].read();
+    receive(source, std::move(packet));
+  }
+}
+
+// Room guards first (one per output, enabled while a packet waits for it),
+// then sources (inputs, injections): guard index = position.
+void Router::build_alt() {
+  for (const auto& out : ends_.outputs) {
+    room_guard_.push_back(alt_.add_room(out));
+    alt_.enable(room_guard_.back(), false);
+  }
+  for (const auto& in : ends_.inputs) source_guard_.push_back(alt_.add_input(in));
+  for (const auto& in : ends_.injections) source_guard_.push_back(alt_.add_input(in));
+}
+
+void Router::receive(std::size_t source, Packet packet) {
+  if (source >= ends_.inputs.size()) {
+    accept_injection(packet);
+  } else {
+    ++packet.hops;
+    if (packet.traced) packet.route.push_back(self_);
+    if (log_ && packet.recorded) log_->arrived.push_back({packet.id, config_.recorder->now(), 0, packet.hops});
+  }
+  const std::size_t queue = output_queue(packet);
+  // Packets already held back for this output go first.
+  if (held_for_[queue] > 0 || !try_send(queue, packet)) hold(source, std::move(packet), queue);
+}
+
+void Router::accept_injection(Packet& packet) const {
+  const std::size_t ports = ends_.outputs.size() - link_queues_;
+  if (packet.destination >= topology_.size() || packet.port >= ports)
+    throw std::out_of_range("node " + std::to_string(self_) + ": packet " +
+                            std::to_string(packet.id) + " sent to node " +
+                            std::to_string(packet.destination) + " port " +
+                            std::to_string(packet.port) + ", which does not exist");
+  ++counters_.injected;
+  packet.source = self_;
+  packet.hops = 0;
+  packet.traced = packet.traced || take_route_to_trace(packet.kind);
+  packet.route.clear();
+  if (packet.traced) packet.route.push_back(self_);
+  packet.recorded = log_ && config_.recorder->admit();
+  if (packet.recorded)
+    log_->injected.push_back({packet.id, config_.recorder->now(), packet.destination,
+                              static_cast<std::uint32_t>(packet.payload.size()), packet.kind});
+}
+
+bool Router::take_route_to_trace(std::uint8_t kind) const {
+  if (config_.routes_to_trace == nullptr) return false;
+  if (config_.kinds_to_trace != nullptr && !(*config_.kinds_to_trace)[kind]) return false;
+  std::uint64_t left = config_.routes_to_trace->load(std::memory_order_relaxed);
+  while (left > 0)
+    if (config_.routes_to_trace->compare_exchange_weak(left, left - 1, std::memory_order_relaxed)) return true;
+  return false;
+}
+
+std::size_t Router::output_queue(const Packet& packet) const {
+  if (packet.destination == self_) return link_queues_ + packet.port;
+  const topology::Hop hop = topology_.next_hop(self_, packet.destination);
+  return hop.port * topology_.buffer_classes() + hop.buffer_class;
+}
+
+// Writes the packet into its output queue if that has room; false (packet
+// untouched) if it is full.
+bool Router::try_send(std::size_t queue, Packet& packet) {
+  const std::size_t bytes = packet.payload.size();
+  const bool delivery = queue >= link_queues_;
+  const std::uint32_t hops = packet.hops;
+  const std::uint8_t kind = packet.kind;
+  const bool recorded = packet.recorded;
+  const std::uint64_t id = packet.id;
+  // Before the write: on another thread the next router may read it at once.
+  const double left_at = log_ && recorded ? config_.recorder->now() : 0.0;
+  std::optional<RouteRecord> route;
+  if (delivery && packet.traced) route = RouteRecord{packet.id, packet.kind, packet.route};
+  if (!ends_.outputs[queue].try_write(packet)) return false;
+  ++counters_.sent[queue].packets;
+  counters_.sent[queue].bytes += bytes;
+  if (log_) record_sent(recorded, id, static_cast<std::uint16_t>(hops), kind, queue, left_at);
+  if (!delivery) {
+    ++counters_.forwarded;
+    return true;
+  }
+  ++counters_.delivered;
+  counters_.hops.add(hops);
+  counters_.hops_by_kind[kind].add(hops);
+  if (route) counters_.routes.push_back(std::move(*route));
+  return true;
+}
+
+// Off the hot path: only a recorded run calls it.
+void Router::record_sent(bool recorded, std::uint64_t id, std::uint16_t hops, std::uint8_t kind, std::size_t queue,
+                         double time) {
+  const bool delivery = queue >= link_queues_;
+  if (!recorded) {
+    if (delivery) {
+      ++log_->unrecorded[kind];
+      log_->unrecorded_hops += hops;
+    }
+    return;
+  }
+  if (delivery)
+    log_->delivered.push_back({id, time, hops});
+  else
+    log_->departed.push_back({id, time, static_cast<std::uint32_t>(queue), hops});
+}
+
+void Router::hold(std::size_t source, Packet packet, std::size_t queue) {
+  pending_[source] = Pending{std::move(packet), queue};
+  alt_.enable(source_guard_[source], false);
+  if (held_for_[queue]++ == 0) alt_.enable(room_guard_[queue], true);
+  counters_.peak_pending = std::max(counters_.peak_pending, ++pending_count_);
+}
+
+// `queue` has room: write the packets held back for it while it has, taking
+// the pending slots in rotation so that no input starves.
+void Router::admit_pending(std::size_t queue) {
+  for (std::size_t k = 0; k < pending_.size() && held_for_[queue] > 0; ++k) {
+    const std::size_t s = (next_admit_ + k) % pending_.size();
+    if (!pending_[s] || pending_[s]->queue != queue) continue;
+    if (!try_send(queue, pending_[s]->packet)) return;
+    pending_[s].reset();
+    alt_.enable(source_guard_[s], true);
+    --pending_count_;
+    if (--held_for_[queue] == 0) alt_.enable(room_guard_[queue], false);
+    next_admit_ = s + 1;
+  }
+}
+
+}  // namespace nodes

@@ -1,0 +1,135 @@
+// The router of one processor: store-and-forward switching by the topology's
+// deadlock-free routing function.
+//
+// Ends (all inputs read, all outputs written by the router alone):
+//   inputs[q]     packets arriving over link port p in buffer class c,
+//                 q = p * classes + c
+//   injections[j] packets sent by the local processes of this node
+//   outputs[o]    bounded buffers (capacity K): the link queues (same
+//                 numbering as inputs), then one delivery queue per local port
+//
+// Protocol: one ALT (fair select) over the inputs and, for every output that
+// a held-back packet waits for, a room guard. It is a doorbell ALT
+// (csp/alt.hpp): a router selects for every packet and usually finds nothing
+// ready, so its channels ring it rather than have it link a record on each
+// of them every time it parks. A packet read from input i is
+// written to its output queue at once if that has room (try_write: the router
+// never blocks on output while a neighbour blocks on it); otherwise it waits
+// in pending[i], input i is disabled, and the output's room guard is enabled
+// until the packet can be written. Pending packets waiting for one output are
+// admitted in rotation, so no input starves, and an output with packets held
+// back for it takes no newcomers first. So each (link, class) owns at most
+// K queued + 1 pending packets (+ 1 carried by a link process when a link
+// model is on), a packet in one channel's buffers waits only for the next
+// channel on its route, and the acyclic channel dependency graph of
+// topology::next_hop makes the whole network free of deadlock with bounded
+// buffers.
+//
+// Consumption assumption: a delivery queue is a sink; it drains as long as the
+// local process reading that port keeps reading, even while its own writes
+// to an injection channel are blocked. A local process that both receives and
+// sends must therefore read its port in a fiber of its own (or never block on
+// injection while packets for it may be waiting); otherwise it can close a
+// cycle through the network with its own injection.
+#pragma once
+
+#include <array>
+#include <atomic>
+#include <cstdint>
+#include <optional>
+#include <vector>
+
+#include "csp/csp.hpp"
+#include "nodes/net/link.hpp"
+#include "nodes/net/packet.hpp"
+#include "nodes/net/route_log.hpp"
+#include "topology/topology.hpp"
+
+namespace nodes {
+
+struct HopSummary {
+  std::uint64_t packets = 0;
+  std::uint64_t total_hops = 0;
+  std::uint32_t max_hops = 0;
+
+  void add(std::uint32_t hops);
+  void merge(const HopSummary& other);
+  double mean() const { return packets ? static_cast<double>(total_hops) / packets : 0.0; }
+};
+
+struct RouteRecord {
+  std::uint64_t id = 0;
+  std::uint8_t kind = 0;
+  std::vector<NodeId> route;
+};
+
+// Owned by one router process; read only after the runtime has stopped.
+struct RouterCounters {
+  std::uint64_t injected = 0;
+  std::uint64_t forwarded = 0;  // packets sent on into a link queue
+  std::uint64_t delivered = 0;
+  std::uint32_t peak_pending = 0;  // most packets held back at once (outputs full)
+  std::vector<LinkCounters> sent;  // per output queue: packets and payload bytes
+  HopSummary hops;                 // of packets delivered here
+  std::array<HopSummary, 256> hops_by_kind{};  // index = packet kind
+  std::vector<RouteRecord> routes;  // traced packets delivered here
+};
+
+struct RouterEnds {
+  std::vector<csp::In<Packet>> inputs;
+  std::vector<csp::In<Packet>> injections;
+  std::vector<csp::Out<Packet>> outputs;  // buffered channels
+};
+
+struct RouterConfig {
+  // Routes still to trace, shared by every router of the network: each
+  // injection takes one while any are left, so the first packets injected
+  // are traced, however their senders number them. Null: none traced.
+  std::atomic<std::uint64_t>* routes_to_trace = nullptr;
+  // The packet kinds traced, by kind; null: every kind. Packets of other
+  // kinds take no route from routes_to_trace.
+  const std::array<bool, 256>* kinds_to_trace = nullptr;
+  // The run's recorder (route_log.hpp), whose log of this node only this
+  // router writes; null: nothing recorded, one branch per packet.
+  RouteRecorder* recorder = nullptr;
+};
+
+class Router {
+ public:
+  Router(topology::Topology topology, NodeId self, RouterEnds ends, RouterConfig config,
+         RouterCounters& counters);
+  void run();
+
+ private:
+  struct Pending {
+    Packet packet;
+    std::size_t queue;
+  };
+
+  void build_alt();
+  void receive(std::size_t source, Packet packet);
+  void accept_injection(Packet& packet) const;
+  void record_sent(bool recorded, std::uint64_t id, std::uint16_t hops, std::uint8_t kind, std::size_t queue,
+                   double time);
+  bool take_route_to_trace(std::uint8_t kind) const;
+  bool try_send(std::size_t queue, Packet& packet);
+  void hold(std::size_t source, Packet packet, std::size_t queue);
+  void admit_pending(std::size_t queue);
+  std::size_t output_queue(const Packet& packet) const;
+
+  topology::Topology topology_;
+  NodeId self_;
+  RouterEnds ends_;
+  RouterConfig config_;
+  RouterCounters& counters_;
+  RouteLog* log_ = nullptr;   // this node's log when the run is recorded
+  std::size_t link_queues_;  // degree * classes; delivery queues follow
+  std::vector<std::optional<Pending>> pending_;  // per input, then per injection
+  std::vector<std::uint32_t> held_for_;          // per output: pending packets waiting for it
+  std::uint32_t pending_count_ = 0;
+  std::size_t next_admit_ = 0;  // rotates which pending packet is admitted first
+  csp::Alt alt_{csp::Alt::Waiting::doorbell};
+  std::vector<std::size_t> room_guard_, source_guard_;
+};
+
+}  // namespace nodes

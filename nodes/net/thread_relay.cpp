@@ -1,0 +1,287 @@
+// ThreadRelays: the rings, and the relay process of each thread.
+#include "nodes/net/thread_relay.hpp"
+
+#include <algorithm>
+#include <bit>
+#include <optional>
+#include <stdexcept>
+#include <string>
+#include <utility>
+
+namespace nodes {
+
+struct ThreadRelays::Link {
+  unsigned from_thread = 0;
+  unsigned to_thread = 0;
+  csp::In<Packet> queue;
+  csp::Out<Packet> into;
+};
+
+// One producer (the relay of the ring's first thread), one consumer (that
+// of its second). An entry carries a packet for a link, or `credits` > 0
+// returned for a link. Each index is written by one side only and sits on
+// a cache line of its own; each side keeps its last view of the other's, so
+// a push or a drain reads the other side's line only when the view says
+// full or empty. A Packet's vectors move in and out of a slot without
+// allocating.
+class ThreadRelays::Ring {
+ public:
+  struct Entry {
+    std::uint32_t link = 0;
+    std::uint32_t credits = 0;
+    Packet packet;
+  };
+
+  explicit Ring(std::size_t capacity) : slots_(std::bit_ceil(std::max<std::size_t>(capacity, 1))) {}
+
+  // The credits bound what can be in a ring, so a full ring is a broken
+  // invariant, never back-pressure.
+  void push(Entry&& e) {
+    if (tail_ - head_seen_ == slots_.size()) {
+      head_seen_ = head_.load(std::memory_order_acquire);
+      if (tail_ - head_seen_ == slots_.size()) throw std::logic_error("thread relay: ring full");
+    }
+    slots_[tail_ & (slots_.size() - 1)] = std::move(e);
+    tail_published_.store(++tail_, std::memory_order_release);
+  }
+
+  // Takes every entry published so far; the head is published once.
+  template <class F>
+  void drain(F&& take) {
+    const std::uint64_t tail = tail_published_.load(std::memory_order_acquire);
+    if (tail == head_local_) return;
+    for (; head_local_ != tail; ++head_local_) take(slots_[head_local_ & (slots_.size() - 1)]);
+    head_.store(head_local_, std::memory_order_release);
+  }
+
+ private:
+  std::vector<Entry> slots_;
+  alignas(64) std::atomic<std::uint64_t> tail_published_{0};
+  alignas(64) std::uint64_t tail_ = 0;  // the producer's
+  std::uint64_t head_seen_ = 0;         // the producer's view of head_
+  alignas(64) std::atomic<std::uint64_t> head_{0};
+  alignas(64) std::uint64_t head_local_ = 0;  // the consumer's
+};
+
+class ThreadRelays::Relay {
+ public:
+  Relay(ThreadRelays& relays, unsigned thread) : relays_(relays), thread_(thread) {
+    for (std::size_t i = 0; i < relays_.links_.size(); ++i) {
+      const Link& l = relays_.links_[i];
+      if (l.from_thread == thread_) outgoing_.push_back(Outgoing{i, relays_.capacity_});
+      if (l.to_thread == thread_) incoming_.push_back(Incoming{i});
+    }
+    out_index_.assign(relays_.links_.size(), none);
+    in_index_.assign(relays_.links_.size(), none);
+    for (std::size_t k = 0; k < outgoing_.size(); ++k) out_index_[outgoing_[k].link] = k;
+    for (std::size_t k = 0; k < incoming_.size(); ++k) in_index_[incoming_[k].link] = k;
+    touched_.assign(relays_.threads_, false);
+  }
+
+  void run() {
+    csp::Arrivals& arrivals = *relays_.arrivals_[thread_];
+    if (!arrivals.attach([token = relays_.tokens_[thread_].writer()]() mutable {
+          char t = 0;
+          try {
+            (void)token.try_write(t);
+          } catch (const csp::Poisoned&) {
+            // The network is shutting down; the relay ends on its own.
+          }
+        }))
+      throw std::logic_error("thread relay: the runtime's scheduler takes no arrivals");
+    struct Detach {
+      csp::Arrivals& a;
+      ~Detach() { a.detach(); }
+    } detach{arrivals};
+    build_alt();
+    take_arrivals();  // anything signalled before the attach
+    for (;;) {
+      handle(alt_.select());
+      take_ready();
+      // The processes this wake made ready (the routers it delivered to, the
+      // page servers behind them) run before the flush, and what they send
+      // across goes in the same batch: a request that arrives here leaves
+      // as a reply with the credits for it, under one signal. A relay is of
+      // high priority, so the pixel computers of this thread wait for it.
+      for (int round = 0; round < max_rounds && csp::yield_requested(); ++round) {
+        csp::yield();
+        take_ready();
+      }
+      flush();
+    }
+  }
+
+ private:
+  static constexpr std::size_t none = static_cast<std::size_t>(-1);
+  static constexpr int max_rounds = 8;  // yields before a flush, while other high-priority work is ready
+  struct Outgoing {
+    std::size_t link;
+    std::size_t credits;
+    std::size_t guard = 0;
+  };
+  struct Incoming {
+    std::size_t link;
+    std::deque<Packet> staged{};
+    std::uint32_t owed = 0;  // credits to return
+    std::size_t guard = 0;
+  };
+
+  // Guard 0: the token; then per outgoing link its queue (enabled while it
+  // has credits), per incoming link room in its input (enabled while
+  // packets are staged for it).
+  void build_alt() {
+    token_guard_ = alt_.add_input(relays_.tokens_[thread_].reader());
+    for (Outgoing& o : outgoing_) o.guard = alt_.add_input(relays_.links_[o.link].queue);
+    for (Incoming& i : incoming_) {
+      i.guard = alt_.add_room(relays_.links_[i.link].into);
+      alt_.enable(i.guard, false);
+    }
+    guard_owner_.assign(alt_.guard_count(), {false, none});
+    for (std::size_t k = 0; k < outgoing_.size(); ++k) guard_owner_[outgoing_[k].guard] = {true, k};
+    for (std::size_t k = 0; k < incoming_.size(); ++k) guard_owner_[incoming_[k].guard] = {false, k};
+  }
+
+  // One select per wake, then polls until nothing is ready: the doorbell
+  // ALT polls only the guards that rang, and no guard is switched to do
+  // so, so a wake costs what it moves and not the number of links.
+  void take_ready() {
+    while (const std::optional<std::size_t> g = alt_.poll()) handle(*g);
+  }
+
+  void handle(std::size_t guard) {
+    if (guard == token_guard_) {
+      (void)relays_.tokens_[thread_].reader().read();
+      take_arrivals();
+      return;
+    }
+    const auto [outgoing, k] = guard_owner_[guard];
+    if (outgoing) {
+      send(outgoing_[k]);
+    } else {
+      deliver(incoming_[k]);
+    }
+  }
+
+  // Everything the rings into this thread hold.
+  void take_arrivals() {
+    ++relays_.counters_[thread_].wakes;
+    for (unsigned from = 0; from < relays_.threads_; ++from) {
+      if (from == thread_) continue;
+      relays_.ring(from, thread_).drain([this](Ring::Entry& e) {
+        if (e.credits > 0) {
+          Outgoing& o = outgoing_[out_index_[e.link]];
+          if (o.credits == 0) alt_.enable(o.guard, true);
+          o.credits += e.credits;
+          return;
+        }
+        Incoming& i = incoming_[in_index_[e.link]];
+        ++relays_.counters_[thread_].packets_received;
+        if (i.staged.empty() && relays_.links_[i.link].into.try_write(e.packet)) {
+          ++i.owed;
+          return;
+        }
+        if (i.staged.empty()) alt_.enable(i.guard, true);
+        i.staged.push_back(std::move(e.packet));
+      });
+    }
+  }
+
+  // Packets of one outgoing link, while it has credits and packets.
+  void send(Outgoing& o) {
+    Link& l = relays_.links_[o.link];
+    Ring& ring = relays_.ring(thread_, l.to_thread);
+    while (o.credits > 0) {
+      std::optional<Packet> p = l.queue.try_read();
+      if (!p) break;
+      ring.push(Ring::Entry{static_cast<std::uint32_t>(o.link), 0, std::move(*p)});
+      ++relays_.counters_[thread_].packets_sent;
+      --o.credits;
+      touched_[l.to_thread] = true;
+    }
+    if (o.credits == 0) alt_.enable(o.guard, false);
+  }
+
+  // Staged packets of one incoming link, while its input has room.
+  void deliver(Incoming& i) {
+    Link& l = relays_.links_[i.link];
+    while (!i.staged.empty() && l.into.try_write(i.staged.front())) {
+      i.staged.pop_front();
+      ++i.owed;
+    }
+    if (i.staged.empty()) alt_.enable(i.guard, false);
+  }
+
+  // Returns the credits owed, half a link's worth at least at a time, and
+  // signals, once each, the threads written to. Holding back fewer than
+  // half never stalls a link: a sender out of credits has K packets out,
+  // and each is staged (so the input is full and drains as its router
+  // reads) or delivered (owed), so the owed reach K/2 as the far end reads.
+  void flush() {
+    for (Incoming& i : incoming_) {
+      if (i.owed == 0 || 2 * i.owed < relays_.capacity_) continue;
+      const Link& l = relays_.links_[i.link];
+      relays_.ring(thread_, l.from_thread).push(Ring::Entry{static_cast<std::uint32_t>(i.link), i.owed, {}});
+      i.owed = 0;
+      touched_[l.from_thread] = true;
+    }
+    for (unsigned t = 0; t < relays_.threads_; ++t) {
+      if (!touched_[t]) continue;
+      touched_[t] = false;
+      relays_.arrivals_[t]->signal();
+      ++relays_.counters_[thread_].signals;
+    }
+  }
+
+  ThreadRelays& relays_;
+  const unsigned thread_;
+  std::vector<Outgoing> outgoing_;
+  std::vector<Incoming> incoming_;
+  std::vector<std::size_t> out_index_, in_index_;  // per link: its place above, or none
+  std::vector<std::pair<bool, std::size_t>> guard_owner_;  // per guard: (outgoing?, place)
+  std::vector<bool> touched_;                      // per thread: written to since the last flush
+  csp::Alt alt_{csp::Alt::Waiting::doorbell};
+  std::size_t token_guard_ = 0;
+};
+
+ThreadRelays::ThreadRelays(unsigned threads, std::size_t capacity)
+    : threads_(threads), capacity_(capacity), counters_(threads) {
+  for (unsigned t = 0; t < threads_; ++t) {
+    arrivals_.push_back(std::make_unique<csp::Arrivals>());
+    tokens_.emplace_back("relay token " + std::to_string(t), 1);
+  }
+}
+
+ThreadRelays::~ThreadRelays() = default;
+
+std::size_t ThreadRelays::links() const { return links_.size(); }
+
+void ThreadRelays::add(unsigned from_thread, unsigned to_thread, csp::In<Packet> queue, csp::Out<Packet> into) {
+  if (from_thread == to_thread || from_thread >= threads_ || to_thread >= threads_)
+    throw std::invalid_argument("thread relay: a relayed link joins two different threads of the runtime");
+  links_.push_back(Link{from_thread, to_thread, std::move(queue), std::move(into)});
+}
+
+// A ring from a to b carries the packets of links a→b (at most K each, by
+// the credits) and the credits of links b→a (at most K each, each entry
+// at least one).
+void ThreadRelays::spawn(csp::Runtime& runtime) {
+  std::vector<std::size_t> per_pair(std::size_t{threads_} * threads_, 0);
+  std::vector<bool> has_links(threads_, false);
+  for (const Link& l : links_) {
+    per_pair[l.from_thread * threads_ + l.to_thread] += capacity_;
+    per_pair[l.to_thread * threads_ + l.from_thread] += capacity_;
+    has_links[l.from_thread] = has_links[l.to_thread] = true;
+  }
+  for (std::size_t p = 0; p < per_pair.size(); ++p) rings_.push_back(std::make_unique<Ring>(per_pair[p]));
+  for (unsigned t = 0; t < threads_; ++t) {
+    if (!has_links[t]) continue;
+    auto relay = std::make_shared<Relay>(*this, t);
+    runtime.spawn("thread relay " + std::to_string(t), t, [relay] { relay->run(); });
+  }
+}
+
+void ThreadRelays::poison() {
+  for (auto& t : tokens_) t.poison();
+}
+
+}  // namespace nodes

@@ -1,0 +1,364 @@
+// The bridge process: cut links over the transport, with credits; see bridge.hpp.
+#include "nodes/ranks/bridge.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <stdexcept>
+
+namespace nodes {
+
+namespace {
+
+enum class Record : std::uint8_t { packet = 1, credit, end, abort };
+
+constexpr std::chrono::microseconds shortest_poll{4};
+constexpr std::size_t poll_levels = 9;  // 4 us .. 1024 us
+// A frame is posted once it holds this much: a message under the eager
+// limit of MPI's shared-memory transport (4 KB in Open MPI) is delivered
+// whole by the send; a larger one waits, after the receiver matches it,
+// for the sender's next MPI call, which on a busy rank comes only after a
+// run of pixels.
+constexpr std::size_t frame_bytes = 3 * 1024;
+constexpr std::chrono::microseconds hot_window{1000};  // since the last activity
+
+void put_link(WireWriter& w, const CutLink& link) {
+  w.put<std::uint32_t>(link.from);
+  w.put<std::uint32_t>(link.to);
+  w.put<std::uint8_t>(static_cast<std::uint8_t>(link.buffer_class));
+}
+
+CutLink get_link(WireReader& r) {
+  CutLink link;
+  link.from = r.get<std::uint32_t>();
+  link.to = r.get<std::uint32_t>();
+  link.buffer_class = r.get<std::uint8_t>();
+  return link;
+}
+
+void put_packet(WireWriter& w, const Packet& p) {
+  w.put(p.source);
+  w.put(p.destination);
+  w.put(p.kind);
+  w.put(p.port);
+  w.put(p.hops);
+  w.put<std::uint8_t>(p.traced ? 1 : 0);
+  w.put(p.id);
+  w.put_vector(p.payload);
+  w.put_vector(p.route);
+}
+
+Packet get_packet(WireReader& r) {
+  Packet p;
+  p.source = r.get<NodeId>();
+  p.destination = r.get<NodeId>();
+  p.kind = r.get<std::uint8_t>();
+  p.port = r.get<std::uint16_t>();
+  p.hops = r.get<std::uint16_t>();
+  p.traced = r.get<std::uint8_t>() != 0;
+  p.id = r.get<std::uint64_t>();
+  p.payload = r.get_vector<std::byte>();
+  p.route = r.get_vector<NodeId>();
+  return p;
+}
+
+}  // namespace
+
+void FailureNote::set(int rank, std::string text) {
+  std::lock_guard<std::mutex> lk(mutex_);
+  if (set_.load(std::memory_order_relaxed)) return;
+  rank_ = rank;
+  text_ = std::move(text);
+  set_.store(true, std::memory_order_release);
+}
+
+std::optional<std::pair<int, std::string>> FailureNote::get() const {
+  std::lock_guard<std::mutex> lk(mutex_);
+  if (!set_.load(std::memory_order_relaxed)) return std::nullopt;
+  return std::make_pair(rank_, text_);
+}
+
+Bridge::Bridge(Transport& transport, const RankPlan& plan, Network& network, FailureNote& local_failure,
+               FailureNote& remote_failure, BridgeCounters& counters)
+    : transport_(transport),
+      plan_(plan),
+      network_(network),
+      local_failure_(local_failure),
+      remote_failure_(remote_failure),
+      counters_(counters),
+      capacity_(network.options().buffer_capacity),
+      frames_(static_cast<std::size_t>(transport.size())),
+      end_from_(static_cast<std::size_t>(transport.size()), false),
+      ends_missing_(transport.size() - 1) {
+  const CutEnds& cut = network.cut_ends();
+  for (const auto& [link, queue] : cut.outgoing) {
+    outgoing_by_link_[key(link)] = outgoing_.size();
+    outgoing_.push_back(Outgoing{link, queue, plan.rank_of(link.to), capacity_, 0});
+  }
+  for (const auto& [link, into] : cut.incoming) {
+    incoming_by_link_[key(link)] = incoming_.size();
+    incoming_.push_back(Incoming{link, into, plan.rank_of(link.from), {}, 0, 0});
+  }
+  for (std::size_t i = 0; i < outgoing_.size(); ++i) {
+    outgoing_[i].guard = alt_.add_input(outgoing_[i].queue);
+    guard_owner_.emplace_back(true, i);
+  }
+  for (std::size_t i = 0; i < incoming_.size(); ++i) {
+    incoming_[i].guard = alt_.add_room(incoming_[i].into);
+    alt_.enable(incoming_[i].guard, false);
+    guard_owner_.emplace_back(false, i);
+  }
+  for (std::size_t level = 0; level < poll_levels; ++level) {
+    timeout_guards_.push_back(alt_.add_timeout(shortest_poll * (1 << level)));
+    alt_.enable(timeout_guards_.back(), level == 0);
+  }
+}
+
+std::uint64_t Bridge::key(const CutLink& link) const {
+  return (std::uint64_t{link.from} * plan_.nodes() + link.to) * 256 + link.buffer_class;
+}
+
+WireWriter& Bridge::frame(int peer) { return frames_[static_cast<std::size_t>(peer)]; }
+
+void Bridge::run() {
+  try {
+    carry();
+  } catch (const csp::Poisoned&) {
+    throw;
+  } catch (const std::exception& e) {
+    // Tell the peers before this process ends, or they would wait for it.
+    local_failure_.set(transport_.rank(), std::string("process 'bridge' failed: ") + e.what());
+    if (!stopping_) stop();
+    drain();
+    throw;
+  }
+}
+
+void Bridge::carry() {
+  for (;;) {
+    if (!stopping_ && (network_.shut_down() || local_failure_.set_already())) stop();
+    if (stopping_) return drain();
+    bool active = receive_all();
+    if (stopping_) continue;
+    try {
+      active = deliver_staged() || active;
+    } catch (const csp::Poisoned&) {
+      stop();
+      continue;
+    }
+    queue_credits();
+    send_frames();
+    transport_.progress();
+    // Poll at the shortest interval while an answer is due (packets sent
+    // that have not come back as credits) or something happened lately;
+    // back off once all is quiet.
+    const auto now = std::chrono::steady_clock::now();
+    if (active) last_active_ = now;
+    const bool hot = unacknowledged_ > 0 || now - last_active_ < hot_window;
+    alt_.enable(timeout_guards_[level_], false);
+    level_ = hot ? 0 : std::min(level_ + 1, poll_levels - 1);
+    alt_.enable(timeout_guards_[level_], true);
+    const std::size_t guard = alt_.select();
+    if (guard >= guard_owner_.size()) continue;  // a timeout: poll the wire
+    try {
+      if (take(guard)) {
+        take_ready();
+        // Sent now rather than after the next select: the receiver may be idle.
+        send_frames();
+        transport_.progress();
+        last_active_ = std::chrono::steady_clock::now();
+      }
+    } catch (const csp::Poisoned&) {
+      stop();
+    }
+  }
+}
+
+// What a ready guard offers: the packets of an outgoing link (true), or room
+// in a local input, into which the staged packets go at once.
+bool Bridge::take(std::size_t guard) {
+  const auto [is_outgoing, index] = guard_owner_[guard];
+  if (!is_outgoing) {
+    deliver_staged();
+    return false;
+  }
+  take_outgoing(outgoing_[index]);
+  return true;
+}
+
+// Everything else ready after a wake, so that the packets of several links
+// that became ready together leave in one message per rank, not one each.
+void Bridge::take_ready() {
+  while (const std::optional<std::size_t> guard = alt_.poll())
+    if (*guard < guard_owner_.size()) take(*guard);
+}
+
+// Reads what the guard found and whatever else the link holds, while the
+// credits last, into the frame for the link's rank.
+void Bridge::take_outgoing(Outgoing& out) {
+  WireWriter& w = frame(out.peer);
+  std::optional<Packet> packet = out.queue.read();
+  while (packet) {
+    w.put(Record::packet);
+    put_link(w, out.link);
+    put_packet(w, *packet);
+    if (w.size() >= frame_bytes) post_frame(out.peer);
+    ++counters_.packets_sent;
+    ++unacknowledged_;
+    counters_.bytes_sent += packet->payload.size();
+    if (--out.credits == 0) {
+      alt_.enable(out.guard, false);
+      break;
+    }
+    packet = out.queue.try_read();
+  }
+}
+
+bool Bridge::receive_all() {
+  bool any = false;
+  for (;;) {
+    ++counters_.polls;
+    std::optional<nodes::Incoming> message = transport_.poll(Tag::bridge);
+    if (!message) return any;
+    any = true;
+    receive(message->from, message->bytes);
+  }
+}
+
+void Bridge::receive(int from, const Bytes& bytes) {
+  WireReader r(bytes);
+  while (!r.done()) {
+    switch (static_cast<Record>(r.get<std::uint8_t>())) {
+      case Record::packet: {
+        const CutLink link = get_link(r);
+        Packet packet = get_packet(r);
+        if (stopping_) break;  // the network is gone; the machine's end means none should come
+        const auto it = incoming_by_link_.find(key(link));
+        if (it == incoming_by_link_.end())
+          throw std::runtime_error("bridge: rank " + std::to_string(from) + " sent a packet on link " +
+                                   std::to_string(link.from) + "->" + std::to_string(link.to) +
+                                   ", which does not end on this rank");
+        Incoming& in = incoming_[it->second];
+        if (in.staged.size() >= capacity_)
+          throw std::runtime_error("bridge: rank " + std::to_string(from) + " sent more packets on link " +
+                                   std::to_string(link.from) + "->" + std::to_string(link.to) +
+                                   " than it had credits for");
+        ++counters_.packets_received;
+        counters_.bytes_received += packet.payload.size();
+        if (in.staged.empty()) {
+          staged_.push_back(it->second);
+          alt_.enable(in.guard, true);
+        }
+        in.staged.push_back(std::move(packet));
+        break;
+      }
+      case Record::credit: {
+        const CutLink link = get_link(r);
+        const auto count = r.get<std::uint32_t>();
+        if (stopping_) break;
+        const auto it = outgoing_by_link_.find(key(link));
+        if (it == outgoing_by_link_.end()) throw std::runtime_error("bridge: a credit for a link not cut here");
+        Outgoing& out = outgoing_[it->second];
+        if (out.credits + count > capacity_ || count > unacknowledged_)
+          throw std::runtime_error("bridge: rank " + std::to_string(from) + " returned more credits than it owed");
+        if (out.credits == 0) alt_.enable(out.guard, true);
+        out.credits += count;
+        unacknowledged_ -= count;
+        break;
+      }
+      case Record::end:
+        if (end_from_[static_cast<std::size_t>(from)])
+          throw std::runtime_error("bridge: rank " + std::to_string(from) + " ended twice");
+        end_from_[static_cast<std::size_t>(from)] = true;
+        --ends_missing_;
+        if (!stopping_) stop();
+        break;
+      case Record::abort: {
+        const auto rank = r.get<std::int32_t>();
+        remote_failure_.set(rank, r.get_string());
+        if (!stopping_) stop();
+        break;
+      }
+      default:
+        throw std::runtime_error("bridge: rank " + std::to_string(from) + " sent an unknown record");
+    }
+  }
+}
+
+// Moves staged packets into their local inputs while there is room; each
+// moved packet owes its sender a credit.
+bool Bridge::deliver_staged() {
+  bool any = false;
+  for (std::size_t k = 0; k < staged_.size();) {
+    Incoming& in = incoming_[staged_[k]];
+    while (!in.staged.empty() && in.into.try_write(in.staged.front())) {
+      in.staged.pop_front();
+      if (in.credits_owed++ == 0) owing_.push_back(staged_[k]);
+      any = true;
+    }
+    if (in.staged.empty()) {
+      alt_.enable(in.guard, false);
+      staged_[k] = staged_.back();
+      staged_.pop_back();
+    } else {
+      ++k;
+    }
+  }
+  return any;
+}
+
+void Bridge::queue_credits() {
+  for (std::size_t i : owing_) {
+    Incoming& in = incoming_[i];
+    WireWriter& w = frame(in.peer);
+    w.put(Record::credit);
+    put_link(w, in.link);
+    w.put(in.credits_owed);
+    in.credits_owed = 0;
+  }
+  owing_.clear();
+}
+
+void Bridge::post_frame(int peer) {
+  WireWriter& w = frame(peer);
+  ++counters_.messages_sent;
+  counters_.wire_bytes_sent += w.size();
+  transport_.post(peer, Tag::bridge, w.take());
+  w = WireWriter{};
+}
+
+void Bridge::send_frames() {
+  for (int peer = 0; peer < transport_.size(); ++peer)
+    if (frame(peer).size() > 0) post_frame(peer);
+}
+
+void Bridge::stop() {
+  stopping_ = true;
+  network_.shutdown();
+  const auto failure = local_failure_.get();
+  for (int peer = 0; peer < transport_.size(); ++peer) {
+    if (peer == transport_.rank()) continue;
+    WireWriter& w = frame(peer);
+    if (failure) {
+      w.put(Record::abort);
+      w.put<std::int32_t>(failure->first);
+      w.put_string(failure->second);
+    }
+    w.put(Record::end);
+  }
+  send_frames();
+}
+
+// After stop(): until every peer has said `end` and every send is complete.
+void Bridge::drain() {
+  auto nap = shortest_poll;
+  while (ends_missing_ > 0 || transport_.pending() > 0) {
+    const bool any = receive_all();
+    send_frames();
+    transport_.progress();
+    if (any) continue;
+    csp::sleep_for(nap);
+    nap = std::min<std::chrono::microseconds>(nap * 2, shortest_poll * (1 << (poll_levels - 1)));
+  }
+}
+
+}  // namespace nodes

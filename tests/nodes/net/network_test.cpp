@@ -1,0 +1,212 @@
+// The store-and-forward network on csp: storms with buffers of one packet
+// on every kind of topology, exact hop counts under all-to-all traffic,
+// route tracing, and orderly shutdown.
+#include "nodes/net/network.hpp"
+
+#include <gtest/gtest.h>
+
+#include <atomic>
+#include <random>
+
+#include "csp/csp.hpp"
+#include "topology/spec.hpp"
+
+using namespace nodes;
+
+namespace {
+
+// Destinations of every packet, fixed by the seed; plan[n] lists node n's.
+using Plan = std::vector<std::vector<NodeId>>;
+
+Plan random_plan(std::size_t nodes, std::size_t per_node, unsigned seed) {
+  std::mt19937 rng(seed);
+  std::uniform_int_distribution<NodeId> pick(0, static_cast<NodeId>(nodes - 1));
+  Plan plan(nodes);
+  for (auto& dsts : plan)
+    for (std::size_t i = 0; i < per_node; ++i) dsts.push_back(pick(rng));
+  return plan;
+}
+
+Plan all_to_all_plan(std::size_t nodes) {
+  Plan plan(nodes);
+  for (NodeId n = 0; n < nodes; ++n)
+    for (NodeId m = 0; m < nodes; ++m)
+      if (m != n) plan[n].push_back(m);
+  return plan;
+}
+
+struct Received {
+  std::vector<std::uint64_t> ids;
+  std::uint64_t hops = 0;
+  bool misrouted = false;
+};
+
+// Runs `plan` over a network; returns what each node received, by node.
+// Each node has a sender and a receiver fiber (the consumption assumption);
+// the last receiver to finish shuts the network down.
+std::vector<Received> run_plan(const topology::Topology& t, const Plan& plan,
+                               NetworkOptions options, NetworkStats* stats = nullptr,
+                               std::size_t payload = 16) {
+  csp::Runtime runtime(2);
+  Network net(runtime, t, options);
+  std::vector<std::size_t> expected(t.size(), 0);
+  for (const auto& dsts : plan)
+    for (NodeId d : dsts) ++expected[d];
+  std::vector<Received> received(t.size());
+  std::atomic<std::size_t> unfinished{t.size()};
+  std::uint64_t next_id = 0;
+  for (NodeId n = 0; n < t.size(); ++n) {
+    std::vector<Packet> packets;
+    for (NodeId d : plan[n]) {
+      Packet p;
+      p.destination = d;
+      p.kind = kind_traffic;
+      p.id = next_id++;
+      p.payload.assign(payload, std::byte{static_cast<unsigned char>(n)});
+      packets.push_back(std::move(p));
+    }
+    runtime.spawn("send " + std::to_string(n), net.thread_of(n),
+                  [out = net.injector(n), packets = std::move(packets)]() mutable {
+                    for (auto& p : packets) out.write(std::move(p));
+                  });
+    runtime.spawn("receive " + std::to_string(n), net.thread_of(n),
+                  [&, n, in = net.port(n)]() mutable {
+                    for (std::size_t i = 0; i < expected[n]; ++i) {
+                      Packet p = in.read();
+                      received[n].ids.push_back(p.id);
+                      received[n].hops += p.hops;
+                      received[n].misrouted |= p.destination != n || p.hops != t.distance(p.source, n);
+                    }
+                    if (--unfinished == 0) net.shutdown();
+                  });
+  }
+  runtime.run();
+  if (stats) *stats = net.stats();
+  return received;
+}
+
+void expect_each_delivered_once(const topology::Topology& t, const Plan& plan,
+                                const std::vector<Received>& received) {
+  std::size_t total = 0;
+  for (const auto& dsts : plan) total += dsts.size();
+  std::vector<int> seen(total, 0);
+  for (NodeId n = 0; n < t.size(); ++n) {
+    EXPECT_FALSE(received[n].misrouted) << t.spec() << " node " << n;
+    for (std::uint64_t id : received[n].ids) ++seen.at(id);
+  }
+  for (std::size_t id = 0; id < total; ++id)
+    ASSERT_EQ(seen[id], 1) << t.spec() << " packet " << id;
+}
+
+std::string name_kind(std::uint8_t kind) { return kind == kind_traffic ? "traffic" : "other"; }
+
+}  // namespace
+
+TEST(Network, RandomStormWithBuffersOfOneDeliversEveryPacketOnce) {
+  const std::vector<std::string> specs = {
+      "hypercube:0", "hypercube:3", "hypercube:6", "hypercube:8", "mesh:1x1",  "mesh:3x5",
+      "mesh:16x16",  "torus:1x1",   "torus:2x2",   "torus:5x3",   "torus:8x8", "torus:16x16",
+      "ring:1",      "ring:2",      "ring:5",      "ring:64",     "ring:256",  "complete:1",
+      "complete:2",  "complete:7",  "complete:32", "complete:256"};
+  for (const auto& spec : specs) {
+    SCOPED_TRACE(spec);
+    const auto t = topology::parse_topology(spec);
+    const std::size_t per_node = std::max<std::size_t>(8, 1000 / t.size());
+    const Plan plan = random_plan(t.size(), per_node, 1234);
+    NetworkOptions options;
+    options.buffer_capacity = 1;
+    expect_each_delivered_once(t, plan, run_plan(t, plan, options));
+  }
+}
+
+TEST(Network, AllToAllMeanHopsEqualsAnalyticAverageDistance) {
+  for (const auto& spec : {"hypercube:6", "mesh:8x8", "torus:8x8", "torus:5x3", "ring:64",
+                           "ring:9", "complete:16", "mesh:7x3"}) {
+    SCOPED_TRACE(spec);
+    const auto t = topology::parse_topology(spec);
+    const Plan plan = all_to_all_plan(t.size());
+    NetworkStats stats;
+    const auto received = run_plan(t, plan, NetworkOptions{}, &stats);
+    expect_each_delivered_once(t, plan, received);
+    std::uint64_t hops = 0;
+    for (const auto& r : received) hops += r.hops;
+    EXPECT_EQ(hops, t.total_distance()) << spec;
+    EXPECT_EQ(stats.hops.total_hops, t.total_distance()) << spec;
+    EXPECT_DOUBLE_EQ(stats.hops.mean(), t.average_distance()) << spec;
+    EXPECT_EQ(stats.hops.max_hops, t.diameter()) << spec;
+  }
+}
+
+TEST(Network, LinkCountersAddUpToTheHopsTaken) {
+  const auto t = topology::parse_topology("torus:4x4");
+  const Plan plan = all_to_all_plan(t.size());
+  NetworkStats stats;
+  run_plan(t, plan, NetworkOptions{}, &stats, 100);
+  std::uint64_t packets = 0, bytes = 0, forwarded = 0;
+  for (const auto& l : stats.links) {
+    packets += l.packets;
+    bytes += l.bytes;
+  }
+  for (const auto& r : stats.routers) forwarded += r.forwarded;
+  EXPECT_EQ(packets, t.total_distance());
+  EXPECT_EQ(bytes, 100 * t.total_distance());
+  EXPECT_EQ(forwarded, t.total_distance());
+  EXPECT_EQ(stats.hops_by_kind.at(kind_traffic).packets, 16u * 15u);
+}
+
+TEST(Network, TracedRoutesFollowLinksHopByHop) {
+  const auto t = topology::parse_topology("hypercube:4");
+  NetworkOptions options;
+  options.trace_routes = 10;
+  NetworkStats stats;
+  run_plan(t, all_to_all_plan(t.size()), options, &stats);
+  ASSERT_EQ(stats.routes.size(), 10u);
+  for (const auto& r : stats.routes) {
+    ASSERT_GE(r.route.size(), 2u);
+    for (std::size_t i = 1; i < r.route.size(); ++i)
+      EXPECT_EQ(t.distance(r.route[i - 1], r.route[i]), 1u);
+  }
+  // Each goes the topology's own way: e-cube, lowest dimension first.
+  for (const auto& r : stats.routes)
+    for (std::size_t i = 1; i < r.route.size(); ++i)
+      EXPECT_EQ(r.route[i], t.neighbour(r.route[i - 1], t.next_hop(r.route[i - 1], r.route.back()).port));
+  // "traffic 6: 0 → 1 → 3 → 7 (3 hops)" for a packet from node 0 to node 7.
+  const nodes::RouteRecord zero_to_seven{6, kind_traffic, {0, 1, 3, 7}};
+  EXPECT_EQ(format_route(zero_to_seven, name_kind), "traffic 6: 0 \u2192 1 \u2192 3 \u2192 7 (3 hops)");
+  const std::string summary = format_summary(stats, t, name_kind);
+  EXPECT_NE(summary.find("busiest link"), std::string::npos) << summary;
+  EXPECT_NE(summary.find("traffic"), std::string::npos) << summary;
+}
+
+TEST(Network, LinkModelStillDeliversEverything) {
+  const auto t = topology::parse_topology("ring:6");
+  NetworkOptions options;
+  options.link.latency = std::chrono::microseconds(5);
+  options.link.bytes_per_second = 2.8e6;
+  const Plan plan = random_plan(t.size(), 20, 7);
+  expect_each_delivered_once(t, plan, run_plan(t, plan, options));
+}
+
+TEST(Network, ShutdownOfAnIdleNetworkEndsEveryProcess) {
+  csp::Runtime runtime(2);
+  Network net(runtime, topology::parse_topology("torus:4x4"), NetworkOptions{});
+  bool reader_poisoned = false;
+  runtime.spawn("reader", 0, [&, in = net.port(5)]() mutable {
+    try {
+      in.read();
+    } catch (const csp::Poisoned&) {
+      reader_poisoned = true;
+    }
+  });
+  runtime.spawn("stopper", 1, [&] { net.shutdown(); });
+  EXPECT_NO_THROW(runtime.run());
+  EXPECT_TRUE(reader_poisoned);
+}
+
+TEST(Network, BlockPlacementKeepsNeighbourRangesTogether) {
+  EXPECT_EQ(Network::block_placement(0, 64, 2), 0u);
+  EXPECT_EQ(Network::block_placement(31, 64, 2), 0u);
+  EXPECT_EQ(Network::block_placement(32, 64, 2), 1u);
+  EXPECT_EQ(Network::block_placement(63, 64, 2), 1u);
+  EXPECT_EQ(Network::block_placement(0, 1, 2), 0u);
+}
