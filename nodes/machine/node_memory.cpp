@@ -3,7 +3,6 @@
 
 #include <algorithm>
 #include <cstring>
-#include <limits>
 #include <stdexcept>
 #include <string>
 
@@ -65,18 +64,34 @@ NodeMemory::NodeMemory(const PagePlacement& placement, int node, std::size_t pag
   slots_.reserve(capacity_);
 }
 
+void NodeMemory::unlink(int slot) {
+  Slot& s = slots_[static_cast<std::size_t>(slot)];
+  if (s.newer >= 0) slots_[static_cast<std::size_t>(s.newer)].older = s.older;
+  else front_ = s.older;
+  if (s.older >= 0) slots_[static_cast<std::size_t>(s.older)].newer = s.newer;
+  else back_ = s.newer;
+  s.newer = s.older = -1;
+}
+
+void NodeMemory::push_front(int slot) {
+  Slot& s = slots_[static_cast<std::size_t>(slot)];
+  s.newer = -1;
+  s.older = front_;
+  if (front_ >= 0) slots_[static_cast<std::size_t>(front_)].newer = slot;
+  else back_ = slot;
+  front_ = slot;
+}
+
 int NodeMemory::take_slot(std::span<const int> in_use) {
   if (slots_.size() < capacity_) {
-    slots_.push_back(Slot{std::make_unique<std::byte[]>(page_size_), 0, 0});
-    return static_cast<int>(slots_.size() - 1);
+    slots_.push_back(Slot{std::make_unique<std::byte[]>(page_size_)});
+    const int slot = static_cast<int>(slots_.size() - 1);
+    push_front(slot);
+    return slot;
   }
-  int victim = -1;
-  std::uint64_t oldest = std::numeric_limits<std::uint64_t>::max();
-  for (std::size_t s = 0; s < slots_.size(); ++s)
-    if (slots_[s].last_use < oldest && std::find(in_use.begin(), in_use.end(), static_cast<int>(s)) == in_use.end()) {
-      oldest = slots_[s].last_use;
-      victim = static_cast<int>(s);
-    }
+  int victim = back_;
+  while (victim >= 0 && std::find(in_use.begin(), in_use.end(), victim) != in_use.end())
+    victim = slots_[static_cast<std::size_t>(victim)].newer;
   if (victim < 0) throw std::logic_error("page cache: every slot is in use");
   entry_[slots_[static_cast<std::size_t>(victim)].page] = -1;
   ++evictions_;

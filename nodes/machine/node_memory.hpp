@@ -11,15 +11,14 @@
 //    answers every access: >= 0 own page (its index among the own pages,
 //    which lie end to end in one block), -1 not here, <= -2 cache slot
 //    (-2 - entry).
-//  - each occupied slot carries its bytes' address and the time of its last
-//    use side by side, so a hit reads and stamps one record. The time is a
-//    counter that every use and install advances, so stamps are distinct and
-//    order the slots exactly as an LRU list would. Only an install into a
-//    full cache pays, scanning the slots for the oldest one not in use
-//    (O(capacity), once per miss).
+//  - the occupied slots form one list in order of use, most recent first
+//    (each slot links to its neighbours by index): a hit on the most recent
+//    slot changes nothing, any other hit moves its slot to the front, and an
+//    install into a full cache evicts from the back, all in O(1).
 //  - a slot named in install()'s `in_use` is never evicted: the node's
 //    workers each name the slot whose bytes they are using, so one worker's
-//    install cannot pull them away from another.
+//    install cannot pull them away from another; the victim is the least
+//    recently used slot not named (at most |in_use| + 1 steps from the back).
 //  - resident bytes = own pages + occupied slots; slots are allocated on
 //    first use and never exceed the cache capacity.
 // A node's workers are fibers on one OS thread and run one at a time, and no
@@ -76,14 +75,14 @@ class NodeMemory {
 
   // The slot's bytes, making it the most recently used.
   const std::byte* use(int slot) {
-    Slot& s = slots_[static_cast<std::size_t>(slot)];
-    s.last_use = ++clock_;
-    return s.bytes.get();
+    if (slot != front_) to_front(slot);
+    return slots_[static_cast<std::size_t>(slot)].bytes.get();
   }
 
   // Copies a fetched remote page into a free slot or the least recently
-  // used one not named in `in_use`, and returns that slot. Throws
-  // std::logic_error if every slot is in use (cannot happen: see svm.hpp).
+  // used one not named in `in_use`, and returns that slot, now the most
+  // recently used. Throws std::logic_error if every slot is in use (cannot
+  // happen: see svm.hpp).
   int install(std::uint32_t page, std::span<const std::byte> bytes, std::span<const int> in_use = {});
 
   // Miss coalescing: begin_fetch is true for the first worker to miss on a
@@ -102,11 +101,18 @@ class NodeMemory {
  private:
   struct Slot {
     std::unique_ptr<std::byte[]> bytes;  // page_size_ bytes, allocated on first use
-    std::uint64_t last_use;  // clock_ at its last use or install
-    std::uint32_t page;
+    std::uint32_t page = 0;
+    int newer = -1;  // the slot used just after this one; -1: this is the front
+    int older = -1;  // the slot used just before; -1: this is the back
   };
 
   int take_slot(std::span<const int> in_use);
+  void unlink(int slot);
+  void push_front(int slot);
+  void to_front(int slot) {
+    unlink(slot);
+    push_front(slot);
+  }
 
   std::size_t page_size_;
   std::uint32_t capacity_;
@@ -114,7 +120,8 @@ class NodeMemory {
   std::unique_ptr<std::byte[]> own_;  // own_count_ pages end to end
   std::vector<std::int32_t> entry_;
   std::vector<Slot> slots_;
-  std::uint64_t clock_ = 0;
+  int front_ = -1;  // most recently used slot; -1: none
+  int back_ = -1;   // least recently used
   std::uint64_t evictions_ = 0;
   std::unordered_map<std::uint32_t, std::vector<int>> pending_;  // page -> waiting workers
 };
