@@ -131,4 +131,22 @@ std::span<const std::byte> page_reply_bytes(std::span<const std::byte> payload) 
   return payload.subspan(sizeof(std::uint32_t));
 }
 
+Packet make_page_reply(NodeId destination, std::uint16_t port, std::uint32_t page,
+                       std::span<const std::byte> bytes) {
+  std::vector<std::byte> id;
+  put(id, page);
+  Packet p = make_packet(destination, port, MessageKind::page_reply, std::move(id));
+  p.shared = bytes;
+  return p;
+}
+
+std::uint32_t page_reply_id(const Packet& reply) { return page_reply_id(reply.payload); }
+
+std::span<const std::byte> page_reply_bytes(const Packet& reply) {
+  if (reply.shared.empty()) return page_reply_bytes(reply.payload);
+  if (reply.payload.size() != sizeof(std::uint32_t))
+    throw std::runtime_error("malformed page_reply message: a shared page after more than its id");
+  return reply.shared;
+}
+
 }  // namespace nodes

@@ -127,4 +127,14 @@ std::vector<std::byte> encode_page_reply(std::uint32_t page, std::span<const std
 std::uint32_t page_reply_id(std::span<const std::byte> payload);
 std::span<const std::byte> page_reply_bytes(std::span<const std::byte> payload);
 
+// The same reply with the page's bytes carried by reference (Packet::shared):
+// an owner's page never changes while the machine runs, so inside one
+// process it is copied once, into the cache slot of the node that asked.
+// Its bytes on the wire and in every count are those of encode_page_reply.
+Packet make_page_reply(NodeId destination, std::uint16_t port, std::uint32_t page,
+                       std::span<const std::byte> bytes);
+// A reply of either form.
+std::uint32_t page_reply_id(const Packet& reply);
+std::span<const std::byte> page_reply_bytes(const Packet& reply);
+
 }  // namespace nodes

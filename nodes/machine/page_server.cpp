@@ -43,7 +43,7 @@ void PageServer::serve(const Packet& request) {
                            " it does not own");
   const std::span<const std::byte> bytes(memory_.own_page(entry), memory_.page_size());
   if (before_reply_) before_reply_();
-  out_.send(make_packet(request.source, r.reply_port, MessageKind::page_reply, encode_page_reply(r.page, bytes)));
+  out_.send(make_page_reply(request.source, r.reply_port, r.page, bytes));
   ++counters_.pages_served;
   counters_.bytes_served += bytes.size();
   if (recorder_) recorder_->log(node_).serves.push_back({start, recorder_->now(), r.page, request.source});

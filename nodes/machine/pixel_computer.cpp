@@ -102,7 +102,7 @@ PageFetch make_page_fetch(const PagePlacement& placement, std::uint16_t port, Wo
   return [&placement, port, &in, &out](std::uint32_t page) {
     const auto owner = static_cast<NodeId>(placement.owner(page));
     out.send(make_packet(owner, Ports::page_server, MessageKind::page_request, encode_page_request({page, port})));
-    return in.page_reply().payload;
+    return in.page_reply();
   };
 }
 

@@ -34,13 +34,14 @@
 
 #include "csp/csp.hpp"
 #include "nodes/machine/node_memory.hpp"
+#include "nodes/net/packet.hpp"
 #include "tracer/database.hpp"
 
 namespace nodes {
 
-// Blocks the calling fiber until the owner's page_reply payload for `page`
-// arrives, and returns it.
-using PageFetch = std::function<std::vector<std::byte>(std::uint32_t page)>;
+// Blocks the calling fiber until the owner's page_reply for `page` arrives,
+// and returns it (its bytes: page_reply_bytes, messages.hpp).
+using PageFetch = std::function<Packet(std::uint32_t page)>;
 
 // Every access ends in exactly one of the four counts.
 struct SvmStats {

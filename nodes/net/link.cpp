@@ -21,7 +21,7 @@ Link::Link(csp::In<Packet> queue, csp::Out<Packet> next, LinkModel model)
 void Link::run() {
   for (;;) {
     Packet packet = queue_.read();
-    csp::this_process::delay(model_.delay(packet.payload.size()));
+    csp::this_process::delay(model_.delay(packet.bytes()));
     next_.write(std::move(packet));
   }
 }

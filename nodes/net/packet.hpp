@@ -6,10 +6,16 @@
 // source first; a delivered traced packet has route.size() == hops + 1.
 // kind is the application's own tag (the network only counts by it); port
 // names the local process on the destination that receives the packet.
+// shared: bytes the packet carries by reference, which nobody writes while
+// the network runs (a page of the scene); inside one process the packet
+// points at them rather than copying them, but in every count and delay
+// they are bytes carried (bytes()), and across processes the bridge sends
+// them as payload.
 #pragma once
 
 #include <cstddef>
 #include <cstdint>
+#include <span>
 #include <vector>
 
 #include "topology/topology.hpp"
@@ -28,7 +34,11 @@ struct Packet {
   bool recorded = false;   // its hops go into the run's Recorder (set at injection)
   std::uint64_t id = 0;    // application-defined sequence number
   std::vector<std::byte> payload;
+  std::span<const std::byte> shared;  // follows the payload; read-only
   std::vector<NodeId> route;  // visited nodes, for traced packets only
+
+  // The bytes carried: the payload, then the shared bytes.
+  std::size_t bytes() const { return payload.size() + shared.size(); }
 };
 
 // Kinds used by the network's own tests and the traffic example; the

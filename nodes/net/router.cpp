@@ -90,7 +90,7 @@ void Router::accept_injection(Packet& packet) const {
   packet.recorded = log_ && config_.recorder->admit();
   if (packet.recorded)
     log_->injected.push_back({packet.id, config_.recorder->now(), packet.destination,
-                              static_cast<std::uint32_t>(packet.payload.size()), packet.kind});
+                              static_cast<std::uint32_t>(packet.bytes()), packet.kind});
 }
 
 bool Router::take_route_to_trace(std::uint8_t kind) const {
@@ -111,7 +111,7 @@ std::size_t Router::output_queue(const Packet& packet) const {
 // Writes the packet into its output queue if that has room; false (packet
 // untouched) if it is full.
 bool Router::try_send(std::size_t queue, Packet& packet) {
-  const std::size_t bytes = packet.payload.size();
+  const std::size_t bytes = packet.bytes();
   const bool delivery = queue >= link_queues_;
   const std::uint32_t hops = packet.hops;
   const std::uint8_t kind = packet.kind;

@@ -43,7 +43,8 @@ void put_packet(WireWriter& w, const Packet& p) {
   w.put(p.hops);
   w.put<std::uint8_t>(p.traced ? 1 : 0);
   w.put(p.id);
-  w.put_vector(p.payload);
+  // The shared bytes go as payload: the other process has no pointer to them.
+  w.put_joined(p.payload, p.shared);
   w.put_vector(p.route);
 }
 
@@ -204,7 +205,7 @@ void Bridge::take_outgoing(Outgoing& out) {
     if (w.size() >= frame_bytes) post_frame(out.peer);
     ++counters_.packets_sent;
     ++unacknowledged_;
-    counters_.bytes_sent += packet->payload.size();
+    counters_.bytes_sent += packet->bytes();
     if (--out.credits == 0) {
       alt_.enable(out.guard, false);
       break;

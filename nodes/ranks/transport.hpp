@@ -23,6 +23,7 @@
 #include <memory>
 #include <mutex>
 #include <optional>
+#include <span>
 #include <stdexcept>
 #include <string>
 #include <type_traits>
@@ -95,6 +96,12 @@ class WireWriter {
     static_assert(std::is_trivially_copyable_v<T>);
     put<std::uint64_t>(values.size());
     append(values.data(), values.size() * sizeof(T));
+  }
+  // Two runs of bytes as one sequence, read back by get_vector<std::byte>.
+  void put_joined(std::span<const std::byte> first, std::span<const std::byte> second) {
+    put<std::uint64_t>(first.size() + second.size());
+    append(first.data(), first.size());
+    append(second.data(), second.size());
   }
   void put_string(const std::string& s);
   Bytes take() { return std::move(bytes_); }

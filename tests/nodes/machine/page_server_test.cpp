@@ -53,10 +53,13 @@ TEST(PageServer, AnswersARequestWithThePageThenStops) {
     EXPECT_EQ(static_cast<MessageKind>(reply.kind), MessageKind::page_reply);
     EXPECT_EQ(reply.destination, 1u);
     EXPECT_EQ(reply.port, 3u);
-    EXPECT_EQ(nodes::page_reply_id(reply.payload), 2u);
-    const auto bytes = nodes::page_reply_bytes(reply.payload);
+    EXPECT_EQ(nodes::page_reply_id(reply), 2u);
+    const auto bytes = nodes::page_reply_bytes(reply);
     const auto expected = page_bytes(2);
     EXPECT_TRUE(std::equal(bytes.begin(), bytes.end(), expected.begin(), expected.end()));
+    // The page travels by reference inside one process, but counts as the
+    // bytes of a copy.
+    EXPECT_EQ(reply.bytes(), nodes::encode_page_reply(2, expected).size());
 
     s.requests.writer().write(nodes::make_packet(0, Ports::page_server, MessageKind::server_stop));
     const Packet done = s.out.reader().read();

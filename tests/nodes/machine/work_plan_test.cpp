@@ -191,6 +191,27 @@ TEST(Messages, PayloadsRoundTrip) {
   EXPECT_EQ(std::vector<std::byte>(back.begin(), back.end()), bytes);
 }
 
+// A reply that points at the owner's page reads as the copy does, counts
+// the copy's bytes, and becomes the copy when its shared bytes are sent on
+// as payload (as the bridge sends them to another process).
+TEST(Messages, ASharedPageReplyIsTheCopyByReference) {
+  const std::vector<std::byte> page{std::byte{7}, std::byte{8}, std::byte{9}, std::byte{10}};
+  const nodes::Packet shared = nodes::make_page_reply(3, 5, 42, page);
+  EXPECT_EQ(shared.port, 5);
+  EXPECT_EQ(nodes::page_reply_id(shared), 42u);
+  EXPECT_EQ(nodes::page_reply_bytes(shared).data(), page.data());
+  EXPECT_EQ(shared.bytes(), nodes::encode_page_reply(42, page).size());
+  nodes::Packet sent = shared;
+  sent.payload.insert(sent.payload.end(), shared.shared.begin(), shared.shared.end());
+  sent.shared = {};
+  EXPECT_EQ(sent.payload, nodes::encode_page_reply(42, page));
+  const auto back = nodes::page_reply_bytes(sent);
+  EXPECT_EQ(std::vector<std::byte>(back.begin(), back.end()), page);
+  nodes::Packet malformed = shared;
+  malformed.payload.push_back(std::byte{0});
+  EXPECT_THROW(nodes::page_reply_bytes(malformed), std::runtime_error);
+}
+
 TEST(Messages, TruncatedPayloadIsRejected) {
   auto payload = nodes::encode_result(5, {0, 2}, std::vector<tracer::Color>(2));
   payload.pop_back();
