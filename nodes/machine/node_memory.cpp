@@ -64,24 +64,6 @@ NodeMemory::NodeMemory(const PagePlacement& placement, int node, std::size_t pag
   slots_.reserve(capacity_);
 }
 
-void NodeMemory::unlink(int slot) {
-  Slot& s = slots_[static_cast<std::size_t>(slot)];
-  if (s.newer >= 0) slots_[static_cast<std::size_t>(s.newer)].older = s.older;
-  else front_ = s.older;
-  if (s.older >= 0) slots_[static_cast<std::size_t>(s.older)].newer = s.newer;
-  else back_ = s.newer;
-  s.newer = s.older = -1;
-}
-
-void NodeMemory::push_front(int slot) {
-  Slot& s = slots_[static_cast<std::size_t>(slot)];
-  s.newer = -1;
-  s.older = front_;
-  if (front_ >= 0) slots_[static_cast<std::size_t>(front_)].newer = slot;
-  else back_ = slot;
-  front_ = slot;
-}
-
 int NodeMemory::take_slot(std::span<const int> in_use) {
   if (slots_.size() < capacity_) {
     slots_.push_back(Slot{std::make_unique<std::byte[]>(page_size_)});

@@ -107,8 +107,18 @@ class NodeMemory {
   };
 
   int take_slot(std::span<const int> in_use);
-  void unlink(int slot);
-  void push_front(int slot);
+  void unlink(int slot) {
+    Slot& s = slots_[static_cast<std::size_t>(slot)];
+    (s.newer >= 0 ? slots_[static_cast<std::size_t>(s.newer)].older : front_) = s.older;
+    (s.older >= 0 ? slots_[static_cast<std::size_t>(s.older)].newer : back_) = s.newer;
+  }
+  void push_front(int slot) {
+    Slot& s = slots_[static_cast<std::size_t>(slot)];
+    s.newer = -1;
+    s.older = front_;
+    (front_ >= 0 ? slots_[static_cast<std::size_t>(front_)].newer : back_) = slot;
+    front_ = slot;
+  }
   void to_front(int slot) {
     unlink(slot);
     push_front(slot);
