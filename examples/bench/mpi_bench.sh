@@ -6,8 +6,11 @@
 # The configurations run interleaved, REPEAT rounds, so that a noisy
 # machine slows them alike; each row gives the median and the least
 # render wall time (the machine's wall_seconds from --stats, set-up
-# excluded), the ratio of medians to one process on 2 threads, and the
-# packets and bytes that crossed MPI.
+# excluded, the same measure on every row), the ratio of medians to one
+# process on 2 threads, and what crossed MPI: packets, their bytes, and the
+# MPI messages that carried them (the ranks' bridges only; packets between
+# threads of one process are not MPI traffic). Every run's image is compared
+# with the one-process image of its round; a difference stops the bench.
 #
 # usage: examples/bench/mpi_bench.sh [BUILD_DIR] [REPEAT] [SIZE]
 #        (defaults: build/release 5 512)
@@ -21,14 +24,16 @@ export OMPI_MCA_btl_vader_single_copy_mechanism=none OMPI_MCA_rmaps_base_oversub
 work=$(mktemp -d)
 trap 'rm -rf "$work"' EXIT
 
-# field NAME FILE: the first number after "NAME": in a --stats file.
-field() { grep -o "\"$1\": [0-9.e+-]*" "$2" | head -n 1 | sed 's/.*: //'; }
-# sum NAME FILE: the sum of every "NAME": number (one per rank).
-sum() { grep -o "\"$1\": [0-9]*" "$2" | sed 's/.*: //' | awk '{ s += $1 } END { print s + 0 }'; }
+# wall FILE: the machine's render wall time in a --stats file.
+wall() { python3 -c 'import json, sys; print(json.load(open(sys.argv[1]))["machine"]["wall_seconds"])' "$1"; }
+# over_mpi NAME FILE: NAME summed over the ranks' bridges (0 for one process).
+over_mpi() {
+  python3 -c 'import json, sys; print(sum(k[sys.argv[1]] for k in json.load(open(sys.argv[2]))["machine"]["ranks"]))' "$1" "$2"
+}
 
 configs=("1 2 none" "2 1 vader" "2 1 tcp" "4 1 vader" "4 1 tcp")
-run() {  # run SCENE TOPOLOGY RANKS THREADS BTL OUT
-  local args=("$1" --topology "$2" --width "$size" --height "$size" --threads "$4" -q -o "$work/img.png" --stats "$6")
+run() {  # run SCENE TOPOLOGY RANKS THREADS BTL STATS IMAGE
+  local args=("$1" --topology "$2" --width "$size" --height "$size" --threads "$4" -q -o "$7" --stats "$6")
   case $5 in
     none) "$vmpray" "${args[@]}" ;;
     vader) mpirun -np "$3" --mca btl self,vader "$vmpray" "${args[@]}" ;;
@@ -36,7 +41,7 @@ run() {  # run SCENE TOPOLOGY RANKS THREADS BTL OUT
   esac
 }
 
-printf '%-8s %-12s %-22s %10s %10s %8s %12s %14s\n' scene topology configuration median_s least_s ratio packets bytes
+printf '%-8s %-12s %-22s %10s %10s %8s %12s %14s %10s\n' scene topology configuration median_s least_s ratio packets bytes messages
 for scene in teapot rings4; do
   for topology in hypercube:4 hypercube:6; do
     declare -A times=()
@@ -44,8 +49,14 @@ for scene in teapot rings4; do
       for c in "${configs[@]}"; do
         read -r ranks threads btl <<<"$c"
         out="$work/$ranks-$btl-$round.json"
-        run "$scene" "$topology" "$ranks" "$threads" "$btl" "$out" >/dev/null
-        times[$c]+="$(field wall_seconds "$out") "
+        run "$scene" "$topology" "$ranks" "$threads" "$btl" "$out" "$work/img.png" >/dev/null
+        times[$c]+="$(wall "$out") "
+        if [[ $btl == none ]]; then
+          mv "$work/img.png" "$work/one.png"
+        elif ! cmp -s "$work/img.png" "$work/one.png"; then
+          echo "mpi_bench: $scene $topology, $ranks ranks over $btl: image differs from one process" >&2
+          exit 1
+        fi
       done
     done
     base=""
@@ -58,8 +69,9 @@ for scene in teapot rings4; do
       out="$work/$ranks-$btl-0.json"
       label="$ranks x $threads thread(s)"
       [[ $btl != none ]] && label+=" $btl"
-      printf '%-8s %-12s %-22s %10.3f %10.3f %8.2f %12s %14s\n' "$scene" "$topology" "$label" "$median" "$least" \
-        "$(awk -v a="$median" -v b="$base" 'BEGIN { print a / b }')" "$(sum packets_sent "$out")" "$(sum bytes_sent "$out")"
+      printf '%-8s %-12s %-22s %10.3f %10.3f %8.2f %12s %14s %10s\n' "$scene" "$topology" "$label" "$median" "$least" \
+        "$(awk -v a="$median" -v b="$base" 'BEGIN { print a / b }')" "$(over_mpi packets_sent "$out")" \
+        "$(over_mpi bytes_sent "$out")" "$(over_mpi messages_sent "$out")"
     done
     unset times
   done
