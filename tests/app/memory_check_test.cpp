@@ -133,8 +133,12 @@ TEST(MemoryCheck, RefusesAMachineAboveTheLimitNamingTheOptions) {
                  "--nodes/--topology: complete:4096 (4096 nodes, 16773120 link queues) needs about 15.8 GB with its "
                  "image, more than this machine's 8.0 GB");
   }
-  // The image counts too.
-  const std::uint64_t needed = app::machine_memory_bytes(o, 661) + app::image_memory_bytes(o, 512, 512);
+  // The image counts too. Worked out from the sizes memory_check.cpp gives: 4096 nodes of 44 KiB (router, page
+  // server, page mailbox) with a pixel computer of 10 KiB, a page table and the pixel computer's page stamps of
+  // 4 bytes a page each; 4095 link queues of 930 bytes at each node; and the 512x512 image at 30 1/8 bytes a
+  // pixel (see the image's test below; the 4096 pixel computers' tiles of 16 pixels weigh less).
+  constexpr std::uint64_t machine = 4096 * (44 * 1024 + 10 * 1024 + 2 * 4 * 661) + 4096ull * 4095 * 930;
+  constexpr std::uint64_t needed = machine + 512 * 512 * 30 + 512 * 512 / 8;
   EXPECT_NO_THROW(app::check_machine_memory(o, 512, 512, 661, {needed}));
   EXPECT_THROW(app::check_machine_memory(o, 512, 512, 661, {needed - 1}), app::UsageError);
   EXPECT_NO_THROW(app::check_machine_memory(o, 16, 16, 661, {needed - 1}));
@@ -184,7 +188,12 @@ TEST(MemoryCheck, RefusesAnImageAboveTheLimitNamingTheOptions) {
   } catch (const app::UsageError& e) {
     EXPECT_STREQ(e.what(), "--width/--height: a 16384x16384 image needs about 8.1 GB, more than this machine's 4.0 GB");
   }
-  const std::uint64_t needed = app::image_memory_bytes(o, 4096, 3000);
+  // Worked out from the sizes memory_check.cpp gives: on the default 16 nodes, a pixel's colour (12 bytes),
+  // owner (2), arrival bit and place in the Hilbert order (4) while the image (12) is assembled, 30 1/8 bytes
+  // a pixel; more than the pixel computers' tiles (16 of 48000 pixels, and one on its way) and more than the
+  // outputs take (the image, its owners and the 8-bit copy: 17).
+  constexpr std::uint64_t pixels = 4096 * 3000;
+  constexpr std::uint64_t needed = pixels * 30 + pixels / 8;
   EXPECT_NO_THROW(app::check_image_memory(o, 4096, 3000, {needed}));
   EXPECT_THROW(app::check_image_memory(o, 4096, 3000, {needed - 1}), app::UsageError);
   using Source = app::MemoryLimit::Source;

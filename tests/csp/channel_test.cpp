@@ -15,17 +15,23 @@ namespace {
 
 using namespace std::chrono_literals;
 
+// Both processes share one thread, so the writer switches nowhere between
+// setting `writing` and returning from write() but inside write(): once the
+// reader sees `writing`, `written` is still false unless write() returned
+// with no reader there.
 TEST(Channel, WriterBlocksUntilRead) {
   csp::Channel<int> c("c");
-  bool written = false;
+  bool writing = false, written = false;
   int got = 0;
   csp::Runtime rt(1);
-  rt.spawn("writer", 0, [out = c.writer(), &written]() mutable {
+  rt.spawn("writer", 0, [out = c.writer(), &writing, &written]() mutable {
+    writing = true;
     out.write(7);
     written = true;
   });
-  rt.spawn("reader", 0, [in = c.reader(), &written, &got]() mutable {
-    csp::sleep_for(5ms);
+  rt.spawn("reader", 0, [in = c.reader(), &writing, &written, &got]() mutable {
+    for (int i = 0; i < 100 && !writing; ++i) csp::yield();
+    ASSERT_TRUE(writing);
     EXPECT_FALSE(written);
     got = in.read();
   });
@@ -54,16 +60,20 @@ TEST(Channel, KeepsOrderPerChannel) {
 TEST(Channel, BufferHoldsExactlyCapacity) {
   for (std::size_t k : {1u, 2u, 5u}) {
     csp::Channel<int> c("c", k);
-    std::size_t done = 0;  // writes that returned before the reader started
+    std::size_t started = 0, done = 0;  // writes begun, and returned, before the reader reads
     csp::Runtime rt(1);
-    rt.spawn("writer", 0, [out = c.writer(), &done, k]() mutable {
+    rt.spawn("writer", 0, [out = c.writer(), &started, &done, k]() mutable {
       for (std::size_t i = 0; i <= k; ++i) {
+        ++started;
         out.write(static_cast<int>(i));
         ++done;
       }
     });
-    rt.spawn("reader", 0, [in = c.reader(), &done, k]() mutable {
-      csp::sleep_for(5ms);
+    rt.spawn("reader", 0, [in = c.reader(), &started, &done, k]() mutable {
+      // One thread: the writer switches only inside write(), so once it has
+      // begun the k+1-th, that write is blocked, or returned when it should not.
+      for (int i = 0; i < 100 && started <= k; ++i) csp::yield();
+      ASSERT_EQ(started, k + 1);
       EXPECT_EQ(done, k);  // the k+1-th write is still blocked
       for (std::size_t i = 0; i <= k; ++i) EXPECT_EQ(in.read(), static_cast<int>(i));
     });
