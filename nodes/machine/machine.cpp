@@ -115,6 +115,26 @@ struct Wiring {
   }
 };
 
+// The packets the protocol lets be outstanding (machine.hpp): for a page
+// server, one request per sending process of the machine and its
+// server_stop; for the farmer, P + 1 per worker and one per page server.
+std::size_t page_requests_bound(std::size_t nodes, int workers_per_node) {
+  return nodes * Ports::count(workers_per_node) + 1;
+}
+std::size_t farmer_bound(std::size_t nodes, int workers_per_node, std::uint16_t prefetch) {
+  return nodes * static_cast<std::size_t>(workers_per_node) * (prefetch + 1u) + nodes;
+}
+
+// The page requests of node n: its delivery port itself, which holds them
+// all, or with a link model (delivery by rendezvous) a mailbox.
+csp::In<Packet> page_requests(const Wiring& w, NodeId n, NodeState& node, const std::string& name) {
+  if (!w.net.options().link.enabled()) return w.net.port(n, Ports::page_server);
+  node.mailbox = std::make_unique<Mailbox>(name + " page requests", static_cast<std::size_t>(w.processes) + 1);
+  w.runtime.spawn(name + " page mailbox", w.net.thread_of(n),
+                  [mb = node.mailbox.get(), in = w.net.port(n, Ports::page_server)] { mb->forward(in); });
+  return node.mailbox->reader();
+}
+
 // The miss path with each wait for a page logged on the node.
 PageFetch recording_fetch(Recorder& recorder, NodeId n, int worker, PageFetch inner) {
   return [&recorder, n, worker, inner = std::move(inner)](std::uint32_t page) {
@@ -129,14 +149,12 @@ void spawn_node(const Wiring& w, NodeId n, NodeState& node) {
   const unsigned thread = w.net.thread_of(n);
   const std::string name = "node " + std::to_string(n);
   const int k = w.options.workers_per_node;
-  node.mailbox = std::make_unique<Mailbox>(name + " page requests", static_cast<std::size_t>(w.processes) + 1);
-  w.runtime.spawn(name + " page mailbox", thread,
-                  [mb = node.mailbox.get(), in = w.net.port(n, Ports::page_server)] { mb->forward(in); });
+  csp::In<Packet> requests = page_requests(w, n, node, name);
   std::function<void()> serve_hook = w.timing ? w.timing->serve_hook(static_cast<int>(n)) : nullptr;
   w.runtime.spawn(
       name + " page server", thread,
-      [n, &node, out = w.outbox(n, Ports::page_server), serve_hook, recorder = w.recorder] {
-        PageServer(n, node.svm->memory(), node.mailbox->reader(), out, node.served, serve_hook, recorder).run();
+      [n, &node, requests, out = w.outbox(n, Ports::page_server), serve_hook, recorder = w.recorder] {
+        PageServer(n, node.svm->memory(), requests, out, node.served, serve_hook, recorder).run();
       });
   node.work.resize(static_cast<std::size_t>(k));
   for (int i = 0; i < k; ++i) {
@@ -184,15 +202,18 @@ void spawn_node(const Wiring& w, NodeId n, NodeState& node) {
 void spawn_host(const Wiring& w, Host& host) {
   const unsigned thread = w.net.thread_of(0);
   const auto nodes = static_cast<std::size_t>(w.net.topology().size());
-  const auto workers = nodes * static_cast<std::size_t>(w.options.workers_per_node);
-  // Outstanding for the farmer: P + 1 per worker, one per page server.
-  host.mailbox = std::make_unique<Mailbox>("farmer requests", workers * (w.options.prefetch + 1u) + nodes);
-  w.runtime.spawn("farmer mailbox", thread, [mb = host.mailbox.get(), in = w.net.port(0, Ports::farmer)] {
-    mb->forward(in);
-  });
+  // Its port holds every packet outstanding for it; with a link model
+  // (delivery by rendezvous) a mailbox does.
+  csp::In<Packet> requests = w.net.port(0, Ports::farmer);
+  if (w.net.options().link.enabled()) {
+    host.mailbox = std::make_unique<Mailbox>("farmer requests",
+                                             farmer_bound(nodes, w.options.workers_per_node, w.options.prefetch));
+    w.runtime.spawn("farmer mailbox", thread, [mb = host.mailbox.get(), in = requests] { mb->forward(in); });
+    requests = host.mailbox->reader();
+  }
   host.results = std::make_unique<csp::Channel<Packet>>("results", results_buffer);
-  w.runtime.spawn("farmer", thread, [&w, &host, nodes, out = w.outbox(0, Ports::farmer)] {
-    Farmer(*host.plan, static_cast<int>(nodes), w.options.workers_per_node, host.mailbox->reader(), out,
+  w.runtime.spawn("farmer", thread, [&w, &host, nodes, requests, out = w.outbox(0, Ports::farmer)] {
+    Farmer(*host.plan, static_cast<int>(nodes), w.options.workers_per_node, requests, out,
            host.results->writer(), [&net = w.net] { net.shutdown(); }, host.farmer)
         .run();
   });
@@ -336,7 +357,8 @@ csp::RuntimeOptions runtime_options(const MachineOptions& options, std::size_t l
 }
 
 NetworkOptions network_options(const MachineOptions& options, const MachineTiming* timing, const Share& share,
-                               std::size_t local_nodes, unsigned threads, Recorder* recorder) {
+                               std::size_t topology_size, std::size_t local_nodes, unsigned threads,
+                               Recorder* recorder) {
   NetworkOptions net;
   net.buffer_capacity = options.buffer_capacity;
   net.ports_per_node = Ports::count(options.workers_per_node);
@@ -344,6 +366,13 @@ NetworkOptions network_options(const MachineOptions& options, const MachineTimin
   net.trace_kinds = options.trace_kinds;
   net.recorder = recorder;
   if (timing) net.link = timing->model().link_model();
+  if (!net.link.enabled()) {
+    // The page servers and the farmer read their ports directly (spawn_node, spawn_host).
+    const std::size_t nodes = topology_size;
+    net.port_capacity.assign(Ports::first_worker, 0);
+    net.port_capacity[Ports::page_server] = page_requests_bound(nodes, options.workers_per_node);
+    net.port_capacity[Ports::farmer] = farmer_bound(nodes, options.workers_per_node, options.prefetch);
+  }
   net.relay_between_threads = options.relay_between_threads && !timing;
   if (share.plan) {
     net.local = [share](NodeId n) { return share.runs(n); };
@@ -512,7 +541,7 @@ Executed execute(const tracer::DatabaseHeader& header, const topology::Topology&
     recorder = std::make_unique<Recorder>(topology.size(), options.record_packets, timing != nullptr, started);
   }
   Network net(runtime, topology,
-              network_options(options, timing, share, local_nodes, runtime.threads(), recorder.get()));
+              network_options(options, timing, share, topology.size(), local_nodes, runtime.threads(), recorder.get()));
   network = &net;
   const Items items(header, options);
   const Wiring wiring{runtime,

@@ -3,10 +3,10 @@
 // demand, everything carried by the store-and-forward network.
 //
 // Processes of processor n, all on the OS thread of n's router:
-//   page server (+ its mailbox)      Ports::page_server
+//   page server                      Ports::page_server
 //   pixel computers w = 0..k-1       Ports::first_worker + w
 // and on node 0 only:
-//   farmer (+ its mailbox)           Ports::farmer
+//   farmer                           Ports::farmer
 //   frame collector                  fed by the farmer over a local channel
 // The host's copy of the database is moved into the owners before the run:
 // page p lives only on its owner and in caches.
@@ -34,9 +34,10 @@
 // a tile still owed to it, so at most P + 1 per worker and one per page
 // server are outstanding for the farmer (N*k*(P+1) + N); at most N*k page
 // requests for a page server (one per worker, plus its server_stop), which
-// sizes their mailboxes. Whenever a worker does not read its port (it traces,
-// or sends), at most P answers and one page reply are on their way to it,
-// which must fit the network's delivery buffer (so P < buffer capacity).
+// size their ports (with a link model, their mailboxes). Whenever a worker
+// does not read its port (it traces, or sends), at most P answers and one
+// page reply are on their way to it, which must fit the network's delivery
+// buffer (so P < buffer capacity).
 #pragma once
 
 #include <cstdint>

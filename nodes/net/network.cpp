@@ -32,6 +32,8 @@ Network::Network(csp::Runtime& runtime, topology::Topology topology, NetworkOpti
   if (options_.ports_per_node == 0) throw std::invalid_argument("network: each node needs at least one local port");
   if (options_.local && options_.link.enabled())
     throw std::invalid_argument("network: a link model cannot carry links between processes");
+  if (!options_.port_capacity.empty() && options_.link.enabled())
+    throw std::invalid_argument("network: a link model delivers by rendezvous, so ports take no capacity");
   if (options_.relay_between_threads && options_.link.enabled())
     throw std::invalid_argument("network: a link model cannot be relayed between threads");
   for (const std::uint8_t kind : options_.trace_kinds) kinds_to_trace_[kind] = true;
@@ -50,8 +52,11 @@ Network::Network(csp::Runtime& runtime, topology::Topology topology, NetworkOpti
         if (!is_local(from)) cut_.incoming.emplace_back(CutLink{from, node, c}, link_in_[node].back().writer());
       }
     injections_[node] = csp::Channel<Packet>("inject " + std::to_string(node), options_.buffer_capacity);
-    for (unsigned j = 0; j < options_.ports_per_node; ++j)
-      ports_[node].emplace_back("port " + std::to_string(node) + "." + std::to_string(j), queue_capacity());
+    for (unsigned j = 0; j < options_.ports_per_node; ++j) {
+      const std::size_t asked = j < options_.port_capacity.size() ? options_.port_capacity[j] : 0;
+      ports_[node].emplace_back("port " + std::to_string(node) + "." + std::to_string(j),
+                                asked > 0 ? std::max(asked, queue_capacity()) : queue_capacity());
+    }
   }
   for (NodeId node = 0; node < n; ++node)
     if (is_local(node)) wire_node(runtime, node);

@@ -64,6 +64,12 @@ struct NetworkOptions {
   std::vector<std::uint8_t> trace_kinds;  // of these kinds only (empty: every kind)
   RouteRecorder* recorder = nullptr;      // every router records its hops here (route_log.hpp); null: none
   LinkModel link;                   // optional per-hop latency and bandwidth
+  // Delivery queues larger than buffer_capacity, by local port (0 or no
+  // entry: buffer_capacity): a receiver whose outstanding packets the
+  // protocol bounds can read its port directly, the queue holding them all,
+  // instead of through a mailbox (mailbox.hpp). Without a link model only:
+  // with one, delivery is a rendezvous.
+  std::vector<std::size_t> port_capacity;
   std::function<unsigned(NodeId)> placement;  // thread of node n; default block
   std::function<bool(NodeId)> local;          // nodes this process runs; default all
   // Links between routers on different threads go through the threads'
