@@ -109,6 +109,16 @@ int run(const app::Options& o, const std::vector<std::string>& command_line, nod
 }
 
 // One rank of several: see the opening comment.
+// --help or --version on standard output: 0, or 1 with one line if it could
+// not be written (a full device, a closed descriptor).
+int print_help_or_version(const app::Options& options) {
+  std::cout << (options.action == app::Options::Action::help ? app::usage_text() : "vmpray " VMPRAY_VERSION "\n");
+  std::cout.flush();
+  if (std::cout) return 0;
+  std::cerr << "vmpray: cannot write to standard output\n";
+  return 1;
+}
+
 int rank_main(int argc, char** argv, const vmpi::MpiSession& mpi) {
   const bool host = mpi.rank() == 0;
   const auto say = [host](const std::string& line) {
@@ -127,10 +137,7 @@ int rank_main(int argc, char** argv, const vmpi::MpiSession& mpi) {
     say(std::string(e.what()) + " (see vmpray --help)");
     return 2;
   }
-  if (options.action != app::Options::Action::render) {
-    if (host) std::cout << (options.action == app::Options::Action::help ? app::usage_text() : "vmpray " VMPRAY_VERSION "\n");
-    return 0;
-  }
+  if (options.action != app::Options::Action::render) return host ? print_help_or_version(options) : 0;
   options.machine.threads = app::threads_per_rank(options.machine.threads, mpi.ranks_on_this_host());
   options.machine.shared_cores = app::cores_shared(options.machine.threads, mpi.ranks_on_this_host());
   try {
@@ -165,14 +172,7 @@ int one_process(int argc, char** argv) {
     std::cerr << "vmpray: " << e.what() << " (see vmpray --help)\n";
     return 2;
   }
-  if (options.action == app::Options::Action::help) {
-    std::cout << app::usage_text();
-    return 0;
-  }
-  if (options.action == app::Options::Action::version) {
-    std::cout << "vmpray " << VMPRAY_VERSION << "\n";
-    return 0;
-  }
+  if (options.action != app::Options::Action::render) return print_help_or_version(options);
   try {
     return run(options, std::vector<std::string>(argv, argv + argc));
   } catch (const app::UsageError& e) {  // an image too large: no help to see

@@ -295,6 +295,17 @@ TEST_F(MachineCli, AReportThatCannotBePrintedFailsTheRun) {
   }
 }
 
+// The help and the version are the output of their runs: unwritten, they fail.
+TEST_F(MachineCli, HelpOrVersionThatCannotBePrintedFails) {
+  for (const char* args : {"--help", "--version"})
+    for (const char* target : {"/dev/full", "&-"}) {
+      const Outcome r = run_vmpray(args, target);
+      EXPECT_EQ(r.exit_code, 1) << args << " > " << target;
+      EXPECT_EQ(r.err, "vmpray: cannot write to standard output\n") << args << " > " << target;
+    }
+  EXPECT_EQ(run_vmpray("--help").exit_code, 0);
+}
+
 // Two outputs at one path would overwrite each other. Refused before the
 // render, leaving nothing.
 TEST_F(MachineCli, TwoOutputsAtOnePathAreAnError) {
