@@ -5,6 +5,7 @@
 #include <charconv>
 #include <chrono>
 #include <cmath>
+#include <filesystem>
 #include <fstream>
 #include <map>
 #include <sstream>
@@ -205,6 +206,8 @@ void apply_costs(CostModel& model, const std::string& spec, const std::string& w
 }
 
 CostModel read_profile_file(const std::string& path) {
+  // A directory opens, then reads as nothing: an empty profile in silence.
+  if (std::filesystem::is_directory(path)) throw std::runtime_error(path + ": is a directory, not a profile");
   std::ifstream in(path);
   if (!in) throw std::runtime_error(path + ": cannot open profile");
   CostModel model;

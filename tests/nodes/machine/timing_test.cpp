@@ -256,6 +256,16 @@ TEST(CostModel, ProfileFileErrorsNameFileAndLine) {
   std::remove(path.c_str());
 }
 
+TEST(CostModel, ADirectoryIsNoProfile) {
+  const std::string dir = ::testing::TempDir();
+  try {
+    nodes::read_profile_file(dir);
+    ADD_FAILURE() << "a directory read as a profile";
+  } catch (const std::runtime_error& e) {
+    EXPECT_EQ(std::string(e.what()), dir + ": is a directory, not a profile");
+  }
+}
+
 // The last of two settings would win in silence, and a base profile after
 // a cost would reset it: both are mistakes in the file.
 TEST(CostModel, ProfileFileSetsEachKeyOnceAndItsBaseFirst) {
