@@ -114,9 +114,13 @@ void check_sweep(SweepOptions& o, const RawSweep& raw, const po::variables_map& 
     throw UsageError("--fit-seconds: expected a finite number of seconds above 0");
   o.topologies = split(raw.topologies);
   if (o.topologies.empty()) throw UsageError("--topology: empty list");
-  if (!raw.nodes.empty()) o.nodes = parse_list<std::size_t>(raw.nodes, "--nodes");
+  for (auto t = o.topologies.begin(); t != o.topologies.end(); ++t)
+    if (std::find(o.topologies.begin(), t, *t) != t) throw UsageError("--topology: " + *t + " is listed twice");
+  // Given, a list must hold values: an empty one is not the default.
+  const bool nodes_given = vm.count("nodes") > 0, cache_given = vm.count("cache-pages") > 0;
+  if (nodes_given) o.nodes = parse_list<std::size_t>(raw.nodes, "--nodes");
   else if (o.kind == SweepOptions::Kind::cache) o.nodes = {16};
-  if (!raw.cache.empty()) o.cache_pages = parse_list<std::uint32_t>(raw.cache, "--cache-pages");
+  if (cache_given) o.cache_pages = parse_list<std::uint32_t>(raw.cache, "--cache-pages");
   else if (o.kind == SweepOptions::Kind::cache) o.cache_pages = {8, 16, 32, 64, 128, 256, 512};
   // The other axis is one value: a list there would be cut to its first item.
   if (o.kind == SweepOptions::Kind::cache && o.nodes.size() > 1)
@@ -129,6 +133,9 @@ void check_sweep(SweepOptions& o, const RawSweep& raw, const po::variables_map& 
       try {
         topology::parse_topology(topology, n);
       } catch (const std::invalid_argument& e) {
+        if (!nodes_given && topology.find(':') != std::string::npos)
+          throw UsageError("--topology: " + topology + " has a size of its own, which the default --nodes list "
+                           "does not fit; give --nodes with its node count, or the bare kind");
         throw UsageError(std::string("--topology: ") + e.what());
       }
       check_grid_shape(topology, n);

@@ -108,6 +108,13 @@ TEST(SweepOptions, BadValuesNameTheOption) {
       {{"nodes", "--nodes", "2,4,2"}, "--nodes: 2 is listed twice"},
       {{"cache", "--cache-pages", "8,8"}, "--cache-pages: 8 is listed twice"},
       {{"cache", "--cache-pages", "4294967297"}, "--cache-pages: expected positive integers, got '4294967297'"},
+      {{"nodes", "--topology", "ring,ring"}, "--topology: ring is listed twice"},
+      // Given empty, a list is a mistake, not the default list.
+      {{"nodes", "--nodes", ""}, "--nodes: empty list"},
+      {{"cache", "--cache-pages", ""}, "--cache-pages: empty list"},
+      // A sized spec does not fit the default node counts: say so, not "asked for 1".
+      {{"nodes", "--topology", "mesh:4x4"},
+       "--topology: mesh:4x4 has a size of its own, which the default --nodes list does not fit"},
   };
   for (const auto& [args, option] : cases) {
     try {
