@@ -88,9 +88,6 @@ int run(const app::Options& o, const std::vector<std::string>& command_line, nod
   std::ostream& report_out = o.stats_path == "-" ? std::cerr : std::cout;
   if (o.stats_path == "-") std::cout << app::stats_json(result.report);
   else if (!o.stats_path.empty()) outputs.write_text(o.stats_path, app::stats_json(result.report));
-  if (!o.quiet) app::print_report(report_out, result.report);
-  // Asked for by name, so printed even when --quiet.
-  if (result.report.machine) app::print_routes(report_out, result.report.machine->report);
   if (result.report.machine && !o.tiles_csv.empty())
     outputs.write_text(o.tiles_csv, app::tiles_csv(result.report.machine->report));
   if (result.report.machine && !o.replay_html.empty())
@@ -105,10 +102,14 @@ int run(const app::Options& o, const std::vector<std::string>& command_line, nod
              {.title = result.report.scene, .version = "vmpray " VMPRAY_VERSION, .command_line = command_line},
              std::move(result.image), result.report.machine->report))
       outputs.add(path);
+  // Printed once every file it names is written: a run stopped before then
+  // (an error, a signal) leaves no line naming a file that is not there.
+  if (!o.quiet) app::print_report(report_out, result.report);
+  // Asked for by name, so printed even when --quiet.
+  if (result.report.machine) app::print_routes(report_out, result.report.machine->report);
   return phase.finish(std::cout, "report");
 }
 
-// One rank of several: see the opening comment.
 // --help or --version on standard output: 0, or 1 with one line if it could
 // not be written (a full device, a closed descriptor).
 int print_help_or_version(const app::Options& options) {
@@ -119,6 +120,7 @@ int print_help_or_version(const app::Options& options) {
   return 1;
 }
 
+// One rank of several: see the opening comment.
 int rank_main(int argc, char** argv, const vmpi::MpiSession& mpi) {
   const bool host = mpi.rank() == 0;
   const auto say = [host](const std::string& line) {
