@@ -191,7 +191,8 @@ void print_thread_use(std::ostream& out, const std::vector<csp::ThreadUse>& thre
         << " s: " << std::setprecision(1) << "running " << share * u.running_seconds << "%, spinning "
         << share * u.spinning_seconds << "%, sleeping " << share * u.sleeping_seconds << "%; cpu "
         << share * u.cpu_seconds << "%; " << u.sleeps << " sleeps in " << u.waits << " idle waits; woke "
-        << u.remote_wakes << " processes of other threads, " << u.sleepers_woken << " of them asleep\n";
+        << u.remote_wakes << " processes of other threads; woke a sleeping thread " << u.sleepers_woken
+        << " times\n";
   }
   out << std::setprecision(3);
 }

@@ -47,7 +47,10 @@ struct ThreadUse {
   std::uint64_t waits = 0;  // times it ran out of processes to run
   std::uint64_t sleeps = 0; // of which it spun in vain and slept in the OS
   std::uint64_t remote_wakes = 0;    // processes of other threads it woke
-  std::uint64_t sleepers_woken = 0;  // of which found their thread asleep: a system call
+  // Times it woke another thread from sleep, a system call each: for a
+  // process it woke there, or for a relay's signal (Arrivals::signal), so
+  // at most remote_wakes plus the signals its relay gave.
+  std::uint64_t sleepers_woken = 0;
 };
 
 struct RuntimeOptions {

@@ -132,6 +132,10 @@ TEST_F(MachineCli, DefaultMachineWritesImageAndJsonWithMachineFields) {
     // A relay wakes once as it starts, then only to a signal from the other thread's relay.
     EXPECT_GE(relay.at("wakes").get<double>(), 1);
     EXPECT_LE(relay.at("wakes").get<double>(), 1 + m.at("relays")[1 - t].at("signals").get<double>());
+    // A thread is woken from sleep only for a process woken there or a relay's signal.
+    const Json& use = m.at("host_threads")[t];
+    EXPECT_LE(use.at("sleepers_woken").get<double>(),
+              use.at("remote_wakes").get<double>() + relay.at("signals").get<double>());
   }
   EXPECT_GT(relay_sent, 0);
   EXPECT_EQ(relay_sent, relay_received);
