@@ -22,6 +22,7 @@
 // recording, are inside the time, as the single process's frame is.
 //
 // usage: machine_bench [SCENE [SIZE [THREADS [REPEATS]]]]   default: teapot 512 2 5
+//   SIZE 16..4096, THREADS 1..1024, REPEATS 1..100; a bad argument: usage, exit 2
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
@@ -31,6 +32,7 @@
 #include <string>
 #include <vector>
 
+#include "examples/bench/bench_args.hpp"
 #include "nodes/machine/machine.hpp"
 #include "tracer/generators.hpp"
 #include "tracer/render.hpp"
@@ -118,12 +120,34 @@ void print_run(const char* label, const MachineRun& r, double baseline) {
 
 }  // namespace
 
+const char* const usage =
+    "usage: machine_bench [SCENE [SIZE [THREADS [REPEATS]]]]   default: teapot 512 2 5\n"
+    "  SIZE 16..4096, THREADS 1..1024, REPEATS 1..100\n";
+
 int main(int argc, char** argv) {
-  const std::string spec = argc > 1 ? argv[1] : "teapot";
-  const int size = argc > 2 ? std::stoi(argv[2]) : 512;
-  const unsigned threads = argc > 3 ? static_cast<unsigned>(std::stoul(argv[3])) : 2u;
-  const int repeats = argc > 4 ? std::max(1, std::stoi(argv[4])) : 5;
-  const auto db = make_db(spec, size);
+  std::string spec = "teapot";
+  int size = 512, repeats = 5;
+  unsigned threads = 2;
+  tracer::Database db;
+  try {
+    const std::vector<std::string> args(argv + 1, argv + argc);
+    if (!args.empty() && (args[0] == "-h" || args[0] == "--help")) {
+      std::fputs(usage, stdout);
+      return 0;
+    }
+    if (args.size() > 4) throw bench::BadArgument{"too many arguments"};
+    if (args.size() > 0) spec = args[0];
+    if (args.size() > 1) size = static_cast<int>(bench::parse_int(args[1], 16, 4096, "SIZE"));
+    if (args.size() > 2) threads = static_cast<unsigned>(bench::parse_int(args[2], 1, 1024, "THREADS"));
+    if (args.size() > 3) repeats = static_cast<int>(bench::parse_int(args[3], 1, 100, "REPEATS"));
+    db = make_db(spec, size);  // an unknown scene fails here, before any run
+  } catch (const bench::BadArgument& e) {
+    std::fprintf(stderr, "machine_bench: %s\n%s", e.what.c_str(), usage);
+    return 2;
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "machine_bench: %s\n%s", e.what(), usage);
+    return 2;
+  }
   std::printf("scene %s at %dx%d, %u database pages of %u bytes, cache = 1/8 of the database per node, "
               "%d runs of each line: median (fastest)\n",
               spec.c_str(), size, size, db.header.page_count, db.header.page_size, repeats);

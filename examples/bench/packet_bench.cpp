@@ -16,7 +16,6 @@
 #include <sys/resource.h>
 
 #include <algorithm>
-#include <charconv>
 #include <chrono>
 #include <cstdio>
 #include <cstring>
@@ -24,6 +23,7 @@
 #include <string>
 #include <vector>
 
+#include "examples/bench/bench_args.hpp"
 #include "nodes/machine/machine.hpp"
 #include "tracer/generators.hpp"
 #include "tracer/render.hpp"
@@ -35,18 +35,8 @@ const char* const usage =
     "  REPEATS 1..100 (default 5), SIZE 16..4096 (default 512),\n"
     "  cases default to rings4:16 rings4:64 teapot:16 teapot:256\n";
 
-struct BadArgument {
-  std::string what;
-};
-
-long parse_int(const std::string& text, long lo, long hi, const char* name) {
-  long value = 0;
-  const auto [end, ec] = std::from_chars(text.data(), text.data() + text.size(), value);
-  if (ec != std::errc() || end != text.data() + text.size() || value < lo || value > hi)
-    throw BadArgument{std::string(name) + ": expected " + std::to_string(lo) + ".." + std::to_string(hi) +
-                      ", got '" + text + "'"};
-  return value;
-}
+using bench::BadArgument;
+using bench::parse_int;
 
 double cpu_seconds() {
   rusage u{};
