@@ -23,6 +23,7 @@
 #include <string>
 #include <vector>
 
+#include "examples/bench/bench_args.hpp"
 #include "tracer/database.hpp"
 #include "tracer/generators.hpp"
 
@@ -58,11 +59,13 @@ void build(const tracer::Scene& scene, unsigned threads, tracer::Database& out, 
   runs.bvh.push_back(out.stats.accel_seconds);
 }
 
-}  // namespace
+const char* const usage =
+    "usage: build_bench [THREADS [REPEATS]]   (THREADS 1..1024, default 2; REPEATS 1..100, default 3)\n";
 
-int main(int argc, char** argv) {
-  const unsigned threads = argc > 1 ? static_cast<unsigned>(std::max(1, std::stoi(argv[1]))) : 2u;
-  const int repeats = argc > 2 ? std::max(1, std::stoi(argv[2])) : 3;
+int bench_build(const std::vector<std::string>& args) {
+  if (args.size() > 2) throw bench::BadArgument{"too many arguments"};
+  const auto threads = args.size() > 0 ? static_cast<unsigned>(bench::parse_int(args[0], 1, 1024, "THREADS")) : 2u;
+  const auto repeats = args.size() > 1 ? static_cast<int>(bench::parse_int(args[1], 1, 100, "REPEATS")) : 3;
   std::printf("build_database, BVH with treelet layout, page size 1024; median of %d runs\n", repeats);
   const std::string t = std::to_string(threads);
   std::printf("%-9s %10s %9s %9s %8s %14s   %9s %9s %8s\n", "scene", "triangles", "1 thread", (t + " threads").c_str(),
@@ -96,4 +99,9 @@ int main(int argc, char** argv) {
                 t1 / (n * std::log2(n)), b1, bt, b1 / bt, a.pages == b.pages ? "" : "  DIFFERENT PAGES");
     std::fflush(stdout);
   }
+  return 0;
 }
+
+}  // namespace
+
+int main(int argc, char** argv) { return bench::run_main("build_bench", usage, argc, argv, bench_build); }

@@ -9,15 +9,19 @@
 #include <cstdlib>
 #include <string>
 
+#include "examples/bench/bench_args.hpp"
 #include "nodes/net/traffic.hpp"
 #include "topology/spec.hpp"
 
-int main(int argc, char** argv) {
-  const std::size_t per_node = argc > 1 ? std::strtoul(argv[1], nullptr, 10) : 500;
-  if (per_node == 0) {
-    std::fprintf(stderr, "network_bench: packets per node must be a positive number\n");
-    return 2;
-  }
+namespace {
+
+const char* const usage = "usage: network_bench [PACKETS_PER_NODE]   (1..1000000, default 500)\n";
+
+int bench_network(const std::vector<std::string>& args) {
+  if (args.size() > 1) throw bench::BadArgument{"too many arguments"};
+  const auto per_node =
+      args.empty() ? std::size_t{500}
+                   : static_cast<std::size_t>(bench::parse_int(args[0], 1, 1000000, "PACKETS_PER_NODE"));
   std::printf("%-14s %8s %10s %12s %10s %10s %10s\n", "topology", "payload", "packets",
               "packets/s", "rel", "mean hops", "analytic");
   for (std::size_t payload : {64u, 1024u}) {
@@ -39,3 +43,7 @@ int main(int argc, char** argv) {
   }
   return 0;
 }
+
+}  // namespace
+
+int main(int argc, char** argv) { return bench::run_main("network_bench", usage, argc, argv, bench_network); }

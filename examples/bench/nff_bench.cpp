@@ -19,6 +19,7 @@
 #include <string>
 #include <variant>
 
+#include "examples/bench/bench_args.hpp"
 #include "tracer/generators.hpp"
 #include "tracer/nff.hpp"
 
@@ -89,10 +90,20 @@ Read read_in_child(const std::string& self, const std::string& path) {
 
 }  // namespace
 
-int main(int argc, char** argv) {
-  if (argc == 3 && std::string(argv[1]) == "--read") return read_once(argv[2]);
-  const std::string spec = argc > 1 ? argv[1] : "tetra:10";
-  const int runs = argc > 2 ? std::atoi(argv[2]) : 3;
+const char* const usage =
+    "usage: nff_bench [SCENE [RUNS [--keep]]]   (default tetra:10 3; RUNS 1..100)\n"
+    "       nff_bench --read FILE               (one read, as the bench's child process does it)\n";
+
+int bench_nff(const std::vector<std::string>& args) {
+  if (!args.empty() && args[0] == "--read") {
+    if (args.size() != 2) throw bench::BadArgument{"--read takes one FILE"};
+    return read_once(args[1].c_str());
+  }
+  if (args.size() > 3 || (args.size() == 3 && args[2] != "--keep"))
+    throw bench::BadArgument{"expected SCENE [RUNS [--keep]]"};
+  const std::string spec = args.size() > 0 ? args[0] : "tetra:10";
+  const int runs = args.size() > 1 ? static_cast<int>(bench::parse_int(args[1], 1, 100, "RUNS")) : 3;
+  const bool keep = args.size() > 2;
   const std::string self = std::filesystem::read_symlink("/proc/self/exe").string();
   char tmpl[] = "/tmp/nff_bench.XXXXXX";
   if (!mkdtemp(tmpl)) return 1;
@@ -124,8 +135,11 @@ int main(int argc, char** argv) {
         "  %s  %.3f s CPU (%.3f s wall), %6.1f MB/s of NFF text per CPU second, peak resident %.0f MB, %zu objects\n",
         name, best.cpu, best.wall, plain_mb / best.cpu, double(best.peak_kb) / 1024.0, best.objects);
   }
-  if (argc > 3 && std::string(argv[3]) == "--keep")
+  if (keep)
     std::printf("files kept in %s\n", dir.c_str());
   else
     std::filesystem::remove_all(dir);
+  return 0;
 }
+
+int main(int argc, char** argv) { return bench::run_main("nff_bench", usage, argc, argv, bench_nff); }

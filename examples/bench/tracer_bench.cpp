@@ -17,6 +17,7 @@
 #include <time.h>
 
 #include <algorithm>
+#include <charconv>
 #include <cstdio>
 #include <cstring>
 #include <numbers>
@@ -24,6 +25,7 @@
 #include <string>
 #include <vector>
 
+#include "examples/bench/bench_args.hpp"
 #include "tracer/database.hpp"
 #include "tracer/generators.hpp"
 #include "tracer/geometry.hpp"
@@ -297,19 +299,35 @@ void bench_triangulation() {
 
 }  // namespace
 
-int main(int argc, char** argv) {
-  // tracer_bench [--grid] [--density CELLS_PER_PRIMITIVE] [SCENE...]
+const char* const usage =
+    "usage: tracer_bench [--grid] [--density CELLS_PER_PRIMITIVE] [SCENE...]\n"
+    "  (default scenes teapot mountain rings4 tetra9; density above 0, at most 64)\n";
+
+int bench_tracer(const std::vector<std::string>& args) {
   std::vector<std::string> scenes;
   bool grid_only = false;
-  for (int i = 1; i < argc; ++i) {
-    if (std::string(argv[i]) == "--grid")
+  for (std::size_t i = 0; i < args.size(); ++i) {
+    if (args[i] == "--grid") {
       grid_only = true;
-    else if (std::string(argv[i]) == "--density" && i + 1 < argc)
-      grid_density = std::stof(argv[++i]);
-    else
-      scenes.push_back(argv[i]);
+    } else if (args[i] == "--density") {
+      if (i + 1 == args.size()) throw bench::BadArgument{"--density needs a value"};
+      const std::string& v = args[++i];
+      float d = 0;
+      const auto [end, ec] = std::from_chars(v.data(), v.data() + v.size(), d);
+      if (ec != std::errc() || end != v.data() + v.size() || !(d > 0 && d <= 64))
+        throw bench::BadArgument{"--density: expected a number above 0, at most 64, got '" + v + "'"};
+      grid_density = d;
+    } else if (args[i].starts_with("-")) {
+      throw bench::BadArgument{"unknown option '" + args[i] + "'"};
+    } else {
+      scenes.push_back(args[i]);
+    }
   }
   if (scenes.empty()) scenes = {"teapot", "mountain", "rings4", "tetra9"};
+  for (const auto& s : scenes) tracer::generate_scene(s);  // an unknown scene fails before any work
   for (const auto& s : scenes) bench_scene(s, grid_only);
   if (!grid_only) bench_triangulation();
+  return 0;
 }
+
+int main(int argc, char** argv) { return bench::run_main("tracer_bench", usage, argc, argv, bench_tracer); }
