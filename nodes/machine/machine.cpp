@@ -125,14 +125,17 @@ std::size_t farmer_bound(std::size_t nodes, int workers_per_node, std::uint16_t 
   return nodes * static_cast<std::size_t>(workers_per_node) * (prefetch + 1u) + nodes;
 }
 
-// The page requests of node n: its delivery port itself, which holds them
-// all, or with a link model (delivery by rendezvous) a mailbox.
-csp::In<Packet> page_requests(const Wiring& w, NodeId n, NodeState& node, const std::string& name) {
-  if (!w.net.options().link.enabled()) return w.net.port(n, Ports::page_server);
-  node.mailbox = std::make_unique<Mailbox>(name + " page requests", static_cast<std::size_t>(w.processes) + 1);
-  w.runtime.spawn(name + " page mailbox", w.net.thread_of(n),
-                  [mb = node.mailbox.get(), in = w.net.port(n, Ports::page_server)] { mb->forward(in); });
-  return node.mailbox->reader();
+// What the page server or the farmer (port) of node n reads: the delivery
+// port itself, sized to its bound (network_options), or with a link model
+// (delivery by rendezvous) a mailbox of that size, kept in `mailbox`
+// (channel "WHO requests", process "WHO mailbox").
+csp::In<Packet> drained_port(const Wiring& w, NodeId n, std::uint16_t port, std::size_t bound,
+                             const std::string& who, std::unique_ptr<Mailbox>& mailbox) {
+  if (!w.net.options().link.enabled()) return w.net.port(n, port);
+  mailbox = std::make_unique<Mailbox>(who + " requests", bound);
+  w.runtime.spawn(who + " mailbox", w.net.thread_of(n),
+                  [mb = mailbox.get(), in = w.net.port(n, port)] { mb->forward(in); });
+  return mailbox->reader();
 }
 
 // The miss path with each wait for a page logged on the node.
@@ -149,7 +152,9 @@ void spawn_node(const Wiring& w, NodeId n, NodeState& node) {
   const unsigned thread = w.net.thread_of(n);
   const std::string name = "node " + std::to_string(n);
   const int k = w.options.workers_per_node;
-  csp::In<Packet> requests = page_requests(w, n, node, name);
+  const csp::In<Packet> requests =
+      drained_port(w, n, Ports::page_server, page_requests_bound(w.net.topology().size(), k), name + " page",
+                   node.mailbox);
   std::function<void()> serve_hook = w.timing ? w.timing->serve_hook(static_cast<int>(n)) : nullptr;
   w.runtime.spawn(
       name + " page server", thread,
@@ -202,15 +207,9 @@ void spawn_node(const Wiring& w, NodeId n, NodeState& node) {
 void spawn_host(const Wiring& w, Host& host) {
   const unsigned thread = w.net.thread_of(0);
   const auto nodes = static_cast<std::size_t>(w.net.topology().size());
-  // Its port holds every packet outstanding for it; with a link model
-  // (delivery by rendezvous) a mailbox does.
-  csp::In<Packet> requests = w.net.port(0, Ports::farmer);
-  if (w.net.options().link.enabled()) {
-    host.mailbox = std::make_unique<Mailbox>("farmer requests",
-                                             farmer_bound(nodes, w.options.workers_per_node, w.options.prefetch));
-    w.runtime.spawn("farmer mailbox", thread, [mb = host.mailbox.get(), in = requests] { mb->forward(in); });
-    requests = host.mailbox->reader();
-  }
+  const csp::In<Packet> requests =
+      drained_port(w, 0, Ports::farmer, farmer_bound(nodes, w.options.workers_per_node, w.options.prefetch),
+                   "farmer", host.mailbox);
   host.results = std::make_unique<csp::Channel<Packet>>("results", results_buffer);
   w.runtime.spawn("farmer", thread, [&w, &host, nodes, requests, out = w.outbox(0, Ports::farmer)] {
     Farmer(*host.plan, static_cast<int>(nodes), w.options.workers_per_node, requests, out,
