@@ -118,36 +118,18 @@ void print_run(const char* label, const MachineRun& r, double baseline) {
               r.same_image ? "identical" : "DIFFERS");
 }
 
-}  // namespace
-
 const char* const usage =
     "usage: machine_bench [SCENE [SIZE [THREADS [REPEATS]]]]   default: teapot 512 2 5\n"
     "  SIZE 16..4096, THREADS 1..1024, REPEATS 1..100\n";
 
-int main(int argc, char** argv) {
-  std::string spec = "teapot";
-  int size = 512, repeats = 5;
-  unsigned threads = 2;
-  tracer::Database db;
-  try {
-    const std::vector<std::string> args(argv + 1, argv + argc);
-    if (!args.empty() && (args[0] == "-h" || args[0] == "--help")) {
-      std::fputs(usage, stdout);
-      return 0;
-    }
-    if (args.size() > 4) throw bench::BadArgument{"too many arguments"};
-    if (args.size() > 0) spec = args[0];
-    if (args.size() > 1) size = static_cast<int>(bench::parse_int(args[1], 16, 4096, "SIZE"));
-    if (args.size() > 2) threads = static_cast<unsigned>(bench::parse_int(args[2], 1, 1024, "THREADS"));
-    if (args.size() > 3) repeats = static_cast<int>(bench::parse_int(args[3], 1, 100, "REPEATS"));
-    db = make_db(spec, size);  // an unknown scene fails here, before any run
-  } catch (const bench::BadArgument& e) {
-    std::fprintf(stderr, "machine_bench: %s\n%s", e.what.c_str(), usage);
-    return 2;
-  } catch (const std::exception& e) {
-    std::fprintf(stderr, "machine_bench: %s\n%s", e.what(), usage);
-    return 2;
-  }
+int bench_machine(const std::vector<std::string>& args) {
+  if (args.size() > 4) throw bench::BadArgument{"too many arguments"};
+  const std::string spec = args.size() > 0 ? args[0] : "teapot";
+  const int size = args.size() > 1 ? static_cast<int>(bench::parse_int(args[1], 16, 4096, "SIZE")) : 512;
+  const unsigned threads =
+      args.size() > 2 ? static_cast<unsigned>(bench::parse_int(args[2], 1, 1024, "THREADS")) : 2u;
+  const int repeats = args.size() > 3 ? static_cast<int>(bench::parse_int(args[3], 1, 100, "REPEATS")) : 5;
+  const tracer::Database db = make_db(spec, size);  // an unknown scene fails here, before any run
   std::printf("scene %s at %dx%d, %u database pages of %u bytes, cache = 1/8 of the database per node, "
               "%d runs of each line: median (fastest)\n",
               spec.c_str(), size, size, db.header.page_count, db.header.page_size, repeats);
@@ -228,3 +210,7 @@ int main(int argc, char** argv) {
   for (std::size_t v = 0; v < variants.size(); ++v) print_run(variants[v].label, runs[v], baseline.median());
   return 0;
 }
+
+}  // namespace
+
+int main(int argc, char** argv) { return bench::run_main("machine_bench", usage, argc, argv, bench_machine); }

@@ -114,33 +114,22 @@ bool run_case(const Case& c, int size, int repeats) {
   return identical;
 }
 
+int bench_packets(const std::vector<std::string>& args) {
+  const int repeats = args.size() > 0 ? static_cast<int>(parse_int(args[0], 1, 100, "REPEATS")) : 5;
+  const int size = args.size() > 1 ? static_cast<int>(parse_int(args[1], 16, 4096, "SIZE")) : 512;
+  std::vector<Case> cases;
+  for (std::size_t i = 2; i < args.size(); ++i) cases.push_back(parse_case(args[i]));
+  if (cases.empty()) cases = {{"rings4", 16}, {"rings4", 64}, {"teapot", 16}, {"teapot", 256}};
+  for (const Case& c : cases) tracer::generate_scene(c.scene);  // a bad scene name fails before any work
+  std::printf("one thread, %dx%d, hypercube, default caches; CPU seconds, median of %d alternating runs\n", size,
+              size, repeats);
+  std::printf("%-8s %5s %8s %8s %7s %9s %9s %9s %10s %9s\n", "scene", "nodes", "plain", "machine", "ratio",
+              "misses", "packets", "hops", "us/miss", "us/hop");
+  bool ok = true;
+  for (const Case& c : cases) ok = run_case(c, size, repeats) && ok;
+  return ok ? 0 : 1;
+}
+
 }  // namespace
 
-int main(int argc, char** argv) {
-  try {
-    std::vector<std::string> args(argv + 1, argv + argc);
-    if (!args.empty() && (args[0] == "-h" || args[0] == "--help")) {
-      std::fputs(usage, stdout);
-      return 0;
-    }
-    const int repeats = args.size() > 0 ? static_cast<int>(parse_int(args[0], 1, 100, "REPEATS")) : 5;
-    const int size = args.size() > 1 ? static_cast<int>(parse_int(args[1], 16, 4096, "SIZE")) : 512;
-    std::vector<Case> cases;
-    for (std::size_t i = 2; i < args.size(); ++i) cases.push_back(parse_case(args[i]));
-    if (cases.empty()) cases = {{"rings4", 16}, {"rings4", 64}, {"teapot", 16}, {"teapot", 256}};
-    for (const Case& c : cases) tracer::generate_scene(c.scene);  // a bad scene name fails before any work
-    std::printf("one thread, %dx%d, hypercube, default caches; CPU seconds, median of %d alternating runs\n", size,
-                size, repeats);
-    std::printf("%-8s %5s %8s %8s %7s %9s %9s %9s %10s %9s\n", "scene", "nodes", "plain", "machine", "ratio",
-                "misses", "packets", "hops", "us/miss", "us/hop");
-    bool ok = true;
-    for (const Case& c : cases) ok = run_case(c, size, repeats) && ok;
-    return ok ? 0 : 1;
-  } catch (const BadArgument& e) {
-    std::fprintf(stderr, "packet_bench: %s\n%s", e.what.c_str(), usage);
-    return 2;
-  } catch (const std::exception& e) {
-    std::fprintf(stderr, "packet_bench: %s\n", e.what());
-    return 2;
-  }
-}
+int main(int argc, char** argv) { return bench::run_main("packet_bench", usage, argc, argv, bench_packets); }
