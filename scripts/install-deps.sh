@@ -2,7 +2,7 @@
 # Installs, with apt-get, exactly the Debian packages vmpray needs that are
 # missing. Idempotent: a second run installs nothing. Run as root.
 # --dev adds the developer tools (sanitizer runtime, fuzzer, browser,
-# ccache); --ccache installs only ccache.
+# ccache, iproute2 for the cluster check); --ccache installs only ccache.
 set -euo pipefail
 packages=(
   cmake ninja-build g++ pkg-config
@@ -13,8 +13,8 @@ packages=(
   nlohmann-json3-dev libcairo2-dev fonts-dejavu-core
 )
 case "${1:-}" in
-  --dev) # sanitizers' clang runtime, the fuzzer, the browser checks, ccache
-    packages+=(clang-14 libclang-rt-14-dev chromium python3 ccache) ;;
+  --dev) # sanitizers' clang runtime, the fuzzer, the browser checks, ccache, namespaces
+    packages+=(clang-14 libclang-rt-14-dev chromium python3 ccache iproute2 util-linux) ;;
   --ccache) # only the compiler cache every preset uses when installed
     packages=(ccache) ;;
   "") ;;
