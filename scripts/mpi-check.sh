@@ -3,7 +3,7 @@
 # of localhost slots, 4 ranks over shared memory and over TCP on loopback,
 # each image compared byte for byte with the one-process render; then how
 # much CPU a rank uses while it only waits (rank 1 while rank 0 builds the
-# Tetra10 database). Exits non-zero on any difference or failure.
+# Tetra10 database), bounded. Exits non-zero on any difference or failure.
 #
 # usage: scripts/mpi-check.sh [BUILD_DIR]   (default build/release)
 set -euo pipefail
@@ -26,7 +26,24 @@ for btl in "self,vader" "self,tcp --mca btl_tcp_if_include lo"; do
 done
 
 # CPU of a waiting rank: rank 1 waits for its pages while rank 0 reads and
-# builds the scene, then renders a tiny frame.
+# builds the scene, then renders a tiny frame. A rank that only waits must
+# sleep: its CPU time (user + system, its start, its pages and its pixels
+# included) at most a third of its wall time (a rank that spun while
+# waiting would use about as much CPU as wall time).
 timeout -k 10 300 mpirun -np 2 --oversubscribe --mca btl self,vader \
   sh -c 'exec /usr/bin/time -f "rank $OMPI_COMM_WORLD_RANK: %e s wall, %U s user, %S s system" "$0" "$@"' \
-  "$vmpray" tetra10 --width 16 --height 16 --topology hypercube:1 -q -o tetra.png 2>&1 | grep '^rank'
+  "$vmpray" tetra10 --width 16 --height 16 --topology hypercube:1 -q -o tetra.png 2>&1 | grep '^rank' | tee times.txt
+python3 - times.txt <<'CHECK'
+import re, sys
+ranks = {}
+for line in open(sys.argv[1]):
+    m = re.match(r"rank (\d+): ([\d.]+) s wall, ([\d.]+) s user, ([\d.]+) s system", line)
+    if m:
+        ranks[int(m[1])] = (float(m[2]), float(m[3]) + float(m[4]))
+if set(ranks) != {0, 1}:
+    sys.exit("mpi-check: expected the times of ranks 0 and 1, got " + repr(sorted(ranks)))
+(wall0, cpu0), (wall1, cpu1) = ranks[0], ranks[1]
+if cpu1 > wall1 / 3:
+    sys.exit(f"mpi-check: the waiting rank used {cpu1:.2f} s of CPU in {wall1:.2f} s, rank 0 {cpu0:.2f} s: it did not sleep")
+print(f"mpi-check: the waiting rank used {cpu1:.2f} s of CPU in {wall1:.2f} s (rank 0: {cpu0:.2f} s)")
+CHECK
