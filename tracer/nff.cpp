@@ -19,6 +19,9 @@
 #include <iostream>
 #include <iterator>
 #include <limits>
+#include <optional>
+#include <sstream>
+#include <string>
 #include <vector>
 
 namespace tracer {
@@ -418,7 +421,7 @@ class Parser {
     entity_key_ = key;
     entity_line_ = lex_.line();
     if (key == "v") return view();
-    if (key == "b") return void(scene_.background = color("background colour"));
+    if (key == "b") return void(scene_.background = color("background colour", true));
     if (key == "l") return light();
     if (key == "f") return material();
     if (key == "c") return cone();
@@ -468,9 +471,30 @@ class Parser {
     return v;
   }
 
-  Color color(std::string_view what) {
-    Vec3d c = vec3(what);
+  // A colour whose components are at least 0 and, if `at_most_one`, at most 1
+  // (a reflectance; a light's colour is an intensity, unbounded).
+  Color color(std::string_view what, bool at_most_one) {
+    const Vec3d c = vec3(what);
+    for (const double v : {c.x, c.y, c.z})
+      if (v < 0 || (at_most_one && v > 1))
+        fail_here(std::string(what) + (at_most_one ? " must lie in 0..1" : " must not be negative") +
+                  " in each component, got " + format_number(v));
     return {static_cast<float>(c.x), static_cast<float>(c.y), static_cast<float>(c.z)};
+  }
+
+  // A number at least 0, and at most `hi` if given.
+  double non_negative(std::string_view what, std::optional<double> hi = std::nullopt) {
+    const double v = number(what);
+    if (v < 0 || (hi && v > *hi))
+      fail_here(std::string(what) + (hi ? " must lie in 0.." + format_number(*hi) : std::string(" must not be negative")) +
+                ", got " + format_number(v));
+    return v;
+  }
+
+  static std::string format_number(double v) {
+    std::ostringstream out;
+    out << v;
+    return out.str();
   }
 
   long long integer(std::string_view what, long long lo, long long hi) {
@@ -565,18 +589,18 @@ void Parser::view() {
 void Parser::light() {
   Light light;
   light.position = vec3("light position");
-  if (looks_numeric(lex_.peek())) light.color = color("light colour");
+  if (looks_numeric(lex_.peek())) light.color = color("light colour", false);
   scene_.lights.push_back(light);
 }
 
 void Parser::material() {
   Material m;
-  m.color = color("material colour");
-  m.kd = number("Kd");
-  m.ks = number("Ks");
-  m.shine = number("Phong exponent");
-  m.transmittance = number("transmittance");
-  m.ior = number("index of refraction");
+  m.color = color("material colour", true);
+  m.kd = non_negative("Kd");
+  m.ks = non_negative("Ks");
+  m.shine = non_negative("Phong exponent");
+  m.transmittance = non_negative("transmittance", 1.0);
+  m.ior = non_negative("index of refraction");
   if (m.transmittance > 0 && !(m.ior > 0))
     fail_at_entity("a transmitting material (T > 0) needs an index of refraction above 0");
   scene_.materials.push_back(m);

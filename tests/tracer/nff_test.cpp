@@ -167,6 +167,12 @@ TEST(Nff, OpaqueMaterialMayHaveZeroIndexOfRefraction) {
   EXPECT_DOUBLE_EQ(s.materials[0].ior, 0);
 }
 
+TEST(Nff, ALightMayBeBrighterThanOneAMaterialExactlyOne) {
+  Scene s = parse("l 0 0 5 4 4 4\nf 1 1 1 1 1 100 1 1.5\nb 1 1 1\ns 0 0 0 1");
+  EXPECT_FLOAT_EQ(s.lights[0].color.r, 4.0f);
+  EXPECT_DOUBLE_EQ(s.materials[0].transmittance, 1.0);
+}
+
 TEST(Nff, NearlyPlanarPolygonIsAccepted) {
   Scene s = parse("p 4\n0 0 0\n1 0 0\n1 1 0.001\n0 1 0\n");
   EXPECT_EQ(std::get<Polygon>(s.objects[0].shape).vertices.size(), 4u);
@@ -290,6 +296,12 @@ INSTANTIATE_TEST_SUITE_P(
                  "t.nff:2: expected an entity keyword (v b l f c s p pp), got '2' "
                  "(does the 's' at line 2 have more numbers than it takes?)"},
         BadInput{"ZeroPatchNormal", "pp 3\n0 0 0 0 0 1\n1 0 0 0 0 0\n", "t.nff:3: patch vertex normal has zero length"},
+        BadInput{"HugeMaterialColour", "f 1e30 1 1 1 0 1 0 0\ns 0 0 0 1", "t.nff:1: material colour must lie in 0..1 in each component, got 1e+30"},
+        BadInput{"NegativeBackground", "b 0 -0.5 0\n", "t.nff:1: background colour must lie in 0..1 in each component, got -0.5"},
+        BadInput{"NegativeLightColour", "l 0 0 0 1 -1 1\n", "t.nff:1: light colour must not be negative in each component, got -1"},
+        BadInput{"NegativeIor", "f 1 1 1 1 0 1 0\n-1\n", "t.nff:2: index of refraction must not be negative, got -1"},
+        BadInput{"NegativeKd", "f 1 1 1 -1 0 1 0 0\n", "t.nff:1: Kd must not be negative, got -1"},
+        BadInput{"TransmittanceAboveOne", "f 1 1 1 1 0 1 2 1.5\n", "t.nff:1: transmittance must lie in 0..1, got 2"},
         BadInput{"ShortMaterial", "f 1 1 1 1 0 1 0\ns 0 0 0 1", "t.nff:2: expected a finite number (index of refraction), got 's'"},
         BadInput{"BinaryGarbage", std::string("s 0 0 0 1\n\x01\x02\xff", 13), "t.nff:2: expected an entity keyword (v b l f c s p pp), got '\\x01\\x02\\xff'"}),
     [](const auto& info) { return std::string(info.param.label); });
