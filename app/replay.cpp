@@ -1,5 +1,5 @@
 // The replay page's data and markup (see replay.hpp); the script that plays
-// it is in replay_script.cpp.
+// it and its style are in replay/replay.js and replay/replay.css.
 #include "app/replay.hpp"
 
 #include <algorithm>

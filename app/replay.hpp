@@ -38,7 +38,8 @@ Json replay_data(const ReplaySource& source);
 // The whole page.
 std::string replay_page(const ReplaySource& source);
 
-// The page's script and style (app/replay_script.cpp).
+// The page's script and style: app/replay/replay.js and replay.css, compiled
+// in at build time (cmake/embed_text.cmake), less their opening comments.
 extern const char* const replay_script;
 extern const char* const replay_style;
 

@@ -1,41 +1,16 @@
-// The replay page's script and style (see replay.hpp), kept as raw strings so
-// the page needs no file beside it. The script reads the JSON of
-// #replay-data, draws the run at a time t on a canvas over the machine's SVG
-// (node places come from the machine picture, in its user units) and on a
-// canvas of the frame, and exposes window.vmprayReplay for scripted checks:
-// stepToEnd() and counters() (packets delivered, hops, misses, pixels).
+// The replay page's script (see app/replay.hpp), inlined into the page at
+// build time (app/CMakeLists.txt, cmake/embed_text.cmake) so the page needs
+// no file beside it and vmpray reads no file to write it; this opening
+// comment is left out of the page, the rest goes in as it is.
+// The script reads the JSON of #replay-data, draws the run at a time t on a
+// canvas over the machine's SVG (node places come from the machine picture,
+// in its user units) and on a canvas of the frame, and exposes
+// window.vmprayReplay for scripted checks: stepToEnd() and counters()
+// (packets delivered, hops, misses, pixels).
 // Cost: a frame walks the packets injected by t and the hops left by t, so a
 // recording of 36 000 packets draws in a few milliseconds.
-#include "app/replay.hpp"
 
-namespace app {
-
-const char* const replay_style =
-    R"css(body { font-family: sans-serif; margin: 1.5em auto; max-width: 1250px; color: #222; }
-h1 { border-bottom: 2px solid #444; font-size: 1.5em; }
-p.made { color: #555; }
-p.made code { background: #f4f4f4; padding: 0.1em 0.3em; overflow-wrap: anywhere; }
-#bound { background: #fff4d6; padding: 0.4em 0.6em; border-left: 4px solid #e0a000; }
-#controls { display: flex; flex-wrap: wrap; gap: 0.5em; align-items: center; margin: 0.6em 0; }
-#slider { flex: 1; min-width: 200px; }
-#clock { font-variant-numeric: tabular-nums; min-width: 11em; }
-#counters { display: flex; flex-wrap: wrap; gap: 1.5em; margin: 0.4em 0 0.8em; font-variant-numeric: tabular-nums; }
-#counters b { font-size: 1.2em; }
-#panes { display: flex; flex-wrap: wrap; gap: 1em; align-items: flex-start; }
-#stage { position: relative; flex: 1 1 560px; max-width: 720px; }
-#stage svg { display: block; width: 100%; height: auto; }
-#overlay { position: absolute; left: 0; top: 0; cursor: pointer; }
-#picture { flex: 0 1 420px; }
-#frame { width: 100%; max-width: 512px; image-rendering: pixelated; background: #222; }
-#legend { margin: 0.8em 0; font-size: 0.9em; }
-#legend span.sw { display: inline-block; width: 0.9em; height: 0.9em; border-radius: 50%; margin: 0 0.3em 0 0.9em;
-                  vertical-align: -0.1em; }
-#details { border-top: 1px solid #ccc; margin-top: 0.8em; padding-top: 0.4em; }
-#details table { border-collapse: collapse; margin: 0.4em 0; }
-#details th, #details td { border: 1px solid #ccc; padding: 0.15em 0.5em; text-align: right; }
-)css";
-
-const char* const replay_script = R"js("use strict";
+"use strict";
 (function () {
 const D = JSON.parse(document.getElementById("replay-data").textContent);
 const N = D.nodes, END = D.end, TICK = D.tick;
@@ -440,6 +415,3 @@ window.vmprayReplay = {
   packets: recorded,
 };
 })();
-)js";
-
-}  // namespace app
