@@ -79,13 +79,18 @@ sed 's|</body>|<script>undefined_function();</script></body>|' "$work/run.html" 
 printf '<!DOCTYPE html><html><head><title>x</title></head><body><p> </p></body></html>\n' >"$work/bad/blank.html"
 # So must a replay whose counters end one packet short of the stats it is held to.
 cp "$work/replay.html" "$work/bad/miscounts.html"
-for bad in fetches throws blank miscounts; do
+# And a replay that never becomes ready: its checks never settle, so no PASS.
+sed 's|const ready = Promise.all(|const ready = new Promise(() => {}), decoded = Promise.all(|' "$work/replay.html" \
+  >"$work/bad/hangs.html"
+cmp -s "$work/replay.html" "$work/bad/hangs.html" && { echo "browser-check: cannot make the hanging replay" >&2; exit 1; }
+for bad in fetches throws blank miscounts hangs; do
   least=(2 2 3) expect=""
   [[ $bad == miscounts ]] && least=(0 0 0) expect=$(awk -F, -v OFS=, '{ $1 += 1; print }' <<<"$replay_stats")
+  [[ $bad == hangs ]] && least=(0 0 0) expect=$replay_stats
   if check "$work/bad/$bad.html" "${least[@]}" "$expect" 2>/dev/null; then
     echo "browser-check: the page that $bad passed the check" >&2
     status=1
   fi
 done
-((status == 0)) && echo "browser-check: the check fails a page that fetches, throws, is blank or miscounts"
+((status == 0)) && echo "browser-check: the check fails a page that fetches, throws, is blank, miscounts or never settles"
 exit $status
