@@ -4,8 +4,12 @@
 // Every message travels as a nodes::Packet by value (processors share
 // nothing); the payload is a flat little-endian-as-host byte string written
 // and read here only, so a processor could run unchanged in another process.
-// Decoding checks sizes and throws std::runtime_error on a malformed payload
-// rather than reading out of bounds.
+// Each payload's layout is the one field list below, in wire order, that
+// its encoder and decoder both go by (wire_fields.hpp): fixed-width fields
+// with no padding and no counts; a result's colours and a page reply's
+// bytes run to the end of the payload. Decoding checks sizes and throws
+// std::runtime_error on a malformed payload rather than reading out of
+// bounds.
 //
 // Who sends what (see machine.hpp for the whole protocol):
 //   worker    -> farmer     work_request {reply port, tiles}   (once, at start)
@@ -30,6 +34,7 @@
 
 #include "csp/csp.hpp"
 #include "nodes/net/packet.hpp"
+#include "nodes/ranks/wire_fields.hpp"
 #include "tracer/vec.hpp"
 
 namespace nodes {
@@ -87,6 +92,44 @@ struct ResultView {
   tracer::Color color(std::uint32_t i) const;
 };
 
+// A page reply: the page id leads the bytes so a reply names what it carries.
+struct PageReplyView {
+  std::uint32_t page = 0;
+  std::span<const std::byte> bytes;
+};
+
+// The payloads, in wire order: 4, 8, 6 + 12 x count, 6 and 4 + page bytes.
+template <class V>
+void wire_fields(V& v, WireView<WorkRequest> auto& request) {
+  v(request.reply_port);
+  v(request.tiles);
+}
+
+template <class V>
+void wire_fields(V& v, WireView<Tile> auto& tile) {
+  v(tile.first);
+  v(tile.count);
+}
+
+template <class V>
+void wire_fields(V& v, WireView<ResultView> auto& result) {
+  v(result.reply_port);
+  v(result.tile);
+  v(wire_rest(result.rgb));
+}
+
+template <class V>
+void wire_fields(V& v, WireView<PageRequest> auto& request) {
+  v(request.page);
+  v(request.reply_port);
+}
+
+template <class V>
+void wire_fields(V& v, WireView<PageReplyView> auto& reply) {
+  v(reply.page);
+  v(wire_rest(reply.bytes));
+}
+
 std::vector<std::byte> encode_work_request(WorkRequest request);
 WorkRequest decode_work_request(std::span<const std::byte> payload);
 
@@ -122,7 +165,6 @@ class Outbox {
   std::uint64_t step_;
 };
 
-// The page id leads the bytes so a reply names what it carries.
 std::vector<std::byte> encode_page_reply(std::uint32_t page, std::span<const std::byte> bytes);
 std::uint32_t page_reply_id(std::span<const std::byte> payload);
 std::span<const std::byte> page_reply_bytes(std::span<const std::byte> payload);

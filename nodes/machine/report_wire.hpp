@@ -1,21 +1,98 @@
 // The byte form of what ranks of a split machine send one another outside
 // the network: the database header (rank 0 to every rank, before the run)
 // and the reports of a rank's nodes and routers (to rank 0, after it).
-// Encode and decode are inverses field by field; a decoder throws
-// std::runtime_error (transport.hpp) on a message too short for its fields.
+// Each format is the one field list below, in wire order, that both encode
+// and decode go by (wire_fields.hpp says how a field travels), so they are
+// inverses field by field; a decoder throws std::runtime_error
+// (transport.hpp) on a message too short for its fields.
 #pragma once
 
 #include <vector>
 
 #include "csp/runtime.hpp"
 #include "nodes/ranks/transport.hpp"
+#include "nodes/ranks/wire_fields.hpp"
 #include "tracer/database.hpp"
 
 namespace nodes {
 
 struct NodeReport;
 struct RankReport;
+struct RouteRecord;
 struct RouterCounters;
+struct WorkerCounters;
+
+template <class V>
+void wire_fields(V& v, WireView<tracer::DatabaseHeader> auto& h) {
+  v(h.scene_name);
+  v(h.camera);
+  v(h.background);
+  v(h.lights);
+  v(h.page_size);
+  v(h.page_shift);
+  v(h.page_count);
+  v(h.sections);
+  v(h.accel);
+  v(h.bounds);
+  v(h.bvh_root);
+  v(h.bvh_depth);
+  v(h.grid_dims);
+  v(h.epsilon);
+  v(h.polygon_count);
+  v(h.object_count);
+  v(h.primitive_count);
+}
+
+template <class V>
+void wire_fields(V& v, WireView<WorkerCounters> auto& w) {
+  v(w.items);
+  v(w.tiles);
+  v(w.rays);
+  v(w.spans);
+}
+
+template <class V>
+void wire_fields(V& v, WireView<NodeReport> auto& n) {
+  v(n.svm);
+  v(n.served);
+  v(n.work);
+  v(n.own_bytes);
+  v(n.peak_resident_bytes);
+  v(n.cache_capacity);
+  v(n.evictions);
+}
+
+template <class V>
+void wire_fields(V& v, WireView<RouteRecord> auto& route) {
+  v(route.id);
+  v(route.kind);
+  v(route.route);
+}
+
+template <class V>
+void wire_fields(V& v, WireView<RouterCounters> auto& c) {
+  v(c.injected);
+  v(c.forwarded);
+  v(c.delivered);
+  v(c.peak_pending);
+  v(c.sent);
+  v(c.hops);
+  v(c.hops_by_kind);
+  v(c.routes);
+}
+
+// Followed on the wire by the rank's host threads (put_rank_report).
+template <class V>
+void wire_fields(V& v, WireView<RankReport> auto& k) {
+  v(k.rank);
+  v(k.first_node);
+  v(k.node_count);
+  v(k.threads);
+  v(k.bridge);
+  v(k.wall_seconds);
+  v(k.cpu_seconds);
+  v(k.peak_scene_bytes);
+}
 
 void put_header(WireWriter& w, const tracer::DatabaseHeader& header);
 tracer::DatabaseHeader get_header(WireReader& r);

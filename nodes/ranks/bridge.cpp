@@ -5,11 +5,11 @@
 #include <chrono>
 #include <stdexcept>
 
+#include "nodes/ranks/bridge_wire.hpp"
+
 namespace nodes {
 
 namespace {
-
-enum class Record : std::uint8_t { packet = 1, credit, end, abort };
 
 constexpr std::chrono::microseconds shortest_poll{4};
 constexpr std::size_t poll_levels = 9;  // 4 us .. 1024 us
@@ -20,47 +20,6 @@ constexpr std::size_t poll_levels = 9;  // 4 us .. 1024 us
 // run of pixels.
 constexpr std::size_t frame_bytes = 3 * 1024;
 constexpr std::chrono::microseconds hot_window{1000};  // since the last activity
-
-void put_link(WireWriter& w, const CutLink& link) {
-  w.put<std::uint32_t>(link.from);
-  w.put<std::uint32_t>(link.to);
-  w.put<std::uint8_t>(static_cast<std::uint8_t>(link.buffer_class));
-}
-
-CutLink get_link(WireReader& r) {
-  CutLink link;
-  link.from = r.get<std::uint32_t>();
-  link.to = r.get<std::uint32_t>();
-  link.buffer_class = r.get<std::uint8_t>();
-  return link;
-}
-
-void put_packet(WireWriter& w, const Packet& p) {
-  w.put(p.source);
-  w.put(p.destination);
-  w.put(p.kind);
-  w.put(p.port);
-  w.put(p.hops);
-  w.put<std::uint8_t>(p.traced ? 1 : 0);
-  w.put(p.id);
-  // The shared bytes go as payload: the other process has no pointer to them.
-  w.put_joined(p.payload, p.shared);
-  w.put_vector(p.route);
-}
-
-Packet get_packet(WireReader& r) {
-  Packet p;
-  p.source = r.get<NodeId>();
-  p.destination = r.get<NodeId>();
-  p.kind = r.get<std::uint8_t>();
-  p.port = r.get<std::uint16_t>();
-  p.hops = r.get<std::uint16_t>();
-  p.traced = r.get<std::uint8_t>() != 0;
-  p.id = r.get<std::uint64_t>();
-  p.payload = r.get_vector<std::byte>();
-  p.route = r.get_vector<NodeId>();
-  return p;
-}
 
 }  // namespace
 
@@ -199,7 +158,7 @@ void Bridge::take_outgoing(Outgoing& out) {
   WireWriter& w = frame(out.peer);
   std::optional<Packet> packet = out.queue.read();
   while (packet) {
-    w.put(Record::packet);
+    w.put(BridgeRecord::packet);
     put_link(w, out.link);
     put_packet(w, *packet);
     if (w.size() >= frame_bytes) post_frame(out.peer);
@@ -228,8 +187,8 @@ bool Bridge::receive_all() {
 void Bridge::receive(int from, const Bytes& bytes) {
   WireReader r(bytes);
   while (!r.done()) {
-    switch (static_cast<Record>(r.get<std::uint8_t>())) {
-      case Record::packet: {
+    switch (static_cast<BridgeRecord>(r.get<std::uint8_t>())) {
+      case BridgeRecord::packet: {
         const CutLink link = get_link(r);
         Packet packet = get_packet(r);
         if (stopping_) break;  // the network is gone; the machine's end means none should come
@@ -252,9 +211,8 @@ void Bridge::receive(int from, const Bytes& bytes) {
         in.staged.push_back(std::move(packet));
         break;
       }
-      case Record::credit: {
-        const CutLink link = get_link(r);
-        const auto count = r.get<std::uint32_t>();
+      case BridgeRecord::credit: {
+        const auto [link, count] = get_fields<CreditRecord>(r);
         if (stopping_) break;
         const auto it = outgoing_by_link_.find(key(link));
         if (it == outgoing_by_link_.end()) throw std::runtime_error("bridge: a credit for a link not cut here");
@@ -266,16 +224,16 @@ void Bridge::receive(int from, const Bytes& bytes) {
         unacknowledged_ -= count;
         break;
       }
-      case Record::end:
+      case BridgeRecord::end:
         if (end_from_[static_cast<std::size_t>(from)])
           throw std::runtime_error("bridge: rank " + std::to_string(from) + " ended twice");
         end_from_[static_cast<std::size_t>(from)] = true;
         --ends_missing_;
         if (!stopping_) stop();
         break;
-      case Record::abort: {
-        const auto rank = r.get<std::int32_t>();
-        remote_failure_.set(rank, r.get_string());
+      case BridgeRecord::abort: {
+        auto abort = get_fields<AbortRecord>(r);
+        remote_failure_.set(abort.rank, std::move(abort.text));
         if (!stopping_) stop();
         break;
       }
@@ -311,9 +269,8 @@ void Bridge::queue_credits() {
   for (std::size_t i : owing_) {
     Incoming& in = incoming_[i];
     WireWriter& w = frame(in.peer);
-    w.put(Record::credit);
-    put_link(w, in.link);
-    w.put(in.credits_owed);
+    w.put(BridgeRecord::credit);
+    put_fields(w, CreditRecord{in.link, in.credits_owed});
     in.credits_owed = 0;
   }
   owing_.clear();
@@ -340,11 +297,10 @@ void Bridge::stop() {
     if (peer == transport_.rank()) continue;
     WireWriter& w = frame(peer);
     if (failure) {
-      w.put(Record::abort);
-      w.put<std::int32_t>(failure->first);
-      w.put_string(failure->second);
+      w.put(BridgeRecord::abort);
+      put_fields(w, AbortRecord{failure->first, failure->second});
     }
-    w.put(Record::end);
+    w.put(BridgeRecord::end);
   }
   send_frames();
 }

@@ -27,6 +27,7 @@
 #include <stdexcept>
 #include <string>
 #include <type_traits>
+#include <utility>
 #include <vector>
 
 namespace nodes {
@@ -84,6 +85,8 @@ class LocalTransportGroup {
 // bytes (every rank runs the same binary on the same architecture),
 // sequences with a 64-bit count before them. Reader throws
 // std::runtime_error on a message shorter than what is read from it.
+// Structured values are written and read by their field lists
+// (wire_fields.hpp).
 class WireWriter {
  public:
   template <class T>
@@ -104,6 +107,9 @@ class WireWriter {
     append(second.data(), second.size());
   }
   void put_string(const std::string& s);
+  // Bytes with no count: the end of a message, read back by take_rest().
+  void put_raw(std::span<const std::byte> bytes) { append(bytes.data(), bytes.size()); }
+  void reserve(std::size_t n) { bytes_.reserve(n); }
   Bytes take() { return std::move(bytes_); }
   std::size_t size() const { return bytes_.size(); }
 
@@ -114,7 +120,9 @@ class WireWriter {
 
 class WireReader {
  public:
-  explicit WireReader(const Bytes& bytes) : bytes_(bytes) {}
+  // Reads `bytes` in place: they must outlive the reader and what
+  // take_rest() returns.
+  explicit WireReader(std::span<const std::byte> bytes) : bytes_(bytes) {}
   template <class T>
   T get() {
     static_assert(std::is_trivially_copyable_v<T>);
@@ -132,12 +140,18 @@ class WireReader {
     return values;
   }
   std::string get_string();
+  // All that is left, as a view into the message.
+  std::span<const std::byte> take_rest() { return bytes_.subspan(std::exchange(at_, bytes_.size())); }
+  // Throws unless at least n bytes are left.
+  void need(std::uint64_t n) const {
+    if (n > bytes_.size() - at_) fail();
+  }
   bool done() const { return at_ == bytes_.size(); }
 
  private:
   const std::byte* take(std::size_t n);
   [[noreturn]] static void fail();
-  const Bytes& bytes_;
+  std::span<const std::byte> bytes_;
   std::size_t at_ = 0;
 };
 
