@@ -130,6 +130,7 @@ void Alt::prepare() {
       if (on_channel(g.kind)) enabled_[i / 64] |= bit;
       if (always_ready(g)) always_[i / 64] |= bit;
     }
+    for (std::size_t w = 0; w < enabled_.size(); ++w) bell_->arm(w, enabled_[w]);
   }
   for (std::size_t i : by_address_) {
     const Guard& g = guards_[i];
@@ -203,7 +204,8 @@ std::size_t Alt::select_by_bell(std::size_t first) {
 // The first ready guard from guard `first` on, in rotation, among the
 // enabled guards that are always ready (SKIP, an expired timeout) or whose
 // channel rang the bell since it was last found not ready (see Bell): each
-// such channel's mark is cleared, and its hint confirmed under its lock alone.
+// such channel's mark is cleared, and its hint confirmed under its lock alone
+// (a rendezvous channel's: a buffered one's needs no confirming).
 std::size_t Alt::poll_each(std::size_t first) const {
   const std::size_t words = enabled_.size();
   const std::size_t first_word = first / 64;
@@ -220,6 +222,13 @@ std::size_t Alt::poll_each(std::size_t first) const {
       if (!on_channel(g.kind)) return i;
       bell_->clear_mark(i);
       if (!hinted(g)) continue;
+      // A buffered channel's hint, once true, stays true until this ALT's
+      // owner acts: only its one reader takes values (an input guard), only
+      // its one writer fills slots (a room guard). No lock is needed to confirm.
+      if (g.channel->capacity() > 0) {
+        bell_->keep_mark(i);
+        return i;
+      }
       detail::ChannelLock lk(g.channel->lock_);
       if (ready_locked(g)) {
         bell_->keep_mark(i);

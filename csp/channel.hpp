@@ -90,6 +90,7 @@ class ChannelState final : public ChannelBase {
   T read() {
     ChannelLock lk(lock_);
     check_poison("In::read");
+    if (count_ > 0) return pop_locked();
     if (std::optional<T> v = take_locked()) return std::move(*v);
     std::optional<T> slot;
     Waiter w;
@@ -159,24 +160,29 @@ class ChannelState final : public ChannelBase {
     if (poisoned()) throw_poisoned(use);
   }
 
-  // Lock held: a value without waiting (buffer first, then a parked writer).
-  std::optional<T> take_locked() {
-    if (count_ > 0) {
-      std::optional<T> v(std::in_place, std::move(*ring_[head_]));
-      ring_[head_].reset();
-      head_ = (head_ + 1) % ring_.size();
-      --count_;
-      if (Record* r = claim_front_locked(writers_)) {
-        push_locked(std::move(*static_cast<T*>(r->slot)));
-        complete(*r->waiter, WaitState::data, r->guard);
-        publish_hints_locked();
-        return v;
-      }
-      if (Record* alt = claim_front_locked(room_waiters_)) complete(*alt->waiter, WaitState::data, alt->guard);
+  // Lock held, count_ > 0: the buffer's first value, moved straight out
+  // (the value a read returns); refills the slot from the first parked
+  // writer, or rings for the room it frees.
+  T pop_locked() {
+    T v(std::move(*ring_[head_]));
+    ring_[head_].reset();
+    head_ = (head_ + 1) % ring_.size();
+    --count_;
+    if (Record* r = claim_front_locked(writers_)) {
+      push_locked(std::move(*static_cast<T*>(r->slot)));
+      complete(*r->waiter, WaitState::data, r->guard);
       publish_hints_locked();
-      room_bell_.ring();
       return v;
     }
+    if (Record* alt = claim_front_locked(room_waiters_)) complete(*alt->waiter, WaitState::data, alt->guard);
+    publish_hints_locked();
+    room_bell_.ring();
+    return v;
+  }
+
+  // Lock held: a value without waiting (buffer first, then a parked writer).
+  std::optional<T> take_locked() {
+    if (count_ > 0) return std::optional<T>(pop_locked());
     if (Record* r = claim_front_locked(writers_)) {
       std::optional<T> v(std::move(*static_cast<T*>(r->slot)));
       complete(*r->waiter, WaitState::data, r->guard);

@@ -102,9 +102,9 @@ void Bell::wake() {
 }
 
 BellMark Bell::mark(std::size_t guard) {
-  while (marks_.size() <= guard / 64) marks_.push_back(std::make_unique<std::atomic<std::uint64_t>>(0));
-  std::atomic<std::uint64_t>& word = *marks_[guard / 64];
-  word.fetch_or(mark_bit(guard), std::memory_order_relaxed);
+  while (marks_.size() <= guard / 64) marks_.push_back(std::make_unique<BellWord>());
+  BellWord& word = *marks_[guard / 64];
+  word.marks.fetch_or(mark_bit(guard), std::memory_order_relaxed);
   return BellMark{this, &word, mark_bit(guard)};
 }
 

@@ -73,11 +73,18 @@ struct Process;
 class ChannelBase;
 class Bell;
 
+// The marks of 64 guards of a doorbell ALT, and which of them are armed
+// (see Bell); one cache line.
+struct alignas(64) BellWord {
+  std::atomic<std::uint64_t> marks{0};
+  std::atomic<std::uint64_t> armed{~std::uint64_t{0}};
+};
+
 // Where a channel rings a doorbell ALT: the ALT's bell, and the mark bit of
 // the guard that watches the channel (see Bell). No bell: nobody watches.
 struct BellMark {
   Bell* bell = nullptr;
-  std::atomic<std::uint64_t>* word = nullptr;
+  BellWord* word = nullptr;
   std::uint64_t bit = 0;
 
   void ring() const;
@@ -207,14 +214,23 @@ class ChannelBase {
 // look that found it not ready. A poll may therefore skip every guard whose
 // mark is clear. Mark words are allocated by the owner as guards are added
 // and never move, so channels ring them without a lock.
+// Arming: a ring always sets its mark, but rings the bell (and so wakes the
+// owner) only if its guard is armed; the owner arms the guards it has
+// enabled (arm()), so a channel whose guard is switched off, such as a
+// router's room guard while nothing waits for room, never wakes it in vain.
+// A ring's mark (seq_cst) comes before its look at the armed bits, and
+// arm() is followed by a full fence before the owner's next poll reads the
+// marks, so a ring that finds its guard not yet armed leaves a mark that
+// poll sees.
 class Bell final : public ChannelBase {
  public:
   explicit Bell(std::string name) : ChannelBase(std::move(name), 0) {}
   bool ready_locked() const override { return rung_.load(std::memory_order_relaxed); }
   bool room_locked() const override { return true; }
 
-  void ring(std::atomic<std::uint64_t>& word, std::uint64_t bit) {
-    word.fetch_or(bit, std::memory_order_release);
+  void ring(BellWord& word, std::uint64_t bit) {
+    word.marks.fetch_or(bit, std::memory_order_seq_cst);
+    if (!(word.armed.load(std::memory_order_seq_cst) & bit)) return;  // switched off: the mark waits for the poll
     if (!rung_.exchange(true, std::memory_order_acq_rel)) wake();  // else already rung, not yet seen
   }
   void clear() {
@@ -230,15 +246,24 @@ class Bell final : public ChannelBase {
   BellMark mark(std::size_t guard);
   // Owner only: the 64 marks of guards 64 w .. 64 w + 63 (0 if none added).
   std::uint64_t marks(std::size_t w) const {
-    return w < marks_.size() ? marks_[w]->load(std::memory_order_relaxed) : 0;
+    return w < marks_.size() ? marks_[w]->marks.load(std::memory_order_relaxed) : 0;
   }
   // Owner only, before it looks at guard's channel: clears its mark.
   void clear_mark(std::size_t guard) {
-    marks_[guard / 64]->fetch_and(~mark_bit(guard), std::memory_order_acq_rel);
+    marks_[guard / 64]->marks.fetch_and(~mark_bit(guard), std::memory_order_acq_rel);
   }
   // Owner only, after finding guard's channel ready: keeps it marked, since
   // it may stay ready after the owner acts on it.
-  void keep_mark(std::size_t guard) { marks_[guard / 64]->fetch_or(mark_bit(guard), std::memory_order_relaxed); }
+  void keep_mark(std::size_t guard) {
+    marks_[guard / 64]->marks.fetch_or(mark_bit(guard), std::memory_order_relaxed);
+  }
+  // Owner only, before its next poll: the guards 64 w .. 64 w + 63 whose
+  // rings wake it (all, until first armed).
+  void arm(std::size_t w, std::uint64_t armed) {
+    if (w >= marks_.size()) return;
+    marks_[w]->armed.store(armed, std::memory_order_seq_cst);
+    std::atomic_thread_fence(std::memory_order_seq_cst);
+  }
 
  private:
   static std::uint64_t mark_bit(std::size_t guard) { return std::uint64_t{1} << (guard % 64); }
@@ -247,7 +272,7 @@ class Bell final : public ChannelBase {
   // Set only by ring(), cleared only by the waiter. Once a ring finds it
   // clear, that ring wakes the waiter if it is parked (under lock_).
   std::atomic<bool> rung_{false};
-  std::vector<std::unique_ptr<std::atomic<std::uint64_t>>> marks_;  // stable addresses
+  std::vector<std::unique_ptr<BellWord>> marks_;  // stable addresses
 };
 
 inline void BellMark::ring() const {

@@ -550,6 +550,59 @@ TEST(AltDoorbell, DestroyedAltReleasesItsChannels) {
 // Forwarders in a line, each selecting over its input and the room in its
 // output, on alternating threads: every channel between two of them is
 // watched at both ends, by the bells of two ALTs on different threads.
+// A channel whose guard is off rings without waking its ALT, but its mark
+// stays: once the guard is on again, the next poll finds the channel ready.
+TEST(AltDoorbell, AChannelThatRangWhileItsGuardWasOffIsSeenWhenItIsOn) {
+  csp::Channel<int> a("a", 4), b("b", 4);
+  csp::Alt alt(csp::Alt::Waiting::doorbell);
+  auto ia = a.reader();
+  auto ib = b.reader();
+  const std::size_t ga = alt.add_input(ia), gb = alt.add_input(ib);
+  alt.enable(ga, false);
+  EXPECT_FALSE(alt.poll().has_value());  // a's guard is off, and no longer armed
+  a.writer().write(7);
+  EXPECT_FALSE(alt.poll().has_value());
+  alt.enable(ga, true);
+  EXPECT_EQ(alt.poll(), std::optional<std::size_t>(ga));
+  EXPECT_EQ(ia.read(), 7);
+  EXPECT_FALSE(alt.poll().has_value());
+  b.writer().write(8);
+  EXPECT_EQ(alt.poll(), std::optional<std::size_t>(gb));
+}
+
+// Across threads: an ALT parked with one guard off is woken by the guard
+// that is on, never wrongly chosen for the one that is off, and takes the
+// other's values once it turns it on.
+TEST(AltDoorbell, AGuardThatIsOffNeverWinsAcrossThreads) {
+  constexpr int count = 2000;
+  csp::Channel<int> off("off", 4), on("on", 1);
+  std::vector<int> from_on, from_off;
+  csp::Runtime rt(2);
+  rt.spawn("reader", 0, [&, io = off.reader(), in = on.reader()]() mutable {
+    csp::Alt alt(csp::Alt::Waiting::doorbell);
+    const std::size_t g_off = alt.add_input(io), g_on = alt.add_input(in);
+    alt.enable(g_off, false);
+    while (from_on.size() < count) {
+      const std::size_t g = alt.select();
+      ASSERT_EQ(g, g_on);
+      from_on.push_back(in.read());
+    }
+    alt.enable(g_off, true);
+    alt.enable(g_on, false);
+    while (from_off.size() < 4) {
+      ASSERT_EQ(alt.select(), g_off);
+      from_off.push_back(io.read());
+    }
+  });
+  rt.spawn("writer", 1, [wo = off.writer(), wi = on.writer()]() mutable {
+    for (int k = 0; k < 4; ++k) wo.write(k);
+    for (int k = 0; k < count; ++k) wi.write(k);
+  });
+  rt.run();
+  EXPECT_EQ(from_on.size(), std::size_t{count});
+  EXPECT_EQ(from_off, (std::vector<int>{0, 1, 2, 3}));
+}
+
 TEST(AltDoorbell, LineOfForwardersLosesNothingAcrossThreads) {
   constexpr int stages = 4;
   constexpr int count = 20000;
