@@ -93,15 +93,33 @@ int NodeMemory::install(std::uint32_t page, std::span<const std::byte> bytes, st
   return slot;
 }
 
-bool NodeMemory::begin_fetch(std::uint32_t page) { return pending_.try_emplace(page).second; }
+// The pending fetches are few (one per worker of the node at most), so a
+// short list searched in order, whose entries are reused, serves them with
+// no allocation per miss.
+NodeMemory::PendingFetch* NodeMemory::pending(std::uint32_t page) {
+  for (PendingFetch& p : pending_)
+    if (p.page == page) return &p;
+  return nullptr;
+}
 
-void NodeMemory::add_waiter(std::uint32_t page, int worker) { pending_.at(page).push_back(worker); }
+bool NodeMemory::begin_fetch(std::uint32_t page) {
+  if (pending(page)) return false;
+  pending_.push_back({page, {}});
+  return true;
+}
+
+void NodeMemory::add_waiter(std::uint32_t page, int worker) {
+  PendingFetch* p = pending(page);
+  if (!p) throw std::logic_error("a waiter for a page fetch that never began");
+  p->waiters.push_back(worker);
+}
 
 std::vector<int> NodeMemory::end_fetch(std::uint32_t page) {
-  auto it = pending_.find(page);
-  if (it == pending_.end()) throw std::logic_error("end of a page fetch that never began");
-  auto waiters = std::move(it->second);
-  pending_.erase(it);
+  PendingFetch* p = pending(page);
+  if (!p) throw std::logic_error("end of a page fetch that never began");
+  std::vector<int> waiters = std::move(p->waiters);
+  *p = std::move(pending_.back());
+  pending_.pop_back();
   return waiters;
 }
 

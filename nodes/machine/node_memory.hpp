@@ -29,7 +29,6 @@
 #include <cstdint>
 #include <memory>
 #include <span>
-#include <unordered_map>
 #include <vector>
 
 namespace nodes {
@@ -133,7 +132,12 @@ class NodeMemory {
   int front_ = -1;  // most recently used slot; -1: none
   int back_ = -1;   // least recently used
   std::uint64_t evictions_ = 0;
-  std::unordered_map<std::uint32_t, std::vector<int>> pending_;  // page -> waiting workers
+  struct PendingFetch {
+    std::uint32_t page = 0;
+    std::vector<int> waiters;  // workers woken when it ends
+  };
+  PendingFetch* pending(std::uint32_t page);
+  std::vector<PendingFetch> pending_;  // fetches begun and not ended, in no order
 };
 
 }  // namespace nodes

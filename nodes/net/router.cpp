@@ -46,7 +46,7 @@ void Router::run() {
     Packet packet = source < ends_.inputs.size()
                         ? ends_.inputs[source].read()
                         : ends_.injections[source - ends_.inputs.size()].read();
-    receive(source, std::move(packet));
+    receive(source, packet);
   }
 }
 
@@ -61,7 +61,7 @@ void Router::build_alt() {
   for (const auto& in : ends_.injections) source_guard_.push_back(alt_.add_input(in));
 }
 
-void Router::receive(std::size_t source, Packet packet) {
+void Router::receive(std::size_t source, Packet& packet) {
   if (source >= ends_.inputs.size()) {
     accept_injection(packet);
   } else {
@@ -71,7 +71,7 @@ void Router::receive(std::size_t source, Packet packet) {
   }
   const std::size_t queue = output_queue(packet);
   // Packets already held back for this output go first.
-  if (held_for_[queue] > 0 || !try_send(queue, packet)) hold(source, std::move(packet), queue);
+  if (held_for_[queue] > 0 || !try_send(queue, packet)) hold(source, packet, queue);
 }
 
 void Router::accept_injection(Packet& packet) const {
@@ -153,7 +153,7 @@ void Router::record_sent(bool recorded, std::uint64_t id, std::uint16_t hops, st
     log_->departed.push_back({id, time, static_cast<std::uint32_t>(queue), hops});
 }
 
-void Router::hold(std::size_t source, Packet packet, std::size_t queue) {
+void Router::hold(std::size_t source, Packet& packet, std::size_t queue) {
   pending_[source] = Pending{std::move(packet), queue};
   alt_.enable(source_guard_[source], false);
   if (held_for_[queue]++ == 0) alt_.enable(room_guard_[queue], true);

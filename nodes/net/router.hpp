@@ -107,13 +107,13 @@ class Router {
   };
 
   void build_alt();
-  void receive(std::size_t source, Packet packet);
+  void receive(std::size_t source, Packet& packet);
   void accept_injection(Packet& packet) const;
   void record_sent(bool recorded, std::uint64_t id, std::uint16_t hops, std::uint8_t kind, std::size_t queue,
                    double time);
   bool take_route_to_trace(std::uint8_t kind) const;
   bool try_send(std::size_t queue, Packet& packet);
-  void hold(std::size_t source, Packet packet, std::size_t queue);
+  void hold(std::size_t source, Packet& packet, std::size_t queue);
   void admit_pending(std::size_t queue);
   std::size_t output_queue(const Packet& packet) const;
 

@@ -183,6 +183,26 @@ TEST(NodeMemory, SecondMissOnAPendingPageWaitsForTheFirst) {
   EXPECT_TRUE(memory.begin_fetch(7));
 }
 
+// Several fetches pending at once (one per worker), ended in any order:
+// each keeps its own waiters, and a fetch never begun cannot end.
+TEST(NodeMemory, PendingFetchesKeepTheirOwnWaitersWhateverOrderTheyEnd) {
+  const PagePlacement placement(Distribution::modulo, 2, 10);
+  NodeMemory memory(placement, 0, page_size, own_pages(placement, 0), 2);
+  for (std::uint32_t page : {1u, 3u, 5u}) EXPECT_TRUE(memory.begin_fetch(page));
+  memory.add_waiter(3, 4);
+  memory.add_waiter(1, 2);
+  memory.add_waiter(5, 6);
+  memory.add_waiter(3, 5);
+  EXPECT_EQ(memory.end_fetch(1), (std::vector<int>{2}));
+  EXPECT_FALSE(memory.begin_fetch(5));
+  EXPECT_EQ(memory.end_fetch(5), (std::vector<int>{6}));
+  EXPECT_TRUE(memory.begin_fetch(1));
+  EXPECT_EQ(memory.end_fetch(3), (std::vector<int>{4, 5}));
+  EXPECT_EQ(memory.end_fetch(1), std::vector<int>{});
+  EXPECT_THROW(memory.end_fetch(3), std::logic_error);
+  EXPECT_THROW(memory.add_waiter(9, 1), std::logic_error);
+}
+
 TEST(NodeMemory, WrongSizedPageIsRejected) {
   const PagePlacement placement(Distribution::modulo, 2, 10);
   NodeMemory memory(placement, 0, page_size, own_pages(placement, 0), 2);
