@@ -105,15 +105,15 @@ void Bridge::carry() {
       stop();
       continue;
     }
-    queue_credits();
-    send_frames();
-    transport_.progress();
     // Poll at the shortest interval while an answer is due (packets sent
     // that have not come back as credits) or something happened lately;
-    // back off once all is quiet.
+    // back off once all is quiet, and then return every credit held back.
     const auto now = std::chrono::steady_clock::now();
     if (active) last_active_ = now;
     const bool hot = unacknowledged_ > 0 || now - last_active_ < hot_window;
+    queue_credits(!hot);
+    send_frames();
+    transport_.progress();
     alt_.enable(timeout_guards_[level_], false);
     level_ = hot ? 0 : std::min(level_ + 1, poll_levels - 1);
     alt_.enable(timeout_guards_[level_], true);
@@ -121,7 +121,11 @@ void Bridge::carry() {
     if (guard >= guard_owner_.size()) continue;  // a timeout: poll the wire
     try {
       if (take(guard)) {
+        // The rest of this pass first (the routers ready now may have more
+        // for the wire), then everything ready, in one message per rank.
+        csp::yield();
         take_ready();
+        queue_credits(false);
         // Sent now rather than after the next select: the receiver may be idle.
         send_frames();
         transport_.progress();
@@ -265,15 +269,27 @@ bool Bridge::deliver_staged() {
   return any;
 }
 
-void Bridge::queue_credits() {
+// Credits ride with packets: a link's credits go into its rank's frame when
+// that frame carries something anyway, when half the link's buffer is owed,
+// or (`all`) when the bridge goes quiet. Held back, they cannot stall the
+// sender: while fewer than half are owed, more than half of its credits
+// are with it or with packets on their way here, and those, delivered,
+// make the owed half.
+void Bridge::queue_credits(bool all) {
+  const std::uint32_t batch = static_cast<std::uint32_t>((capacity_ + 1) / 2);
+  std::size_t kept = 0;
   for (std::size_t i : owing_) {
     Incoming& in = incoming_[i];
     WireWriter& w = frame(in.peer);
+    if (!all && in.credits_owed < batch && w.size() == 0) {
+      owing_[kept++] = i;
+      continue;
+    }
     w.put(BridgeRecord::credit);
     put_fields(w, CreditRecord{in.link, in.credits_owed});
     in.credits_owed = 0;
   }
-  owing_.clear();
+  owing_.resize(kept);
 }
 
 void Bridge::post_frame(int peer) {

@@ -6,8 +6,9 @@
 // queue only while it holds a credit for that link; it starts with K
 // credits (K = the network's buffer capacity). The bridge of rank q keeps
 // arriving packets in a staging queue for the link and moves them into b's
-// input channel with try_write as room appears; each packet moved returns
-// one credit to a's rank. So a cut link holds at most K packets in a's output
+// input channel with try_write as room appears; each packet moved owes
+// one credit to a's rank, sent with the next frame to that rank, or alone
+// once half the link's K are owed or the bridge goes quiet (queue_credits). So a cut link holds at most K packets in a's output
 // queue, K in flight or staged, and K in b's input: a bounded FIFO from a's
 // router to b's router, which is all a link between routers is.
 //
@@ -28,8 +29,9 @@
 // tens of microseconds, not a sleep. Once all is quiet it waits twice as
 // long each time, up to 1 ms, so a rank with nothing to do sleeps instead
 // of spinning a core; any packet sent toward another rank wakes it at once.
-// A wake takes everything then ready on every link (Alt::poll) before it
-// sends, so the packets and credits of one wake reach a rank as one message.
+// A wake lets the rest of the thread's ready pass run (csp::yield), then
+// takes everything ready on every link (Alt::poll) before it sends, so the
+// packets and credits of one pass reach a rank as one message.
 //
 // Orderly end: the machine's protocol ends with nothing in flight, and then
 // rank 0 shuts its network down. A bridge that sees its network shut down,
@@ -114,7 +116,7 @@ class Bridge {
   bool take(std::size_t guard);
   void take_ready();
   void take_outgoing(Outgoing& out);
-  void queue_credits();
+  void queue_credits(bool all);
   void post_frame(int peer);
   void send_frames();
   void stop();
