@@ -74,7 +74,9 @@ std::vector<std::uint16_t> pixel_owners(const nodes::MachineReport& report, int 
 
 viz::Timeline timeline(const nodes::MachineReport& report) {
   viz::Timeline t;
-  t.title = report.topology + ", " + std::to_string(report.threads) + " thread(s): tiles over time";
+  t.title = report.topology + ", " + std::to_string(report.threads) + (report.threads == 1 ? " thread" : " threads") +
+            (report.ranks.empty() ? "" : " per rank, " + std::to_string(report.ranks.size()) + " ranks") +
+            ": tiles over time";
   t.time_axis = !report.model ? "wall time (s)" : "virtual time (s)";
   t.nodes = report.nodes;
   t.workers_per_node = report.workers_per_node;

@@ -181,13 +181,25 @@ Json json_host_threads(const std::vector<csp::ThreadUse>& threads) {
 // One line per runtime thread: where its time went, as shares of its wall
 // time, and the CPU time the OS gave it (less than running + spinning when
 // other threads had its core).
-void print_thread_use(std::ostream& out, const std::vector<csp::ThreadUse>& threads) {
+// One line per OS thread; in a run over ranks, named by rank and its
+// thread there (the threads come rank by rank, in the order of `ranks`).
+void print_thread_use(std::ostream& out, const std::vector<csp::ThreadUse>& threads,
+                      const std::vector<nodes::RankReport>& ranks) {
+  std::vector<std::string> labels;
+  for (const nodes::RankReport& rank : ranks)
+    for (unsigned t = 0; t < rank.threads; ++t)
+      labels.push_back("rank " + std::to_string(rank.rank) + " thread " + std::to_string(t));
+  if (labels.size() != threads.size()) labels.clear();
   for (std::size_t t = 0; t < threads.size(); ++t) {
     const csp::ThreadUse& u = threads[t];
     const double share = u.seconds > 0 ? 100 / u.seconds : 0;
     std::ostringstream label;
-    label << "thread " << t;
-    out << std::left << std::setw(15) << label.str() << std::right << std::setprecision(3) << u.seconds
+    if (labels.empty())
+      label << "thread " << t;
+    else
+      label << labels[t];
+    out << std::left << std::setw(static_cast<int>(std::max<std::size_t>(15, label.str().size() + 1))) << label.str()
+        << std::right << std::setprecision(3) << u.seconds
         << " s: " << std::setprecision(1) << "running " << share * u.running_seconds << "%, spinning "
         << share * u.spinning_seconds << "%, sleeping " << share * u.sleeping_seconds << "%; cpu "
         << share * u.cpu_seconds << "%; " << u.sleeps << " sleeps in " << u.waits << " idle waits; woke "
@@ -252,13 +264,17 @@ void print_machine_report(std::ostream& out, const MachineSummary& m) {
   print_per_node(out, r, m.corner_samples ? "samples" : "pixels");
   out << nodes::format_summary(r.network, topology::parse_topology(r.topology), kind_name);
   print_ranks(out, r);
-  out << std::setprecision(3) << "wall time      " << r.wall_seconds << " s on " << count_of(r.threads, "thread");
+  out << std::setprecision(3) << "wall time      " << r.wall_seconds << " s on ";
+  if (r.ranks.empty())
+    out << count_of(r.threads, "thread");
+  else
+    out << count_of(r.ranks.size(), "rank") << " of " << count_of(r.threads, "thread") << " each";
   if (!r.model)
     out << std::setprecision(1) << ", idle " << 100 * r.idle_share() << "% of thread time" << std::setprecision(3);
   else
     out << "; predicted " << r.predicted_seconds << " s (" << r.model->describe() << ")";
   out << "\n";
-  if (!r.model) print_thread_use(out, r.host_threads);
+  if (!r.model) print_thread_use(out, r.host_threads, r.ranks);
   print_relays(out, r);
   if (m.serial)
     out << "speedup        " << m.speedup() << " (1 node: " << m.serial->seconds << " s on "

@@ -1,6 +1,7 @@
 // Machine rendering; see machine_run.hpp.
 #include "app/machine_run.hpp"
 
+#include <iostream>
 #include <stdexcept>
 #include <string>
 #include <utility>
@@ -92,6 +93,19 @@ nodes::MachineOptions machine_options(const Options& o) {
   return machine;
 }
 
+namespace {
+
+// An explicit --threads above the nodes a process runs is lowered to one
+// thread a node, not refused: say so (on rank 0, which prints for all).
+void note_threads_lowered(unsigned asked, const nodes::MachineReport& r) {
+  bool lowered = r.ranks.empty() && asked > r.threads && r.threads == static_cast<unsigned>(r.nodes);
+  for (const nodes::RankReport& rank : r.ranks) lowered = lowered || (asked > rank.threads && rank.threads == rank.node_count);
+  if (lowered)
+    std::cerr << "vmpray: --threads " << asked << " lowered to " << r.threads << ": no more threads than nodes\n";
+}
+
+}  // namespace
+
 RenderResult render_machine(const Options& o, const tracer::Scene& scene, nodes::Transport* ranks) {
   tracer::Database db;
   RunReport report;
@@ -111,6 +125,7 @@ RenderResult render_machine(const Options& o, const tracer::Scene& scene, nodes:
   // In virtual time T1 is cheap and deterministic: always there for speedup and efficiency.
   if (o.compare_serial || machine.timing) serial = run_serial(db, machine, o);
   nodes::MachineResult result = run_with_progress(std::move(db), machine, o, "", ranks);
+  note_threads_lowered(o.machine.threads, result.report);
   report.rays = result.report.rays();
   report.render_seconds = result.report.wall_seconds;
   report.machine = MachineSummary{std::move(result.report), serial, o.spd_procedure};

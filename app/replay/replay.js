@@ -105,6 +105,13 @@ function counters(at = t) {
   };
 }
 function seconds(ticks) { return ticks * TICK; }
+// A duration to three significant digits, for labels that only compare.
+function brief(ticks) {
+  const s = seconds(ticks);
+  for (const [unit, per] of [["s", 1], ["ms", 1e-3], ["\u00b5s", 1e-6]])
+    if (s >= per) return Number((s / per).toPrecision(3)) + " " + unit;
+  return Number((s * 1e9).toPrecision(3)) + " ns";
+}
 function format(ticks) {
   const s = seconds(ticks);
   if (s >= 60) return Math.floor(s / 60) + " min " + (s % 60).toFixed(1) + " s";
@@ -149,14 +156,18 @@ function drawMachine() {
   for (const k of hopOrder) { if (hopDepart[k] > t) break; load[hopLink[k]] += 1; }
   D.links.forEach(([a, b], k) => {
     if (!load[k]) return;
-    const [ax, ay] = D.places[a], [bx, by] = D.places[b];
-    const len = Math.hypot(bx - ax, by - ay) || 1, ox = (by - ay) / len * 2.5, oy = -(bx - ax) / len * 2.5;
+    const [ax, ay, ar] = D.places[a], [bx, by, br] = D.places[b];
+    const len = Math.hypot(bx - ax, by - ay) || 1, ux = (bx - ax) / len, uy = (by - ay) / len;
+    const ox = uy * 2.5, oy = -ux * 2.5;
+    // From ring to ring, as the static picture draws it: never over a node's number.
+    const from = ar * 1.5, to = len - br * 1.5;
+    if (to <= from) return;
     const share = load[k] / maxLoad;
     g.strokeStyle = `rgba(230, 120, 0, ${0.25 + 0.75 * share})`;
     g.lineWidth = 1 + 5 * share;
     g.beginPath();
-    g.moveTo(ax + ox, ay + oy);
-    g.lineTo(bx + ox, by + oy);
+    g.moveTo(ax + ux * from + ox, ay + uy * from + oy);
+    g.lineTo(ax + ux * to + ox, ay + uy * to + oy);
     g.stroke();
   });
   // Nodes: one arc per pixel computer (tracing, waiting for a page, idle), a
@@ -302,7 +313,7 @@ $("end").onclick = () => seek(END);
 for (const s of [1e-6, 1e-5, 1e-4, 1e-3, 0.01, 0.1, 0.25, 0.5, 1, 2, 4]) {
   const o = document.createElement("option");
   o.value = String(s);
-  o.textContent = format((END / 30) * s) + " a second";
+  o.textContent = brief((END / 30) * s) + " of the run a second";
   if (s === 1) o.selected = true;
   $("speed").appendChild(o);
 }

@@ -55,6 +55,17 @@ TEST_F(MachineCli, ACacheLargerThanTheRemotePagesIsReportedAsCapped) {
       << r.out;
 }
 
+// More threads than nodes are lowered to one a node, and the run says so on
+// stderr; as many threads as nodes, or fewer, says nothing.
+TEST_F(MachineCli, ThreadsAboveTheNodesAreLoweredWithANote) {
+  const Outcome r = run("tetra:3 --width 16 --height 16 --topology ring:4 --threads 8 -q -o out.png");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_EQ(r.err, "vmpray: --threads 8 lowered to 4: no more threads than nodes\n");
+  const Outcome fits = run("tetra:3 --width 16 --height 16 --topology ring:4 --threads 4 -q -o out.png");
+  ASSERT_EQ(fits.exit_code, 0) << fits.err;
+  EXPECT_EQ(fits.err, "");
+}
+
 // Under the SPD procedure the machine farms out corner samples, and the
 // report counts them as such.
 TEST_F(MachineCli, SpdProcedureReportsSamplesNotPixels) {
