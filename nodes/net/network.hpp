@@ -1,45 +1,18 @@
 // nodes::Network: the store-and-forward interconnect of the simulated machine,
-// built on a csp::Runtime along a topology::Topology.
+// built on a csp::Runtime along a topology::Topology (docs/architecture.md,
+// "One processor" and "Why the network cannot deadlock", draws it).
 //
-// Per node n (all placed on thread placement(n), block placement by default,
-// so most links join processes of the same thread):
-//   - one Router process (router.hpp), whose output queues are buffered
-//     channels of buffer_capacity packets: one per outgoing link and buffer
-//     class, read by the neighbour's router, and one per local port, which
-//     the application reads through port(n, p);
-//   - with a link model only: one Link process per output queue (link.hpp)
-//     that carries each packet across the modelled wire into the
-//     neighbour's router (or the port) over a rendezvous channel.
-// Every buffer is bounded; deadlock freedom rests on the acyclic channel
-// dependencies of topology::next_hop and on the consumption assumption
-// documented in router.hpp.
-//
-// Use: create the Network before Runtime::run(); local processes write to
-// injector(n, p) and read port(n, p). The local processes of a node share
-// one injection channel into its router, which keeps the router's ALT
-// short: a buffer of buffer_capacity packets, so that a sender goes on as
-// soon as its packet is queued instead of waiting for its router to run,
-// with blocked writers served in FIFO order when it is full. It feeds only
-// the router, so a process blocked on it holds up no packet on its way to
-// any port. Once the application knows nothing is in flight, one of its
-// processes calls shutdown(), which poisons every network channel: routers,
-// link processes and any reader of a port end with csp::Poisoned, so run()
-// returns with no fiber left blocked. Packets still in the network at
-// shutdown are dropped. stats() is valid after run().
-//
-// With relay_between_threads, a link whose routers run on different
-// threads is a pair of channels, each used by one thread only: the output
-// queue of the sending router, read by its thread's relay, and the input of
-// the receiving router, written by its own thread's relay; the relays carry
-// the packets between the threads (thread_relay.hpp).
-//
-// A machine split over OS processes (rank_plan.hpp) builds, on each rank, a
-// Network whose `local` nodes are that rank's: only their routers and ports
-// exist, and each link between a local and a remote node becomes, per
-// buffer class, one end for the rank's bridge (bridge.hpp): the local
-// router's output queue toward the remote node, whose reader is the
-// bridge, and the local router's input from it, whose only writer is the
-// bridge. The routers cannot tell such a link from any other.
+// Per node: a Router (router.hpp) whose output queues are channels of
+// buffer_capacity packets, one per outgoing link and buffer class and one per
+// local port (port(n, p)); local processes write into one shared injection
+// channel (injector(n)). With a link model, a Link process per output queue
+// (link.hpp); with relay_between_threads, links between threads go through
+// the threads' relays (thread_relay.hpp); split over ranks, only the local
+// nodes exist and cut links end at the rank's bridge (bridge.hpp).
+// Invariants: every buffer is bounded; deadlock freedom rests on the acyclic
+// channel dependencies of topology::next_hop and the consumption assumption
+// of router.hpp. shutdown() poisons every network channel (packets still in
+// flight are dropped), so run() returns with no fiber blocked.
 #pragma once
 
 #include <functional>

@@ -1,36 +1,18 @@
 // The router of one processor: store-and-forward switching by the topology's
-// deadlock-free routing function.
+// deadlock-free routing function (docs/architecture.md, "Why the network
+// cannot deadlock", gives the argument).
 //
-// Ends (all inputs read, all outputs written by the router alone):
-//   inputs[q]     packets arriving over link port p in buffer class c,
-//                 q = p * classes + c
-//   injections[j] packets sent by the local processes of this node
-//   outputs[o]    bounded buffers (capacity K): the link queues (same
-//                 numbering as inputs), then one delivery queue per local port
-//
-// Protocol: one ALT (fair select) over the inputs and, for every output that
-// a held-back packet waits for, a room guard. It is a doorbell ALT
-// (csp/alt.hpp): a router selects for every packet and usually finds nothing
-// ready, so its channels ring it rather than have it link a record on each
-// of them every time it parks. A packet read from input i is
-// written to its output queue at once if that has room (try_write: the router
-// never blocks on output while a neighbour blocks on it); otherwise it waits
-// in pending[i], input i is disabled, and the output's room guard is enabled
-// until the packet can be written. Pending packets waiting for one output are
-// admitted in rotation, so no input starves, and an output with packets held
-// back for it takes no newcomers first. So each (link, class) owns at most
-// K queued + 1 pending packets (+ 1 carried by a link process when a link
-// model is on), a packet in one channel's buffers waits only for the next
-// channel on its route, and the acyclic channel dependency graph of
-// topology::next_hop makes the whole network free of deadlock with bounded
-// buffers.
-//
-// Consumption assumption: a delivery queue is a sink; it drains as long as the
-// local process reading that port keeps reading, even while its own writes
-// to an injection channel are blocked. A local process that both receives and
-// sends must therefore read its port in a fiber of its own (or never block on
-// injection while packets for it may be waiting); otherwise it can close a
-// cycle through the network with its own injection.
+// Ends: inputs[p * classes + c] (link port p, buffer class c), injections
+// from the node's processes, outputs (bounded, capacity K): the link queues
+// numbered as the inputs, then one delivery queue per local port.
+// Protocol: one doorbell ALT (csp/alt.hpp) over the inputs and, for each
+// output a held-back packet waits for, a room guard. A packet goes out with
+// try_write at once, or waits in its input's pending slot (that input off,
+// the output's room guard on); held-back packets are admitted in rotation.
+// So each (link, class) owns at most K queued + 1 pending packets.
+// Consumption assumption: a delivery queue drains while its reader reads,
+// so a process that both receives and sends reads its port in a fiber of
+// its own (or never blocks on injection while packets for it may wait).
 #pragma once
 
 #include <array>

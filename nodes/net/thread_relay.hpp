@@ -1,38 +1,17 @@
 // nodes::ThreadRelays: the links between routers that run on different
 // runtime threads of one process, carried by one relay process per thread
 // over lock-free single-producer rings, so that a packet crossing threads
-// costs an enqueue and no wake-up of the other thread.
+// costs an enqueue and no wake-up of the other thread (docs/architecture.md,
+// "Why the network cannot deadlock", gives the protocol and its argument).
 //
-// Per link (one direction and buffer class, from a router on thread A to a
-// router on thread B): a's router writes its output queue (a buffered
-// channel of K packets, read by A's relay), A's relay moves packets into the
-// ring A→B while it holds a credit for the link (K to start with), B's relay
-// takes them from the ring when B's scheduler tells it they came
-// (csp::Arrivals), stages them, and moves them into b's input channel with
-// try_write as room appears, each move returning one credit to A's relay
-// through the ring B→A. So a link holds at most K packets in a's output
-// queue, K in the ring or staged, and K in b's input: a bounded FIFO from
-// router to router, which is all a link between routers is.
-//
-// Why the network still cannot deadlock: the routers see a relayed link as
-// any other (a bounded output queue that drains while the router at its
-// far end reads its input). A relay blocks on nothing but its one ALT (the
-// arrivals token, every outgoing queue it has credit for, room in every
-// input it has staged packets for): it never writes with a blocking write,
-// and a ring never fills (its capacity is the credits that can be out on
-// it), so no link waits on another through a relay, and the channel
-// dependencies are those of the unrelayed network. The deadlock detector
-// sees packets in a ring as work (a pending csp::Arrivals).
-//
-// Batching: a relay that wakes (one select) takes everything ready (its
-// rings, the queues it has credit for, room in the inputs it has staged
-// packets for), lets the high-priority processes it made ready run and
-// takes what they sent (a page request in, its reply out), then signals
-// the threads it wrote to, once each; a busy thread notices the signal at
-// its next switch.
-//
-// Orderly end: Network::shutdown() poisons the queues, the inputs and the
-// relays' tokens; each relay then ends, as the routers do.
+// Invariants: per link and buffer class, at most K packets in the sending
+// router's queue, K in the ring or staged (the sending relay's credits), and
+// K in the receiving router's input; a ring never fills (its capacity is the
+// credits that can be out on it); a relay blocks on nothing but its one ALT,
+// so the channel dependencies are the unrelayed network's. A relay that
+// wakes takes everything ready, lets what it made ready run, takes what that
+// sent, and signals each thread it wrote to once. The deadlock detector sees
+// packets in a ring as work (csp::Arrivals). Network::shutdown() ends them.
 #pragma once
 
 #include <atomic>

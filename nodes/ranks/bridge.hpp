@@ -1,46 +1,17 @@
 // nodes::Bridge: the one process per rank that carries the links a split
-// machine cuts (network.hpp, rank_plan.hpp) over a Transport.
+// machine cuts (network.hpp, rank_plan.hpp) over a Transport, and its
+// failure note. Its protocol is in docs/architecture.md, "Across processes".
 //
-// Flow control, per direction and buffer class of a cut link (from a on
-// this rank to b on rank q): the bridge takes a packet from a's output
-// queue only while it holds a credit for that link; it starts with K
-// credits (K = the network's buffer capacity). The bridge of rank q keeps
-// arriving packets in a staging queue for the link and moves them into b's
-// input channel with try_write as room appears; each packet moved owes
-// one credit to a's rank, sent with the next frame to that rank, or alone
-// once half the link's K are owed or the bridge goes quiet (queue_credits). So a cut link holds at most K packets in a's output
-// queue, K in flight or staged, and K in b's input: a bounded FIFO from a's
-// router to b's router, which is all a link between routers is.
-//
-// Why the network still cannot deadlock: the routers see a cut link exactly
-// as a local one — a bounded output queue that drains while the router at
-// its far end reads its input. The bridge blocks on nothing but its one
-// ALT (over every outgoing queue it has credit for, room in every input it
-// has staged packets for, and a timeout to poll the wire): it never writes
-// with a blocking write and never waits inside the transport, so no link
-// waits on another link through it. The channel dependency graph is that of
-// the unsplit machine, acyclic by topology::next_hop's buffer classes.
-//
-// Polling: the transport moves and reports messages only when called. The
-// bridge polls it after every wake-up, and every 4 us while an answer is
-// due (a packet it sent has not come back as a credit) or within 1 ms of
-// the last activity: an idle runtime thread watches for that short a
-// timeout without sleeping, so a page request that crosses ranks costs
-// tens of microseconds, not a sleep. Once all is quiet it waits twice as
-// long each time, up to 1 ms, so a rank with nothing to do sleeps instead
-// of spinning a core; any packet sent toward another rank wakes it at once.
-// A wake lets the rest of the thread's ready pass run (csp::yield), then
-// takes everything ready on every link (Alt::poll) before it sends, so the
-// packets and credits of one pass reach a rank as one message.
-//
-// Orderly end: the machine's protocol ends with nothing in flight, and then
-// rank 0 shuts its network down. A bridge that sees its network shut down,
-// or receives `end` from a peer, shuts its network down (once), sends `end`
-// to every peer, and then only drains: it ends when it has `end` from every
-// peer (nothing more can come: the wire keeps each pair's order) and every
-// send is complete. A failure on this rank (note_failure) first sends
-// `abort` with its one line to every peer; a peer that receives it records
-// it (remote_failure()) and ends the same way, so the failure ends the job.
+// Invariants: per cut link and buffer class, at most K packets (K = the
+// network's buffer capacity) in the sender's queue, K in flight or staged,
+// and K in the receiver's input, held by credits; the bridge blocks on
+// nothing but its one ALT and never waits inside the transport, so the
+// channel dependency graph is the unsplit machine's and stays acyclic.
+// Credits owed go with the next frame to their rank, or alone once half of
+// K are owed or the bridge goes quiet. Polling backs off from 4 us to 1 ms
+// when all is quiet. At the end, a bridge that sees its network shut down,
+// or `end` from a peer, sends `end` (after `abort` with the line of a local
+// failure) and drains until every peer's `end` has come.
 #pragma once
 
 #include <atomic>
