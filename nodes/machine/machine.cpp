@@ -17,6 +17,7 @@
 #include <sys/resource.h>
 
 #include "csp/errors.hpp"
+#include "csp/seeded_scheduler.hpp"
 #include "nodes/machine/report_wire.hpp"
 #include "nodes/net/mailbox.hpp"
 #include "topology/spec.hpp"
@@ -63,6 +64,11 @@ void check_fields(const MachineOptions& options) {
   within("grain", options.grain, max_grain);
   within("buffer_capacity", static_cast<std::int64_t>(std::min<std::size_t>(options.buffer_capacity, INT64_MAX)),
          INT64_MAX);
+  if (options.schedule_seed && options.timing)
+    throw OptionError("schedule_seed", "cannot be given with timing (virtual time orders the processes by its clock)");
+  if (options.schedule_seed && options.threads != 1)
+    throw OptionError("schedule_seed", "needs threads = 1 (a seed replays its schedule on one thread only), got " +
+                                           std::to_string(options.threads));
   if (options.prefetch > max_prefetch(options))
     throw OptionError("prefetch", "must be at most " + std::to_string(max_prefetch(options)) + ", got " +
                                       std::to_string(options.prefetch) +
@@ -95,6 +101,8 @@ constexpr std::size_t results_buffer = 16;
 // Pixels a pixel computer traces between two yields: some tens of
 // microseconds of tracing for one context switch.
 constexpr std::uint32_t timeslice_items = 16;
+// The same under a schedule seed: short, so that small tiles are cut too.
+constexpr std::uint32_t seeded_timeslice_items = 3;
 
 struct Wiring {
   csp::Runtime& runtime;
@@ -191,8 +199,12 @@ void spawn_node(const Wiring& w, NodeId n, NodeState& node) {
     // processes, and first-in first-out order lets a router take more
     // packets per wake-up; under virtual time the scheduler orders by clock.
     // A split machine's bridge polls the wire and needs the thread often.
+    // Under a schedule seed they yield every few pixels whatever their
+    // priority, so that the seeded draws also interleave them mid-tile.
     const bool prioritised = !w.timing && (w.runtime.threads() > 1 || w.split);
-    const std::uint32_t timeslice = prioritised ? timeslice_items : 0;
+    const std::uint32_t timeslice = w.options.schedule_seed ? seeded_timeslice_items
+                                    : prioritised           ? timeslice_items
+                                                            : 0;
     w.runtime.spawn(
         name + " pixel computer " + std::to_string(i), thread,
         [&w, port, &source, &in, &out, &counters, charge, timeslice] {
@@ -347,6 +359,7 @@ csp::RuntimeOptions runtime_options(const MachineOptions& options, std::size_t l
   r.threads = thread_count(options, local_nodes);
   r.shared_cores = options.shared_cores;
   if (timing) r = timing->runtime_options(r.stack_size);
+  if (options.schedule_seed) r.scheduler = csp::seeded_scheduler(csp::seed_of_stream(*options.schedule_seed, rank));
   if (split)
     r.on_failure = [split, &network, rank](const std::string& process, std::exception_ptr error) {
       split->local_failure.set(rank, "process '" + process + "' failed: " + csp::message_of(error));

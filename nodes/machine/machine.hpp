@@ -92,6 +92,12 @@ struct MachineOptions {
   std::size_t buffer_capacity = 4;     // packets per network queue
   tracer::TraceOptions trace;
   std::optional<CostModel> timing;     // virtual time under this model (the run takes one thread)
+  // For tests: the one thread's ready processes run in an order drawn from
+  // this seed (csp::SeededScheduler), so one seed replays one schedule, and
+  // pixel computers offer the thread every few pixels so that the draws cut
+  // tiles too. Needs threads = 1; not with timing. A split run draws per rank
+  // (csp::seed_of_stream(seed, rank)), but the wire's timing still varies.
+  std::optional<std::uint64_t> schedule_seed;
   Progress progress;                   // called by the collector (on its thread): at 0 as it starts, then per result
 };
 
