@@ -13,14 +13,22 @@
 # Every namespace, link and bridge it made is removed at the end, whatever
 # happened. Needs root, `ip` and `unshare`; without them it says so and
 # skips (exit 0), unless --require is given (CI gives it): then exit 1.
+# With --bench ROUNDS SIZE it instead times two ranks across two hosts'
+# veth links beside two ranks over TCP on loopback and over shared memory
+# (teapot and rings4, hypercube:4 and :6, SIZE x SIZE, ROUNDS interleaved
+# rounds; medians of the render's wall time, images checked equal).
 #
-# usage: scripts/cluster-check.sh [--require] [BUILD_DIR]   (default build/release)
+# usage: scripts/cluster-check.sh [--require] [--bench ROUNDS SIZE] [BUILD_DIR]
+#        (default build/release)
 set -euo pipefail
-require=0
-if [[ ${1:-} == --require ]]; then
-  require=1
-  shift
-fi
+require=0 bench_rounds=0 bench_size=0
+while [[ ${1:-} == --* ]]; do
+  case $1 in
+    --require) require=1; shift ;;
+    --bench) bench_rounds=${2:?--bench ROUNDS SIZE}; bench_size=${3:?--bench ROUNDS SIZE}; shift 3 ;;
+    *) echo "usage: scripts/cluster-check.sh [--require] [--bench ROUNDS SIZE] [BUILD_DIR]" >&2; exit 2 ;;
+  esac
+done
 vmpray=$(realpath "${1:-build/release}/app/vmpray")
 
 skip() {
@@ -110,6 +118,44 @@ veth_bytes() {
 wire_bytes() {
   python3 -c 'import json, sys; print(sum(r["wire_bytes_sent"] for r in json.load(open(sys.argv[1]))["machine"]["ranks"]))' "$1"
 }
+
+# bench: each configuration's render wall time, interleaved rounds, medians.
+bench() {
+  local scene topology round c med
+  local -a configs=(shared loopback veth)
+  printf '%-8s %-12s %-26s %9s %8s %10s\n' scene topology "2 ranks x 1 thread" median_s ratio msg/packet
+  for scene in teapot rings4; do
+    for topology in hypercube:4 hypercube:6; do
+      declare -A times=() ratio_of=()
+      for ((round = 0; round < bench_rounds; ++round)); do
+        for c in "${configs[@]}"; do
+          local args=("$vmpray" "$scene" --topology "$topology" --width "$bench_size" --height "$bench_size" -q
+            -o "$c.png" --stats "$c.json")
+          case $c in
+            veth) on_hosts 2; "${launch[@]}" "${args[@]}" ;;
+            loopback) mpirun -np 2 --mca btl self,tcp --mca btl_tcp_if_include lo "${args[@]}" ;;
+            shared) OMPI_MCA_btl_vader_single_copy_mechanism=none mpirun -np 2 --mca btl self,vader "${args[@]}" ;;
+          esac
+          times[$c]+="$(python3 -c 'import json,sys; print(json.load(open(sys.argv[1]))["machine"]["wall_seconds"])' "$c.json") "
+        done
+        cmp -s veth.png loopback.png && cmp -s veth.png shared.png ||
+          { echo "cluster-check: $scene $topology: images differ between transports" >&2; exit 1; }
+      done
+      for c in "${configs[@]}"; do
+        med=$(tr ' ' '\n' <<<"${times[$c]}" | sed '/^$/d' | sort -g | sed -n "$(((bench_rounds + 1) / 2))p")
+        ratio_of[$c]=$med
+        printf '%-8s %-12s %-26s %9.3f %8.2f %10.2f\n' "$scene" "$topology" "$c" "$med" \
+          "$(python3 -c 'import sys; print(float(sys.argv[1]) / float(sys.argv[2]))' "$med" "${ratio_of[shared]:-$med}")" \
+          "$(python3 -c 'import json,sys; r=json.load(open(sys.argv[1]))["machine"]["ranks"]; print(sum(x["messages_sent"] for x in r) / max(1, sum(x["packets_sent"] for x in r)))' "$c.json")"
+      done
+      unset times ratio_of
+    done
+  done
+}
+if ((bench_rounds > 0)); then
+  bench
+  exit 0
+fi
 
 size=96
 for topology in hypercube:4 torus:4x4 ring:16; do
