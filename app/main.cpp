@@ -6,6 +6,8 @@
 // Exit 0 on success, 2 for a bad command line (or an image too large for
 // this machine's memory, found once the scene is read), 1 for a runtime
 // error; errors are one line on stderr, and a failed run leaves no output file.
+// The hidden --manpage and --completion bash print the manual page and the
+// completion script the build installs (app/manual.hpp).
 //
 // Started by an MPI launcher (mpirun; vmpi::launched_by_mpi() reads its
 // environment) with more than one rank, the machine is split over the
@@ -24,6 +26,7 @@
 
 #include "app/machine_pictures.hpp"
 #include "app/machine_run.hpp"
+#include "app/manual.hpp"
 #include "app/memory_check.hpp"
 #include "app/options.hpp"
 #include "app/output_check.hpp"
@@ -34,6 +37,7 @@
 #include "app/scene_input.hpp"
 #include "app/single.hpp"
 #include "app/sweep.hpp"
+#include "app/version.hpp"
 #include "mpi/mpi_transport.hpp"
 
 namespace {
@@ -110,10 +114,20 @@ int run(const app::Options& o, const std::vector<std::string>& command_line, nod
   return phase.finish(std::cout, "report");
 }
 
-// --help or --version on standard output: 0, or 1 with one line if it could
-// not be written (a full device, a closed descriptor).
+// What --help, --version, --manpage or --completion print.
+std::string text_for(app::Options::Action action) {
+  switch (action) {
+    case app::Options::Action::help: return app::usage_text();
+    case app::Options::Action::manpage: return app::manual_page();
+    case app::Options::Action::completion: return app::bash_completion();  // the one shell parse_options takes
+    default: return app::version_text();
+  }
+}
+
+// --help, --version, --manpage or --completion on standard output: 0, or 1
+// with one line if it could not be written (a full device, a closed descriptor).
 int print_help_or_version(const app::Options& options) {
-  std::cout << (options.action == app::Options::Action::help ? app::usage_text() : "vmpray " VMPRAY_VERSION "\n");
+  std::cout << text_for(options.action);
   std::cout.flush();
   if (std::cout) return 0;
   std::cerr << "vmpray: cannot write to standard output\n";

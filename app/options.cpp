@@ -353,8 +353,11 @@ std::string default_output(const std::string& scene) {
 Options parse_options(int argc, const char* const argv[]) {
   Options o;
   Raw raw;
+  // Not in --help: the scene is the positional argument, and the manual page
+  // and the completion script are for the build to install.
   po::options_description hidden;
-  hidden.add_options()("scene", po::value(&o.scene));
+  hidden.add_options()("scene", po::value(&o.scene))("manpage", "print the manual page vmpray(1), roff")(
+      "completion", po::value(&o.completion_shell), "print the completion script for this shell (bash)");
   po::options_description all;
   const po::options_description machine = describe_machine(o, raw);
   all.add(describe_render(o, raw)).add(machine).add(hidden);
@@ -369,6 +372,10 @@ Options parse_options(int argc, const char* const argv[]) {
   }
   if (vm.count("help")) o.action = Options::Action::help;
   else if (vm.count("version")) o.action = Options::Action::version;
+  else if (vm.count("manpage")) o.action = Options::Action::manpage;
+  else if (vm.count("completion")) o.action = Options::Action::completion;
+  if (vm.count("completion") && o.completion_shell != "bash")
+    throw UsageError("--completion: expected bash, got '" + o.completion_shell + "'");
   check_render(o, raw, vm);
   check_output_names(o, vm);
   if (o.single) reject_machine_options(machine, vm);
@@ -382,14 +389,50 @@ std::string usage_text() {
   Raw raw;
   std::ostringstream out;
   out << "Usage: vmpray [SCENE] [options]\n"
-         "Ray traces SCENE (an NFF file, '-' for stdin, or a built-in scene; default teapot)\n"
-         "on a simulated distributed-memory machine (default: a 16-node hypercube) whose\n"
-         "processors share the scene database as object pages in a virtual memory, and\n"
-         "writes an image and a report of rays, page traffic, network and per-node work.\n"
-         "The paper's experiments: vmpray sweep nodes|cache [options] (see vmpray sweep --help).\n\n"
+      << usage_summary() << "\n"
       << describe_render(o, raw) << "\n" << describe_machine(o, raw) << "\nBuilt-in scenes (NAME[:SIZE][:tRES]):\n";
   for (const auto& s : tracer::builtin_scenes()) out << "  " << s.name << "  " << s.description << "\n";
   return out.str();
+}
+
+std::string usage_summary() {
+  return "Ray traces SCENE (an NFF file, '-' for stdin, or a built-in scene; default teapot)\n"
+         "on a simulated distributed-memory machine (default: a 16-node hypercube) whose\n"
+         "processors share the scene database as object pages in a virtual memory, and\n"
+         "writes an image and a report of rays, page traffic, network and per-node work.\n"
+         "The paper's experiments: vmpray sweep nodes|cache [options] (see vmpray sweep --help).\n";
+}
+
+// The caption is what --help prints above the options ("Options:"), read
+// back from that text since Boost keeps it to itself.
+OptionGroup option_group(const po::options_description& d) {
+  OptionGroup group;
+  std::ostringstream text;
+  text << d;
+  const std::string first = text.str().substr(0, text.str().find('\n'));
+  if (!first.empty() && first.front() != ' ' && first.back() == ':') group.caption = first.substr(0, first.size() - 1);
+  for (const auto& option : d.options()) {
+    OptionDoc doc;
+    doc.name = option->long_name();
+    doc.description = option->description();
+    const std::string shown = option->canonical_display_name(po::command_line_style::allow_dash_for_short);
+    if (shown.size() == 2 && shown[0] == '-') doc.short_name = shown[1];
+    doc.takes_value = option->semantic()->max_tokens() > 0;
+    doc.takes_text = dynamic_cast<const po::typed_value<std::string>*>(option->semantic().get()) != nullptr;
+    // "arg (=hypercube)": the default as --help shows it.
+    const std::string parameter = option->format_parameter();
+    const std::size_t open = parameter.find(" (=");
+    if (doc.takes_value && open != std::string::npos && parameter.back() == ')')
+      doc.default_value = parameter.substr(open + 3, parameter.size() - open - 4);
+    group.options.push_back(std::move(doc));
+  }
+  return group;
+}
+
+std::vector<OptionGroup> render_option_groups() {
+  Options o;
+  Raw raw;
+  return {option_group(describe_render(o, raw)), option_group(describe_machine(o, raw))};
 }
 
 }  // namespace app

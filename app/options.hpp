@@ -11,6 +11,7 @@
 #include <limits>
 #include <stdexcept>
 #include <string>
+#include <vector>
 
 #include "app/timing_options.hpp"
 #include "nodes/machine/machine.hpp"
@@ -25,8 +26,11 @@ class UsageError : public std::runtime_error {
 };
 
 struct Options {
-  enum class Action { render, help, version };
+  // help, version, manpage and completion print their text (--help, --version,
+  // and the hidden --manpage and --completion SHELL) and render nothing.
+  enum class Action { render, help, version, manpage, completion };
   Action action = Action::render;
+  std::string completion_shell;   // --completion: "bash", the only one
   std::string scene = "teapot";   // NFF path, "-" for stdin, or a built-in spec
   std::string output;             // .png or .ppm; derived from the scene when empty
   std::string stats_path;         // JSON report, none when empty
@@ -138,6 +142,27 @@ void check_grain(nodes::Schedule schedule, bool grain_given);
 
 // The --help text (options and built-in scenes).
 std::string usage_text();
+// What a render does, the lines under --help's usage line.
+std::string usage_summary();
+
+// ---- The options as documentation ----
+// One option as --help lists it: the manual page and the shell completion
+// (app/manual.hpp) are made from these, so they name what the parser takes.
+struct OptionDoc {
+  std::string name;            // the long name, without "--"
+  char short_name = 0;         // 'o' for -o; 0 when there is none
+  bool takes_value = false;
+  bool takes_text = false;     // the value is text (a file, a spec, a list), not a number
+  std::string default_value;   // as --help shows it; empty when none
+  std::string description;
+};
+struct OptionGroup {
+  std::string caption;  // the heading --help prints above them
+  std::vector<OptionDoc> options;
+};
+OptionGroup option_group(const boost::program_options::options_description& d);
+// The render's options, in --help's groups and order.
+std::vector<OptionGroup> render_option_groups();
 
 // "teapot" -> "teapot.png", "tetra:9" -> "tetra-9.png", "dir/x.nff.gz" -> "x.png".
 std::string default_output(const std::string& scene);

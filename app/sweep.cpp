@@ -199,12 +199,25 @@ std::string sweep_usage() {
   SweepOptions o;
   RawSweep raw;
   std::ostringstream out;
-  out << "Usage: vmpray sweep nodes|cache [SCENE] [options]\n"
-         "  nodes: predicted synthesis time, speedup and efficiency against processors (Table 2)\n"
-         "  cache: efficiency, miss ratio and page communications against cache size (Figure 8)\n"
-         "Runs the machine in virtual time (deterministic) and writes CSV, JSON, SVG, PNG and HTML.\n\n"
-      << describe(o, raw);
+  out << "Usage: vmpray sweep nodes|cache [SCENE] [options]\n";
+  for (const SweepKindDoc& kind : sweep_kinds()) out << "  " << kind.name << ": " << kind.description << "\n";
+  out << sweep_summary() << "\n" << describe(o, raw);
   return out.str();
+}
+
+std::vector<SweepKindDoc> sweep_kinds() {
+  return {{"nodes", "predicted synthesis time, speedup and efficiency against processors (Table 2)"},
+          {"cache", "efficiency, miss ratio and page communications against cache size (Figure 8)"}};
+}
+
+std::string sweep_summary() {
+  return "Runs the machine in virtual time (deterministic) and writes CSV, JSON, SVG, PNG and HTML.\n";
+}
+
+OptionGroup sweep_option_group() {
+  SweepOptions o;
+  RawSweep raw;
+  return option_group(describe(o, raw));
 }
 
 SweepTable run_sweep(const SweepOptions& o, std::ostream* progress) {

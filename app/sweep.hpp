@@ -20,6 +20,7 @@
 #include <vector>
 
 #include "app/experiments.hpp"
+#include "app/options.hpp"
 #include "app/output_files.hpp"
 #include "app/viz/plot.hpp"
 
@@ -67,6 +68,14 @@ struct SweepTable {
 // argv[0] is "sweep". Throws UsageError (options.hpp) for a bad command line.
 SweepOptions parse_sweep_options(int argc, const char* const argv[]);
 std::string sweep_usage();
+// What `vmpray sweep --help` says, in pieces, for the manual page: the kinds
+// of sweep, what a sweep does, and its options (options.hpp's OptionGroup).
+struct SweepKindDoc {
+  std::string name, description;
+};
+std::vector<SweepKindDoc> sweep_kinds();
+std::string sweep_summary();
+OptionGroup sweep_option_group();
 
 SweepTable run_sweep(const SweepOptions& options, std::ostream* progress);
 

@@ -2,7 +2,9 @@
 # Installs, with apt-get, exactly the Debian packages vmpray needs that are
 # missing. Idempotent: a second run installs nothing. Run as root.
 # --dev adds the developer tools (sanitizer runtime, fuzzer, browser,
-# ccache, iproute2 for the cluster check); --ccache installs only ccache.
+# ccache, iproute2 for the cluster check; man-db, bash-completion, dpkg-dev
+# and file for the install check and the Debian package's Depends); --ccache
+# installs only ccache.
 set -euo pipefail
 packages=(
   cmake ninja-build g++ pkg-config
@@ -13,8 +15,9 @@ packages=(
   nlohmann-json3-dev libcairo2-dev fonts-dejavu-core
 )
 case "${1:-}" in
-  --dev) # sanitizers' clang runtime, the fuzzer, the browser checks, ccache, namespaces
-    packages+=(clang-14 libclang-rt-14-dev chromium python3 ccache iproute2 util-linux) ;;
+  --dev) # sanitizers' clang runtime, the fuzzer, the browser checks, ccache, namespaces, the install check
+    packages+=(clang-14 libclang-rt-14-dev chromium python3 ccache iproute2 util-linux
+               man-db bash-completion dpkg-dev file) ;;
   --ccache) # only the compiler cache every preset uses when installed
     packages=(ccache) ;;
   "") ;;
