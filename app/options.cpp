@@ -91,7 +91,8 @@ po::options_description describe_machine(Options& o, Raw& raw) {
        "write one self-contained HTML page that replays the run: nodes at work, packets hop by hop, the image "
        "filling in (not over mpirun)")
       ("replay-packets", po::value(&raw.replay_packets)->default_value(100000),
-       "with --replay: packets recorded hop by hop, 0..4194304; later ones are only counted (the page says so)")
+       "with --replay: packets recorded hop by hop, 0..4194304, and the waits for pages and serves begun meanwhile; "
+       "later ones are only counted (the page says so)")
       ("compare-serial", po::bool_switch(&o.compare_serial),
        "also run the 1-node machine; report speedup and efficiency T1/(N*TN)");
   add_timing_options(d, raw.timing, o.pictures);

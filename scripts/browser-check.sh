@@ -59,18 +59,25 @@ cd "$work"
 "$vmpray" sweep nodes --scene teapot:2 --size 16 --nodes 1,2,4 --topology hypercube,ring -q --out "$work/sweep"
 "$vmpray" teapot --width 96 --height 96 --topology torus:4x2 --timing virtual -q -o replay.png \
   --replay "$work/replay.html" --stats "$work/replay.json"
+# A bounded replay: most packets, waits and serves only counted.
+"$vmpray" teapot --width 64 --height 64 --topology hypercube:3 --cache-pages 2 -q -o bounded.png \
+  --replay "$work/bounded.html" --replay-packets 30 --stats "$work/bounded.json"
 # The run's own figures, as the page's counters must end: packets, hops, misses, pixels.
-replay_stats=$(python3 -c '
+stats_of() {
+  python3 -c '
 import json, sys
 m = json.load(open(sys.argv[1]))["machine"]
 n = m["network"]
 print(",".join(str(v) for v in (n["packets"], round(n["packets"] * n["mean_hops"]), m["svm"]["misses"],
-                                sum(x["pixels"] for x in m["per_node"]))))' "$work/replay.json")
+                                sum(x["pixels"] for x in m["per_node"]))))' "$1"
+}
+replay_stats=$(stats_of "$work/replay.json")
 
 status=0
 check "$work/run.html" 2 2 3 || status=1
 check "$work/sweep/nodes.html" 0 1 1 || status=1
 check "$work/replay.html" 0 0 0 "$replay_stats" || status=1
+check "$work/bounded.html" 0 0 0 "$(stats_of "$work/bounded.json")" || status=1
 
 # The check itself must catch what it is for: each of these pages fails it.
 mkdir "$work/bad"

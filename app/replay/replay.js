@@ -100,7 +100,7 @@ function counters(at = t) {
   return {
     packets: upTo(deliveries, at) + (done ? D.unrecorded.packets : 0),
     hops: upTo(arrivals, at) + (done ? D.unrecorded.hops : 0),
-    misses: upTo(misses, at),
+    misses: upTo(misses, at) + (done ? D.unrecorded.fetches : 0),
     pixels: pixelsBefore[upTo(tileEnds, at)],
   };
 }
@@ -348,7 +348,9 @@ function nodeDetails(n) {
   const top = [...served.entries()].sort((a, b) => b[1] - a[1] || a[0] - b[0]).slice(0, 12);
   const totalHits = hits.reduce((a, b) => a + b, 0), totalMisses = miss.reduce((a, b) => a + b, 0);
   $("details").innerHTML = `<h3>node ${n}</h3><p>page calls answered by its own pages or its cache: ${totalHits}; ` +
-      `misses (page requests sent): ${totalMisses}; over the run, in ${buckets} slices of ${format(END / buckets)}:</p>` +
+      `misses (page requests sent): ${totalMisses}` +
+      (D.window < END ? ` (recorded up to ${format(D.window)})` : ``) +
+      `; over the run, in ${buckets} slices of ${format(END / buckets)}:</p>` +
       `<canvas id="cache-chart" width="640" height="140"></canvas>` +
       `<p>pages served: ${servedCount} requests for ${served.size} pages` +
       (top.length ? `; the most asked for:</p><table><tr><th>page</th><th>served</th></tr>` +
@@ -394,6 +396,12 @@ if (D.unrecorded.packets > 0) {
   $("bound").textContent = `Only the first ${D.maxPackets} of ${all} packets were recorded hop by hop ` +
       `(--replay-packets); the other ${D.unrecorded.packets} packets (${D.unrecorded.hops} hops) were only counted, ` +
       `and join the counters at the end.`;
+}
+if (D.unrecorded.fetches + D.unrecorded.serves > 0) {
+  $("bound").hidden = false;
+  $("bound").textContent += ` Waits for pages and pages served are recorded while that budget lasted, up to ` +
+      `${format(D.window)}: ${D.fetches.start.length} waits and ${D.serves.start.length} serves; ` +
+      `the other ${D.unrecorded.fetches} waits and ${D.unrecorded.serves} serves were only counted.`;
 }
 let legend = "<b>packets</b>";
 D.kinds.forEach((name, k) => {

@@ -146,9 +146,14 @@ csp::In<Packet> drained_port(const Wiring& w, NodeId n, std::uint16_t port, std:
   return mailbox->reader();
 }
 
-// The miss path with each wait for a page logged on the node.
+// The miss path with each wait for a page logged on the node while the
+// recorder's budget lasts, and counted after.
 PageFetch recording_fetch(Recorder& recorder, NodeId n, int worker, PageFetch inner) {
   return [&recorder, n, worker, inner = std::move(inner)](std::uint32_t page) {
+    if (!recorder.open()) {
+      ++recorder.log(n).unrecorded_fetches;
+      return inner(page);
+    }
     const double start = recorder.now();
     auto bytes = inner(page);
     recorder.log(n).fetches.push_back({start, recorder.now(), page, static_cast<std::uint16_t>(worker)});

@@ -35,7 +35,9 @@ void PageServer::run() {
 }
 
 void PageServer::serve(const Packet& request) {
-  const double start = recorder_ ? recorder_->now() : 0.0;
+  const bool record = recorder_ && recorder_->open();
+  if (recorder_ && !record) ++recorder_->log(node_).unrecorded_serves;
+  const double start = record ? recorder_->now() : 0.0;
   const PageRequest r = decode_page_request(request.payload);
   const std::int32_t entry = memory_.entry(r.page);
   if (entry < 0)
@@ -46,7 +48,7 @@ void PageServer::serve(const Packet& request) {
   out_.send(make_page_reply(request.source, r.reply_port, r.page, bytes));
   ++counters_.pages_served;
   counters_.bytes_served += bytes.size();
-  if (recorder_) recorder_->log(node_).serves.push_back({start, recorder_->now(), r.page, request.source});
+  if (record) recorder_->log(node_).serves.push_back({start, recorder_->now(), r.page, request.source});
 }
 
 }  // namespace nodes

@@ -129,6 +129,8 @@ Recording merge_recording(const Recorder& recorder, const topology::Topology& to
       r.unrecorded_packets += log.unrecorded[kind];
     }
     r.unrecorded_hops += log.unrecorded_hops;
+    r.unrecorded_fetches += log.unrecorded_fetches;
+    r.unrecorded_serves += log.unrecorded_serves;
   }
   for (std::size_t i = 0; i < r.packets.size(); ++i) {
     if (r.packets[i].times.size() != 2 * r.packets[i].route.size()) broken(r.packets[i].id, "was never delivered");
@@ -145,9 +147,20 @@ Recording merge_recording(const Recorder& recorder, const topology::Topology& to
     t.serves = recorder.log(n).serves;
     t.hits = recorder.log(n).hits;
     t.tiles = std::move(tiles[n]);
+    t.unrecorded_fetches = recorder.log(n).unrecorded_fetches;
+    t.unrecorded_serves = recorder.log(n).unrecorded_serves;
     for (const FetchEvent& e : t.fetches) r.end = std::max(r.end, e.end);
     for (const ServeEvent& e : t.serves) r.end = std::max(r.end, e.end);
     for (const TileSpan& s : t.tiles) r.end = std::max(r.end, s.end);
+  }
+  r.window = r.end;
+  if (r.unrecorded_packets + r.unrecorded_fetches + r.unrecorded_serves > 0) {
+    r.window = 0;
+    for (const PacketTrace& p : r.packets) r.window = std::max(r.window, p.injected());
+    for (const NodeTrace& t : r.nodes) {
+      for (const FetchEvent& e : t.fetches) r.window = std::max(r.window, e.start);
+      for (const ServeEvent& e : t.serves) r.window = std::max(r.window, e.start);
+    }
   }
   return r;
 }

@@ -13,7 +13,9 @@
 // (under virtual time the first in virtual time; in real time the first
 // each router's thread got to, which on several threads is not quite the
 // order of their times); later packets are only counted, per kind, with
-// their hops, where they are delivered.
+// their hops, where they are delivered. Waits for pages and serves are
+// recorded while that budget lasts (begun in the window), later ones only
+// counted; hit samples go one per tile, as the tiles themselves.
 //
 // Invariants of a merged Recording (merge_recording checks them and throws
 // std::logic_error otherwise): each packet's route starts at its source and
@@ -66,6 +68,8 @@ struct NodeLog : RouteLog {
   std::vector<FetchEvent> fetches;
   std::vector<ServeEvent> serves;
   std::vector<HitSample> hits;
+  std::uint64_t unrecorded_fetches = 0;  // begun after the budget was spent
+  std::uint64_t unrecorded_serves = 0;
 };
 
 class Recorder final : public RouteRecorder {
@@ -104,6 +108,7 @@ struct NodeTrace {
   std::vector<ServeEvent> serves;   // in order
   std::vector<HitSample> hits;      // in the order each worker took them
   std::vector<TileSpan> tiles;      // as the machine recorded them (record_tiles)
+  std::uint64_t unrecorded_fetches = 0, unrecorded_serves = 0;  // only counted: begun after the budget was spent
 };
 
 struct Recording {
@@ -114,7 +119,10 @@ struct Recording {
   std::array<std::uint64_t, 256> unrecorded{};  // packets delivered but not recorded, by kind
   std::uint64_t unrecorded_packets = 0;
   std::uint64_t unrecorded_hops = 0;
-  double end = 0;  // the latest time recorded
+  std::uint64_t unrecorded_fetches = 0;  // waits for pages begun after the budget was spent
+  std::uint64_t unrecorded_serves = 0;
+  double end = 0;     // the latest time recorded
+  double window = 0;  // the latest start of a recorded packet, wait or serve: end if nothing went unrecorded
 
   std::uint64_t recorded_hops() const;
 };

@@ -68,6 +68,9 @@ class RouteRecorder {
   double now() const;
   // Whether the packet being injected is recorded: true while the budget lasts.
   bool admit();
+  // Whether the budget lasts: the recording window, which the layer above
+  // also bounds its own events by.
+  bool open() const { return left_.load(std::memory_order_relaxed) > 0; }
 
  private:
   std::uint64_t max_packets_;

@@ -1,7 +1,8 @@
 // --replay end to end: the page stands alone (no script or style from
 // outside, no URL but data:), its embedded data's totals and the packets it
 // recorded add up to the same run's --stats, virtual time replays the same
-// page twice, a bound says how many packets it recorded, and bad uses of
+// page twice, a bound says how many packets it recorded and bounds waits and
+// serves with them, and bad uses of
 // the options fail in one line before any work.
 #include <gtest/gtest.h>
 
@@ -62,7 +63,8 @@ void expect_totals_match(const Json& data, const Json& machine) {
             totals.at("packets").get<std::uint64_t>());
   EXPECT_EQ(sum(p.at("hops")) + data.at("unrecorded").at("hops").get<std::uint64_t>(),
             totals.at("hops").get<std::uint64_t>());
-  EXPECT_EQ(data.at("fetches").at("start").size(), totals.at("misses").get<std::uint64_t>());
+  EXPECT_EQ(data.at("fetches").at("start").size() + data.at("unrecorded").at("fetches").get<std::uint64_t>(),
+            totals.at("misses").get<std::uint64_t>());
   EXPECT_EQ(sum(data.at("tiles").at("count")), pixels);
   EXPECT_EQ(sum(data.at("hits").at("hits")), machine.at("svm").at("local_hits").get<std::uint64_t>() +
                                                  machine.at("svm").at("cache_hits").get<std::uint64_t>());
@@ -109,6 +111,28 @@ TEST_F(ReplayCli, ABoundRecordsThatManyPacketsAndCountsTheRest) {
   EXPECT_EQ(data.at("maxPackets"), 40);
   EXPECT_GT(data.at("unrecorded").at("packets").get<int>(), 0);
   expect_totals_match(data, Json::parse(read_file(dir_ / "s.json")).at("machine"));
+}
+
+// The bound holds for everything that grows with the run: with the cache
+// too small to hold anything, waits for pages and serves outnumber the
+// packet budget many times, and the page stays the size of a short run.
+TEST_F(ReplayCli, TheBoundCoversWaitsAndServesAndThePageFollowsIt) {
+  const std::string run = std::string(kRun) + " --cache-pages 1 --stats s.json --replay ";
+  ASSERT_EQ(run_vmpray(run + "all.html").exit_code, 0);
+  const Outcome r = run_vmpray(run + "few.html --replay-packets 20");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const Json all = data_of(read_file(dir_ / "all.html")), few = data_of(read_file(dir_ / "few.html"));
+  const Json machine = Json::parse(read_file(dir_ / "s.json")).at("machine");
+  expect_totals_match(few, machine);
+  const std::uint64_t misses = machine.at("svm").at("misses").get<std::uint64_t>();
+  ASSERT_EQ(all.at("fetches").at("start").size(), all.at("totals").at("misses").get<std::uint64_t>());
+  EXPECT_GT(misses, 400u);
+  // 20 packets, and the waits and serves of at most the 6 nodes' one request each in flight.
+  EXPECT_LE(few.at("fetches").at("start").size(), 20u + 2 * 6);
+  EXPECT_LE(few.at("serves").at("start").size(), 20u + 2 * 6);
+  EXPECT_GT(few.at("unrecorded").at("serves").get<std::uint64_t>(), 0u);
+  EXPECT_LT(few.at("window"), few.at("end"));
+  EXPECT_LT(4 * std::filesystem::file_size(dir_ / "few.html") / 3, std::filesystem::file_size(dir_ / "all.html"));
 }
 
 TEST_F(ReplayCli, BadUsesFailInOneLineBeforeAnyWork) {

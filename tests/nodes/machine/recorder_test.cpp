@@ -3,7 +3,8 @@
 // arrives before it left, the packets recorded and counted are the routers'
 // own per kind, the pages waited for and served and the page hits match the
 // node reports, and
-// a bound records the first packets hop by hop and only counts the rest.
+// a bound records the first packets hop by hop, and the waits and serves
+// begun while it lasts, and only counts the rest.
 #include "nodes/machine/recorder.hpp"
 
 #include <gtest/gtest.h>
@@ -74,10 +75,13 @@ void expect_consistent(const RecordedRun& run) {
   std::uint64_t items = 0;
   for (std::size_t n = 0; n < rec.nodes.size(); ++n) {
     const nodes::NodeTrace& node = rec.nodes[n];
-    EXPECT_EQ(node.fetches.size(), report.per_node[n].svm.misses) << "node " << n;
-    EXPECT_EQ(node.serves.size(), report.per_node[n].served.pages_served) << "node " << n;
+    EXPECT_EQ(node.fetches.size() + node.unrecorded_fetches, report.per_node[n].svm.misses) << "node " << n;
+    EXPECT_EQ(node.serves.size() + node.unrecorded_serves, report.per_node[n].served.pages_served) << "node " << n;
     for (const auto& f : node.fetches) EXPECT_LE(f.start, f.end);
     for (const auto& s : node.serves) EXPECT_LE(s.start, s.end);
+    // Waits and serves are recorded while the packet budget lasts: begun in the window.
+    for (const auto& f : node.fetches) EXPECT_LE(f.start, rec.window);
+    for (const auto& s : node.serves) EXPECT_LE(s.start, rec.window);
     for (const auto& t : node.tiles) items += t.tile.count;
     // Every page call falls in a tile: each worker's last sample is its total.
     std::map<std::uint16_t, std::uint64_t> last;
@@ -138,6 +142,40 @@ TEST(Recorder, ABoundRecordsTheFirstPacketsAndCountsTheRest) {
   std::uint64_t work_requests = 0;
   for (const auto& p : rec.packets) work_requests += p.kind == std::uint8_t(nodes::MessageKind::work_request);
   EXPECT_EQ(work_requests, 8u);
+}
+
+// Everything recorded that grows with the run is bounded by the budget:
+// waits and serves begin while packets are still recorded (each such wait
+// sends a request the budget took, but for the few in flight as it ran out),
+// and only tile-sized records remain beyond it.
+void expect_bounded(const RecordedRun& run, std::uint64_t budget) {
+  const nodes::Recording& rec = *run.result.report.recording;
+  std::uint64_t fetches = 0, serves = 0, misses = 0, unrecorded = 0;
+  for (const nodes::NodeTrace& node : rec.nodes) {
+    fetches += node.fetches.size();
+    serves += node.serves.size();
+    unrecorded += node.unrecorded_fetches;
+  }
+  for (const auto& node : run.result.report.per_node) misses += node.svm.misses;
+  const std::uint64_t in_flight = rec.nodes.size() * 2 * static_cast<std::uint64_t>(run.result.report.workers_per_node);
+  EXPECT_LE(fetches, budget + in_flight);
+  EXPECT_LE(serves, budget + in_flight);
+  EXPECT_EQ(fetches + unrecorded, misses);
+  EXPECT_EQ(unrecorded, rec.unrecorded_fetches);
+  EXPECT_GT(rec.unrecorded_fetches, 0u);
+  EXPECT_GT(rec.unrecorded_serves, 0u);
+  EXPECT_LT(rec.window, rec.end);
+}
+
+TEST(Recorder, TheBudgetBoundsWaitsAndServesToo) {
+  for (const bool virtual_time : {true, false}) {
+    const RecordedRun run = recorded_run("hypercube", 8, virtual_time, 40);
+    expect_consistent(run);
+    expect_bounded(run, 40);
+  }
+  const RecordedRun split = recorded_run("torus:4x2", 8, false, 40, 2, 2);
+  expect_consistent(split);
+  expect_bounded(split, 40);
 }
 
 TEST(Recorder, ABudgetOfNoneCountsEveryPacket) {
