@@ -39,6 +39,7 @@
 #include "app/sweep.hpp"
 #include "app/version.hpp"
 #include "mpi/mpi_transport.hpp"
+#include "tracer/database.hpp"
 
 namespace {
 
@@ -66,6 +67,18 @@ void check_distinct_outputs(const app::Options& o) {
                               outputs[i].second.string() + "'");
 }
 
+// --estimate-memory: the estimate the checks before a run make, with the
+// database built for its page count (the machine's tables follow it).
+int print_memory_estimate(const app::Options& o, const tracer::Scene& scene) {
+  std::uint32_t pages = 0;
+  if (!o.single) pages = tracer::build_database(scene, app::build_options(o)).header.page_count;
+  std::cout << app::describe_memory(o, scene.camera.width, scene.camera.height, pages, app::memory_limit());
+  std::cout.flush();
+  if (std::cout) return 0;
+  std::cerr << "vmpray: cannot write to standard output\n";
+  return 1;
+}
+
 // The whole run in this process, or rank 0's part over `ranks`.
 int run(const app::Options& o, const std::vector<std::string>& command_line, nodes::Transport* ranks = nullptr) {
   tracer::Scene scene;
@@ -75,6 +88,7 @@ int run(const app::Options& o, const std::vector<std::string>& command_line, nod
     const auto t0 = std::chrono::steady_clock::now();
     scene = app::load_scene(o);
     load_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    if (o.estimate_memory) return print_memory_estimate(o, scene);
     // Before the minutes of work that an image too large for the memory would waste.
     app::check_image_memory(o, scene, app::memory_limit());
   } catch (const std::exception& e) {

@@ -49,8 +49,12 @@
 #include <string>
 #include <string_view>
 
+#include "app/cpu_count.hpp"
+#include "csp/runtime.hpp"
 #include "nodes/machine/pixel_computer.hpp"
 #include "nodes/machine/work_plan.hpp"
+#include "nodes/net/network.hpp"
+#include "nodes/net/thread_relay.hpp"
 #include "topology/spec.hpp"
 #include "tracer/tessellate.hpp"
 #include "tracer/vec.hpp"
@@ -212,16 +216,27 @@ std::string available(const MemoryLimit& limit) {
 }
 
 // Resident bytes of a machine, measured on teapot at 16x16 (so that the
-// image weighs nothing) above the 1-node machine's, fitted over complete
-// graphs of 256 to 2048 nodes and hypercubes, rings, tori and meshes of
-// 1024 and 4096: a node's router, page server, page mailbox, their stacks
-// and state; a pixel computer's stack, tracer and channels; a link queue
-// with the router's guard, pending slot and counters for it, and in virtual
-// time its link process (stack and channel).
-constexpr std::uint64_t node_bytes = 44 * 1024, virtual_node_bytes = 64 * 1024;
-constexpr std::uint64_t worker_bytes = 10 * 1024;
-constexpr std::uint64_t link_queue_bytes = 930, virtual_link_queue_bytes = 9870;
+// image weighs nothing) on one thread, above the 1-node machine's, fitted
+// over complete graphs, hypercubes, rings, tori and meshes
+// (scripts/memory-matrix.py measures them again): a node's router, page
+// server, page mailbox, their stacks and state; a pixel computer's stack,
+// tracer and channels; a link queue (a channel, whose slots come with its
+// first packet) with the router's guard, pending slot and counters for it,
+// and in virtual time its link process (stack and channel). A link between
+// threads adds its relays' state and a queue at the sender, and its
+// share of the rings: K packet entries and two credit entries
+// (ThreadRelays). A replay's recording takes about 600 bytes a packet
+// recorded and 240 a hop it makes (the topology's average distance): its
+// hops, the waits and serves around it and the page's text.
+constexpr std::uint64_t node_bytes = 38 * 1024, virtual_node_bytes = 67 * 1024;
+constexpr std::uint64_t worker_bytes = 7680;
+constexpr std::uint64_t link_queue_bytes = 640, virtual_link_queue_bytes = 9600;
+constexpr std::uint64_t relayed_link_bytes = 480;
+constexpr std::uint64_t ring_entry_bytes = sizeof(nodes::Packet) + 2 * sizeof(std::uint32_t);
+constexpr std::uint64_t recorded_packet_bytes = 600, recorded_hop_bytes = 240;  // a packet, and each hop it makes
 constexpr std::uint64_t page_entry = sizeof(std::int32_t);  // a node's page table, and a tracer's page stamps
+constexpr std::uint64_t host_processes = 4;  // the farmer, the collector, and room for a bridge
+constexpr std::uint64_t guard_page = 4096;
 
 std::uint64_t link_queues(const topology::Topology& t) {
   std::uint64_t ports = 0;
@@ -229,7 +244,60 @@ std::uint64_t link_queues(const topology::Topology& t) {
   return ports * t.buffer_classes();
 }
 
+// The threads a run of `nodes` nodes gets: --threads, or the CPUs this
+// process may use, at most one a node (nodes::thread_count).
+unsigned run_threads(const nodes::MachineOptions& m, std::size_t nodes) {
+  const unsigned wanted = m.threads ? m.threads : usable_cpus();
+  return static_cast<unsigned>(std::min<std::size_t>(std::max(1u, wanted), std::max<std::size_t>(nodes, 1)));
+}
+
+// Link queues whose ends run on different threads, nodes placed in blocks
+// (nodes::Network::block_placement); none when links between threads are
+// plain channels or in virtual time (one thread).
+std::uint64_t relayed_link_queues(const nodes::MachineOptions& m, const topology::Topology& t, unsigned threads) {
+  if (threads < 2 || !m.relay_between_threads || m.timing) return 0;
+  std::uint64_t relayed = 0;
+  for (topology::NodeId n = 0; n < t.size(); ++n) {
+    const unsigned from = nodes::Network::block_placement(n, t.size(), threads);
+    for (const topology::NodeId next : t.neighbours(n))
+      relayed += nodes::Network::block_placement(next, t.size(), threads) != from;
+  }
+  return relayed * t.buffer_classes();
+}
+
 }  // namespace
+
+MachineMemory machine_memory(const Options& o, std::uint32_t page_count) {
+  const nodes::MachineOptions& m = o.machine;
+  const topology::Topology t = topology::parse_topology(m.topology, m.nodes);
+  const bool virtual_time = m.timing.has_value();
+  const auto workers = static_cast<std::uint64_t>(m.workers_per_node);
+  MachineMemory r;
+  r.spec = t.spec();
+  r.nodes = t.size();
+  r.threads = virtual_time ? 1 : run_threads(m, t.size());
+  r.link_queues = link_queues(t);
+  r.relayed_link_queues = relayed_link_queues(m, t, r.threads);
+  r.node_bytes = t.size() * ((virtual_time ? virtual_node_bytes : node_bytes) + workers * worker_bytes +
+                             (1 + workers) * page_entry * page_count);
+  r.link_bytes = r.link_queues * (virtual_time ? virtual_link_queue_bytes : link_queue_bytes);
+  const std::uint64_t ring_entries = m.buffer_capacity + nodes::ThreadRelays::credit_entries(m.buffer_capacity);
+  r.relay_bytes = r.relayed_link_queues * (relayed_link_bytes + ring_entries * ring_entry_bytes);
+  const double per_packet = recorded_packet_bytes + t.average_distance() * recorded_hop_bytes;
+  r.recording_bytes = m.record ? static_cast<std::uint64_t>(static_cast<double>(m.record_packets) * per_packet) : 0;
+  // Every process's stack is mapped whole as it starts, with its guard
+  // page, resident or not: per node its router, page server and pixel
+  // computers, in virtual time its page mailbox and a link process per
+  // queue; a relay a thread; the host's.
+  const std::uint64_t processes = t.size() * (2 + workers + (virtual_time ? 1 : 0)) +
+                                  (virtual_time ? r.link_queues : 0) + r.threads + host_processes;
+  r.reserved_bytes = processes * (csp::RuntimeOptions{}.stack_size + guard_page);
+  return r;
+}
+
+std::uint64_t machine_memory_bytes(const Options& o, std::uint32_t page_count) {
+  return machine_memory(o, page_count).total();
+}
 
 namespace {
 
@@ -275,34 +343,58 @@ void check_tessellation_memory(const std::string& origin, const tracer::Scene& s
                    about(needed) + ", more than " + available(limit));
 }
 
-std::uint64_t machine_memory_bytes(const Options& o, std::uint32_t page_count) {
-  const topology::Topology t = topology::parse_topology(o.machine.topology, o.machine.nodes);
-  const bool virtual_time = o.machine.timing.has_value();
-  const auto workers = static_cast<std::uint64_t>(o.machine.workers_per_node);
-  const std::uint64_t per_node = (virtual_time ? virtual_node_bytes : node_bytes) + workers * worker_bytes +
-                                 (1 + workers) * page_entry * page_count;
-  return t.size() * per_node + link_queues(t) * (virtual_time ? virtual_link_queue_bytes : link_queue_bytes);
-}
-
 namespace {
 
-std::uint64_t machine_run_bytes(const Options& o, int width, int height, std::uint32_t page_count) {
-  return machine_memory_bytes(o, page_count) + image_memory_bytes(o, width, height);
+// Resident bytes, or under an address-space limit the bytes mapped.
+std::uint64_t machine_run_bytes(const Options& o, int width, int height, std::uint32_t page_count,
+                                const MemoryLimit& limit) {
+  const MachineMemory m = machine_memory(o, page_count);
+  const bool mapped = limit.source == MemoryLimit::Source::address_space;
+  return (mapped ? m.mapped() : m.total()) + image_memory_bytes(o, width, height);
 }
 
-void refuse_machine(const Options& o, std::uint64_t needed, const MemoryLimit& limit) {
-  const topology::Topology t = topology::parse_topology(o.machine.topology, o.machine.nodes);
-  throw UsageError("--nodes/--topology: " + t.spec() + " (" + std::to_string(t.size()) + " nodes, " +
-                   std::to_string(link_queues(t)) + " link queues) needs about " + about(needed) +
-                   " with its image, more than " + available(limit));
+// "complete:4096 (4096 nodes, 16773120 link queues, 8386560 of them between
+// 2 threads)".
+std::string machine_words(const MachineMemory& m) {
+  std::string words = m.spec + " (" + std::to_string(m.nodes) + " nodes, " + std::to_string(m.link_queues) + " link queues";
+  if (m.relayed_link_queues > 0)
+    words += ", " + std::to_string(m.relayed_link_queues) + " of them between " + std::to_string(m.threads) + " threads";
+  return words + ")";
+}
+
+void refuse_machine(const Options& o, std::uint64_t needed, std::uint32_t page_count, const MemoryLimit& limit) {
+  const char* what = limit.source == MemoryLimit::Source::address_space ? " of address space" : "";
+  throw UsageError("--nodes/--topology: " + machine_words(machine_memory(o, page_count)) + " needs about " +
+                   about(needed) + what + " with its image, more than " + available(limit));
 }
 
 }  // namespace
 
 void check_machine_memory(const Options& o, int width, int height, std::uint32_t page_count,
                           const MemoryLimit& limit) {
-  const std::uint64_t needed = machine_run_bytes(o, width, height, page_count);
-  if (needed > limit.bytes) refuse_machine(o, needed, limit);
+  const std::uint64_t needed = machine_run_bytes(o, width, height, page_count, limit);
+  if (needed > limit.bytes) refuse_machine(o, needed, page_count, limit);
+}
+
+std::string describe_memory(const Options& o, int width, int height, std::uint32_t page_count,
+                            const MemoryLimit& limit) {
+  const MachineMemory m = machine_memory(o, page_count);
+  const std::uint64_t image = image_memory_bytes(o, width, height);
+  const std::uint64_t needed = (o.single ? 0 : m.total()) + image;
+  const std::uint64_t mapped = (o.single ? 0 : m.mapped()) + image;
+  const std::uint64_t held = limit.source == MemoryLimit::Source::address_space ? mapped : needed;
+  std::ostringstream text;
+  text << "needs about " << about(needed) << " (" << needed << " bytes) resident, and maps about " << about(mapped)
+       << ": " << (held > limit.bytes ? "more" : "less") << " than " << available(limit) << "\n";
+  text << "  image " << width << "x" << height << ": " << about(image) << "\n";
+  if (o.single) return text.str();
+  text << "  machine " << machine_words(m) << ":\n";
+  text << "    nodes " << about(m.node_bytes) << ", link queues " << about(m.link_bytes);
+  if (m.relayed_link_queues > 0) text << ", relays between threads " << about(m.relay_bytes);
+  if (m.recording_bytes > 0) text << ", the replay's recording " << about(m.recording_bytes);
+  text << "\n    processes' stacks, mapped whole and resident as far as used: "
+       << about(m.reserved_bytes) << "\n";
+  return text.str();
 }
 
 unsigned jobs_that_fit(const std::vector<nodes::MachineOptions>& machines, int width, int height,
@@ -312,8 +404,8 @@ unsigned jobs_that_fit(const std::vector<nodes::MachineOptions>& machines, int w
   for (const nodes::MachineOptions& machine : machines) {
     Options o;
     o.machine = machine;
-    needs.push_back(database_copy + machine_run_bytes(o, width, height, page_count));
-    if (needs.back() > limit.bytes) refuse_machine(o, needs.back(), limit);
+    needs.push_back(database_copy + machine_run_bytes(o, width, height, page_count, limit));
+    if (needs.back() > limit.bytes) refuse_machine(o, needs.back(), page_count, limit);
   }
   std::sort(needs.begin(), needs.end(), std::greater<>());
   unsigned fit = 1;

@@ -79,19 +79,41 @@ void check_tessellation_memory(const std::string& origin, const tracer::Scene& s
 
 // The bytes a machine takes beyond its image's buffers, with a database of
 // `page_count` pages: every node's processes and their fixed state, its
-// page table and its pixel computers' page stamps (4 bytes a page each),
-// and every link queue with the router's state for it, and in virtual time
-// the link process that carries it. Per-node and per-queue sizes are
-// measured (memory_check_test.cpp). Left out: the database's own pages,
-// which the host hands over as it distributes them, and the caches, which
-// fill only as far as the render touches pages.
+// page table and its pixel computers' page stamps (4 bytes a page each);
+// every link queue with the router's state for it, and in virtual time the
+// link process that carries it; the relays of the links between threads;
+// and a replay's recording at its bound (--replay-packets). Per-node and
+// per-queue sizes are measured (scripts/memory-matrix.py). Left out: the
+// database's own pages, which the host hands over as it distributes them,
+// and the caches, which fill only as far as the render touches pages. Under
+// an address-space limit (ulimit -v) the checks hold it the bytes mapped:
+// every process's whole stack besides.
+struct MachineMemory {
+  std::string spec;  // the topology, "complete:4096"
+  std::uint64_t nodes = 0, link_queues = 0;
+  unsigned threads = 1;                     // the run's threads
+  std::uint64_t relayed_link_queues = 0;    // link queues between threads
+  std::uint64_t node_bytes = 0, link_bytes = 0, relay_bytes = 0, recording_bytes = 0;
+  std::uint64_t reserved_bytes = 0;  // the processes' whole stacks, mapped beyond what is resident
+  std::uint64_t total() const { return node_bytes + link_bytes + relay_bytes + recording_bytes; }
+  // What ulimit -v holds: the stacks whole, and a seventh more for what the
+  // allocator maps beyond what it touches (its arenas' reserves, vectors
+  // moved as they grow): peaks of mapped bytes (VmPeak) measured up to 13%
+  // above the rest.
+  std::uint64_t mapped() const { return (total() + reserved_bytes) * 115 / 100; }
+};
+MachineMemory machine_memory(const Options& options, std::uint32_t page_count);
 std::uint64_t machine_memory_bytes(const Options& options, std::uint32_t page_count);
 
 // UsageError "--nodes/--topology: complete:4096 (4096 nodes, 16773120 link
-// queues) needs about X GB with its image, more than this machine's Y GB"
-// when the machine's estimate and the image's together exceed `limit`.
+// queues, ...) needs about X GB with its image, more than this machine's
+// Y GB" when the machine's estimate and the image's together exceed `limit`.
 void check_machine_memory(const Options& options, int width, int height, std::uint32_t page_count,
                           const MemoryLimit& limit);
+
+// What --estimate-memory prints: the estimate, its parts and the limit.
+std::string describe_memory(const Options& options, int width, int height, std::uint32_t page_count,
+                            const MemoryLimit& limit);
 
 // For runs that may go side by side (a sweep's) on up to `jobs` threads,
 // each on its own copy of a database of `page_count` pages of `page_size`

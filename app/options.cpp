@@ -48,7 +48,10 @@ po::options_description describe_render(Options& o, Raw& raw) {
       ("tessellate", po::value(&raw.tessellate),
        ("tessellate spheres and cones into triangles at this resolution, 1.." +
         std::to_string(tracer::kMaxTessellation) + " (12 r^2 triangles a sphere, 8 r a cone)").c_str())
-      ("quiet,q", po::bool_switch(&o.quiet), "no progress bar and no report");
+      ("quiet,q", po::bool_switch(&o.quiet), "no progress bar and no report")
+      ("estimate-memory", po::bool_switch(&o.estimate_memory),
+       "print the memory the run needs, as the check before every run counts it, and the limit it is held "
+       "against; render nothing");
   return d;
 }
 // clang-format on

@@ -44,6 +44,7 @@ struct Options {
   int height = 0;
   int tessellate = 0;  // 0: keep spheres and cones as they are
   bool quiet = false;
+  bool estimate_memory = false;  // print the memory the run needs and render nothing
   // The distributed machine (the default) or the plain in-process renderer.
   bool single = false;
   bool compare_serial = false;  // also run the 1-node machine: speedup, efficiency

@@ -16,6 +16,7 @@ void check_rank_options(const Options& o, int ranks) {
   if (ranks <= 1) return;
   const std::string over = " cannot run over several processes (" + std::to_string(ranks) + " MPI ranks here)";
   if (o.single) throw UsageError("--single renders in one process: run it without mpirun");
+  if (o.estimate_memory) throw UsageError("--estimate-memory" + over + ": run it without mpirun");
   if (o.compare_serial) throw UsageError("--compare-serial" + over + ": it runs the 1-node machine beside this one");
   if (!o.replay_html.empty())
     throw UsageError("--replay" + over + ": the recording stays in each rank; run it in one process");

@@ -6,6 +6,9 @@
 //   has the value. Capacity k is a bounded buffer: a writer waits only while
 //   k values are held, a reader only while none is. Values keep their order.
 // - try_read() and try_write() never wait; read_for() waits at most a duration.
+// - A buffer's first slots are allocated with its first value, unless it is
+//   made with Slots::up_front: then a write never allocates, as one made
+//   where an allocation must not fail (a scheduler's callback) needs.
 // - Poison, from either end, is permanent and wakes every waiter: every later
 //   operation on either end throws Poisoned, even with values still buffered.
 // - A default-constructed or moved-from end is unbound: its operations throw
@@ -76,8 +79,9 @@ namespace detail {
 template <class T>
 class ChannelState final : public ChannelBase {
  public:
-  ChannelState(std::string name, std::size_t capacity)
-      : ChannelBase(std::move(name), capacity), ring_(std::min(capacity, kFirstRingSlots)) {
+  ChannelState(std::string name, std::size_t capacity, bool up_front)
+      : ChannelBase(std::move(name), capacity) {
+    if (up_front) ring_.resize(capacity);
     publish_hints(false, capacity > 0);
   }
   explicit ChannelState(Unbound u) : ChannelBase(u) {}
@@ -241,19 +245,22 @@ class ChannelState final : public ChannelBase {
     unwind_wait(*rec.waiter);
   }
 
-  // Room for twice the values, at most capacity_ (a buffer allowed many
-  // values seldom holds them all: a mailbox sized for every sender in a
-  // large machine would otherwise take memory for all of them up front).
+  // The first slots on the first value, then room for twice the values, at
+  // most capacity_ (a buffer allowed many values seldom holds them all: a
+  // mailbox sized for every sender in a large machine, or the link queues
+  // of a complete graph, most of which never carry a packet, would
+  // otherwise take memory for all of them up front).
   void grow_ring_locked() {
-    std::vector<std::optional<T>> bigger(std::min(capacity_, 2 * ring_.size()));
+    const std::size_t slots = ring_.empty() ? kFirstRingSlots : 2 * ring_.size();
+    std::vector<std::optional<T>> bigger(std::min(capacity_, slots));
     for (std::size_t i = 0; i < count_; ++i) bigger[i] = std::move(ring_[(head_ + i) % ring_.size()]);
     ring_ = std::move(bigger);
     head_ = 0;
   }
 
   static constexpr std::size_t kFirstRingSlots = 4;
-  // Values at head_ .. head_+count_ (modulo its size); grown on demand, by
-  // doubling, up to capacity_ slots.
+  // Values at head_ .. head_+count_ (modulo its size); none until the first
+  // value is buffered, then grown on demand, by doubling, up to capacity_.
   std::vector<std::optional<T>> ring_;
   std::size_t head_ = 0;
   std::size_t count_ = 0;
@@ -292,11 +299,14 @@ class ChannelEnd {
 
 }  // namespace detail
 
+// When a buffer's slots are allocated (see the top of this file).
+enum class Slots { on_first_value, up_front };
+
 template <class T>
 class Channel {
  public:
-  explicit Channel(std::string name = {}, std::size_t capacity = 0)
-      : state_(std::make_shared<detail::ChannelState<T>>(std::move(name), capacity)) {}
+  explicit Channel(std::string name = {}, std::size_t capacity = 0, Slots slots = Slots::on_first_value)
+      : state_(std::make_shared<detail::ChannelState<T>>(std::move(name), capacity, slots == Slots::up_front)) {}
 
   In<T> reader() const { return In<T>(state_); }
   Out<T> writer() const { return Out<T>(state_); }

@@ -2,7 +2,6 @@
 #include "nodes/net/thread_relay.hpp"
 
 #include <algorithm>
-#include <bit>
 #include <optional>
 #include <stdexcept>
 #include <string>
@@ -19,11 +18,13 @@ struct ThreadRelays::Link {
 
 // One producer (the relay of the ring's first thread), one consumer (that
 // of its second). An entry carries a packet for a link, or `credits` > 0
-// returned for a link. Each index is written by one side only and sits on
+// returned for a link. Each count is written by one side only and sits on
 // a cache line of its own; each side keeps its last view of the other's, so
 // a push or a drain reads the other side's line only when the view says
-// full or empty. A Packet's vectors move in and out of a slot without
-// allocating.
+// full or empty. The ring holds exactly the entries that can be out on it
+// (a complete graph has millions of relayed links), and each side keeps
+// its own slot index rather than a power-of-two mask. A Packet's vectors
+// move in and out of a slot without allocating.
 class ThreadRelays::Ring {
  public:
   struct Entry {
@@ -32,7 +33,7 @@ class ThreadRelays::Ring {
     Packet packet;
   };
 
-  explicit Ring(std::size_t capacity) : slots_(std::bit_ceil(std::max<std::size_t>(capacity, 1))) {}
+  explicit Ring(std::size_t capacity) : slots_(std::max<std::size_t>(capacity, 1)) {}
 
   // The credits bound what can be in a ring, so a full ring is a broken
   // invariant, never back-pressure.
@@ -41,7 +42,8 @@ class ThreadRelays::Ring {
       head_seen_ = head_.load(std::memory_order_acquire);
       if (tail_ - head_seen_ == slots_.size()) throw std::logic_error("thread relay: ring full");
     }
-    slots_[tail_ & (slots_.size() - 1)] = std::move(e);
+    slots_[tail_slot_] = std::move(e);
+    tail_slot_ = next(tail_slot_);
     tail_published_.store(++tail_, std::memory_order_release);
   }
 
@@ -50,17 +52,24 @@ class ThreadRelays::Ring {
   void drain(F&& take) {
     const std::uint64_t tail = tail_published_.load(std::memory_order_acquire);
     if (tail == head_local_) return;
-    for (; head_local_ != tail; ++head_local_) take(slots_[head_local_ & (slots_.size() - 1)]);
+    for (; head_local_ != tail; ++head_local_) {
+      take(slots_[head_slot_]);
+      head_slot_ = next(head_slot_);
+    }
     head_.store(head_local_, std::memory_order_release);
   }
 
  private:
+  std::size_t next(std::size_t slot) const { return slot + 1 == slots_.size() ? 0 : slot + 1; }
+
   std::vector<Entry> slots_;
   alignas(64) std::atomic<std::uint64_t> tail_published_{0};
   alignas(64) std::uint64_t tail_ = 0;  // the producer's
   std::uint64_t head_seen_ = 0;         // the producer's view of head_
+  std::size_t tail_slot_ = 0;           // the producer's: tail_ modulo the slots
   alignas(64) std::atomic<std::uint64_t> head_{0};
   alignas(64) std::uint64_t head_local_ = 0;  // the consumer's
+  std::size_t head_slot_ = 0;                 // the consumer's: head_local_ modulo the slots
 };
 
 class ThreadRelays::Relay {
@@ -119,9 +128,25 @@ class ThreadRelays::Relay {
     std::size_t credits;
     std::size_t guard = 0;
   };
+  // Packets waiting for room in a link's input: at most K, in arrival
+  // order from `head`. A vector, which takes no memory until a link first
+  // stages (a deque takes half a kilobyte each, and most links never do).
+  struct Staged {
+    std::vector<Packet> packets;
+    std::size_t head = 0;
+    bool empty() const { return head == packets.size(); }
+    Packet& front() { return packets[head]; }
+    void push_back(Packet&& p) { packets.push_back(std::move(p)); }
+    void pop_front() {
+      if (++head == packets.size()) {
+        packets.clear();
+        head = 0;
+      }
+    }
+  };
   struct Incoming {
     std::size_t link;
-    std::deque<Packet> staged{};
+    Staged staged{};
     std::uint32_t owed = 0;  // credits to return
     std::size_t guard = 0;
   };
@@ -247,7 +272,8 @@ ThreadRelays::ThreadRelays(unsigned threads, std::size_t capacity)
     : threads_(threads), capacity_(capacity), counters_(threads) {
   for (unsigned t = 0; t < threads_; ++t) {
     arrivals_.push_back(std::make_unique<csp::Arrivals>());
-    tokens_.emplace_back("relay token " + std::to_string(t), 1);
+    // Written by the scheduler's arrivals callback, which must not allocate.
+    tokens_.emplace_back("relay token " + std::to_string(t), 1, csp::Slots::up_front);
   }
 }
 
@@ -262,14 +288,17 @@ void ThreadRelays::add(unsigned from_thread, unsigned to_thread, csp::In<Packet>
 }
 
 // A ring from a to b carries the packets of links a→b (at most K each, by
-// the credits) and the credits of links b→a (at most K each, each entry
-// at least one).
+// the credits) and the credits of links b→a: at most K out per link, and
+// each entry at least half of K (flush), so at most two entries (one if K
+// is 1).
+std::size_t ThreadRelays::credit_entries(std::size_t capacity) { return capacity > 1 ? 2 : 1; }
+
 void ThreadRelays::spawn(csp::Runtime& runtime) {
   std::vector<std::size_t> per_pair(std::size_t{threads_} * threads_, 0);
   std::vector<bool> has_links(threads_, false);
   for (const Link& l : links_) {
     per_pair[l.from_thread * threads_ + l.to_thread] += capacity_;
-    per_pair[l.to_thread * threads_ + l.from_thread] += capacity_;
+    per_pair[l.to_thread * threads_ + l.from_thread] += credit_entries(capacity_);
     has_links[l.from_thread] = has_links[l.to_thread] = true;
   }
   for (std::size_t p = 0; p < per_pair.size(); ++p) rings_.push_back(std::make_unique<Ring>(per_pair[p]));

@@ -17,7 +17,6 @@
 #include <atomic>
 #include <cstddef>
 #include <cstdint>
-#include <deque>
 #include <memory>
 #include <vector>
 
@@ -52,6 +51,9 @@ class ThreadRelays {
   // the queues and inputs).
   void poison();
   const RelayCounters& counters(unsigned thread) const { return counters_.at(thread); }
+  // The most credit entries of one link out on a ring at once, for links of
+  // `capacity` packets.
+  static std::size_t credit_entries(std::size_t capacity);
 
  private:
   struct Link;

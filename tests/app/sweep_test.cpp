@@ -479,8 +479,8 @@ TEST_F(SweepCli, AMachineTooLargeForTheMemoryIsRefusedBeforeAnyRun) {
                                      "stdout.txt", "ulimit -v 2000000");
   EXPECT_EQ(r.exit_code, 2);
   EXPECT_EQ(r.err,
-            "vmpray sweep: --nodes/--topology: complete:2048 (2048 nodes, 4192256 link queues) needs about 41.5 GB "
-            "with its image, more than the 2.0 GB this process may map (ulimit -v)\n");
+            "vmpray sweep: --nodes/--topology: complete:2048 (2048 nodes, 4192256 link queues) needs about 1332.5 GB "
+            "of address space with its image, more than the 2.0 GB this process may map (ulimit -v)\n");
   EXPECT_FALSE(fs::exists(dir_ / "out"));
 }
 
