@@ -1,8 +1,9 @@
 // What bridges send one another (bridge_wire.hpp): a cut link, a packet,
 // a credit and an abort come back field for field, their bytes are exactly
 // the fields of their lists at their widths, a page reply's shared bytes
-// arrive as payload, and a frame cut short is refused. (The ranks layer has
-// no suite of its own; this one links it.)
+// arrive as payload, and a frame cut short is refused. (It builds the
+// machine's messages, so it sits in the machine's suite rather than in
+// tests/nodes/ranks, which runs the bridge itself.)
 #include "nodes/ranks/bridge_wire.hpp"
 
 #include <gtest/gtest.h>
