@@ -1,0 +1,341 @@
+// The load study's patterns, channel loads and its virtual-time run (see
+// load_study.hpp).
+#include "nodes/net/load_study.hpp"
+
+#include <algorithm>
+#include <bit>
+#include <cmath>
+#include <map>
+#include <memory>
+#include <random>
+#include <stdexcept>
+
+#include "csp/csp.hpp"
+#include "csp/virtual_time.hpp"
+#include "nodes/net/network.hpp"
+
+namespace nodes {
+namespace {
+
+using topology::Kind;
+using topology::NodeId;
+using topology::Topology;
+
+constexpr TrafficPattern all_patterns[] = {TrafficPattern::uniform,      TrafficPattern::transpose,
+                                           TrafficPattern::bit_complement, TrafficPattern::bit_reversal,
+                                           TrafficPattern::shuffle,      TrafficPattern::tornado,
+                                           TrafficPattern::neighbour,    TrafficPattern::hotspot};
+
+// A node id as digits, lowest first, with each digit's radix: the
+// hypercube's bits, the grid's x then y, the ring's or complete graph's index.
+std::vector<unsigned> radices(const Topology& t) {
+  switch (t.kind()) {
+    case Kind::hypercube: return std::vector<unsigned>(t.dimension(), 2);
+    case Kind::mesh:
+    case Kind::torus: return {t.width(), t.height()};
+    case Kind::ring:
+    case Kind::complete: break;
+  }
+  return {static_cast<unsigned>(t.size())};
+}
+
+NodeId each_digit(const Topology& t, NodeId n, unsigned (*f)(unsigned digit, unsigned radix)) {
+  NodeId result = 0, scale = 1;
+  for (const unsigned k : radices(t)) {
+    result += scale * f(n % k, k);
+    n /= k;
+    scale *= k;
+  }
+  return result;
+}
+
+bool power_of_two(const Topology& t) { return std::has_single_bit(t.size()); }
+unsigned bits(const Topology& t) { return static_cast<unsigned>(std::countr_zero(t.size())); }
+unsigned square_side(const Topology& t) {
+  const auto m = static_cast<unsigned>(std::lround(std::sqrt(static_cast<double>(t.size()))));
+  return static_cast<std::size_t>(m) * m == t.size() ? m : 0;
+}
+
+NodeId fixed_destination(TrafficPattern pattern, const Topology& t, NodeId n) {
+  const NodeId mask = static_cast<NodeId>(t.size() - 1);
+  switch (pattern) {
+    case TrafficPattern::bit_complement: return ~n & mask;
+    case TrafficPattern::bit_reversal: {
+      NodeId r = 0;
+      for (unsigned i = 0; i < bits(t); ++i) r |= ((n >> i) & 1u) << (bits(t) - 1 - i);
+      return r;
+    }
+    case TrafficPattern::shuffle: return bits(t) == 0 ? n : ((n << 1) | (n >> (bits(t) - 1))) & mask;
+    case TrafficPattern::transpose: {
+      const unsigned m = square_side(t);
+      return (n % m) * m + n / m;
+    }
+    case TrafficPattern::tornado:
+      return each_digit(t, n, [](unsigned d, unsigned k) { return (d + (k + 1) / 2 - 1) % k; });
+    case TrafficPattern::neighbour: return each_digit(t, n, [](unsigned d, unsigned k) { return (d + 1) % k; });
+    case TrafficPattern::uniform:
+    case TrafficPattern::hotspot: break;
+  }
+  return n;
+}
+
+// The physical link a hop leaves by: (node, port); the delivery channel of
+// node n is (n, degree).
+using LinkKey = std::pair<NodeId, unsigned>;
+
+void add_route(const Topology& t, NodeId from, NodeId to, double weight, std::map<LinkKey, double>& load) {
+  for (NodeId at = from; at != to;) {
+    const topology::Hop hop = t.next_hop(at, to);
+    load[{at, hop.port}] += weight;
+    at = t.neighbour(at, hop.port);
+  }
+  load[{to, t.degree(to)}] += weight;
+}
+
+double seconds_of(csp::VirtualDuration d) { return std::chrono::duration<double>(d).count(); }
+csp::VirtualDuration virtual_of(double seconds) {
+  return std::chrono::duration_cast<csp::VirtualDuration>(std::chrono::duration<double>(seconds));
+}
+
+// What the sources and sinks share: one runtime thread, so plain counters.
+struct Tally {
+  double window_start = 0, window_end = 0;
+  std::uint64_t created = 0, delivered = 0, misdelivered = 0;
+  std::uint64_t created_in_window = 0, delivered_in_window = 0;
+  unsigned sources_running = 0;
+  std::int64_t in_flight = 0;
+  double area = 0, last = 0;  // the integral of in_flight over the window, up to `last`
+  std::vector<std::vector<double>> created_at;  // per node, per sequence number: creation time
+  std::vector<std::vector<std::uint8_t>> seen;  // per node, per sequence number: deliveries
+  std::vector<double> latencies;                // of packets created in the window
+  std::uint64_t hops = 0;
+
+  void integrate_to(double now) {
+    const double to = std::clamp(now, window_start, window_end);
+    if (to > last) {
+      area += static_cast<double>(in_flight) * (to - std::max(last, window_start));
+      last = to;
+    }
+  }
+  bool finished() const { return sources_running == 0 && delivered + misdelivered >= created; }
+};
+
+}  // namespace
+
+const char* pattern_name(TrafficPattern pattern) {
+  switch (pattern) {
+    case TrafficPattern::uniform: return "uniform";
+    case TrafficPattern::transpose: return "transpose";
+    case TrafficPattern::bit_complement: return "bit-complement";
+    case TrafficPattern::bit_reversal: return "bit-reversal";
+    case TrafficPattern::shuffle: return "shuffle";
+    case TrafficPattern::tornado: return "tornado";
+    case TrafficPattern::neighbour: return "neighbour";
+    case TrafficPattern::hotspot: return "hotspot";
+  }
+  return "?";
+}
+
+TrafficPattern parse_traffic_pattern(const std::string& name) {
+  std::string known;
+  for (const TrafficPattern p : all_patterns) {
+    if (name == pattern_name(p)) return p;
+    known += (known.empty() ? "" : ", ") + std::string(pattern_name(p));
+  }
+  throw std::invalid_argument("unknown traffic pattern '" + name + "' (known: " + known + ")");
+}
+
+std::string pattern_descriptions() {
+  return "uniform: each packet to a node drawn at random among the others\n"
+         "transpose: node (x, y) of a square of m x m to (y, x), id = y m + x\n"
+         "bit-complement: every bit of the id inverted (2^b nodes)\n"
+         "bit-reversal: the id's b bits in reverse order (2^b nodes)\n"
+         "shuffle: the id's b bits rotated left by one (2^b nodes)\n"
+         "tornado: each digit d of radix k to d + ceil(k/2) - 1 mod k (digits: the grid's x and y, the "
+         "ring's or complete graph's index; not on a hypercube, whose digits are bits)\n"
+         "neighbour: each digit d of radix k to d + 1 mod k (on a hypercube, every bit)\n"
+         "hotspot: a share of the packets (--hotspot) to node 0, the rest uniform\n";
+}
+
+std::string pattern_unfit(TrafficPattern pattern, const Topology& t) {
+  const std::string on = " (" + t.spec() + " has " + std::to_string(t.size()) + " nodes)";
+  if (t.size() < 2) return std::string(pattern_name(pattern)) + " traffic needs at least 2 nodes" + on;
+  switch (pattern) {
+    case TrafficPattern::bit_complement:
+    case TrafficPattern::bit_reversal:
+    case TrafficPattern::shuffle:
+      if (!power_of_two(t)) return std::string(pattern_name(pattern)) + " traffic needs a power-of-two node count" + on;
+      break;
+    case TrafficPattern::transpose:
+      if (square_side(t) == 0) return "transpose traffic needs a square node count, m x m" + on;
+      break;
+    case TrafficPattern::tornado:
+      if (t.kind() == Kind::hypercube) return "tornado traffic is not defined on a hypercube: its digits are bits";
+      break;
+    case TrafficPattern::uniform:
+    case TrafficPattern::neighbour:
+    case TrafficPattern::hotspot: break;
+  }
+  return "";
+}
+
+std::vector<NodeId> fixed_destinations(TrafficPattern pattern, const Topology& t) {
+  if (pattern == TrafficPattern::uniform || pattern == TrafficPattern::hotspot) return {};
+  std::vector<NodeId> to(t.size());
+  for (NodeId n = 0; n < t.size(); ++n) to[n] = fixed_destination(pattern, t, n);
+  return to;
+}
+
+double max_channel_load(const Topology& t, TrafficPattern pattern, double hotspot_fraction) {
+  if (const std::string why = pattern_unfit(pattern, t); !why.empty()) throw std::invalid_argument(why);
+  std::map<LinkKey, double> load;
+  const auto n = static_cast<NodeId>(t.size());
+  const std::vector<NodeId> fixed = fixed_destinations(pattern, t);
+  for (NodeId s = 0; s < n; ++s) {
+    if (!fixed.empty()) {
+      if (fixed[s] != s) add_route(t, s, fixed[s], 1.0, load);
+      continue;
+    }
+    const double hot = pattern == TrafficPattern::hotspot && s != 0 ? hotspot_fraction : 0.0;
+    if (hot > 0) add_route(t, s, 0, hot, load);
+    for (NodeId d = 0; d < n; ++d)
+      if (d != s) add_route(t, s, d, (1.0 - hot) / (n - 1), load);
+  }
+  double most = 0;
+  for (const auto& [link, l] : load) most = std::max(most, l);
+  return most;
+}
+
+double zero_load_latency(const LinkModel& link, std::size_t payload_bytes, unsigned distance) {
+  const double message = std::chrono::duration<double>(link.delay(payload_bytes)).count();
+  return (distance + 1) * message;
+}
+
+LoadResult run_load(const Topology& t, TrafficPattern pattern, double offered, const LoadStudyOptions& options) {
+  if (const std::string why = pattern_unfit(pattern, t); !why.empty()) throw std::invalid_argument(why);
+  if (!options.link.enabled()) throw std::invalid_argument("a load study needs a link model: a latency or a bandwidth");
+  if (!(offered > 0)) throw std::invalid_argument("an offered load must be above 0");
+  const double base = zero_load_latency(options.link, options.payload_bytes,
+                                        static_cast<unsigned>(std::ceil(t.average_distance())));
+  auto tally = std::make_shared<Tally>();
+  tally->window_start = options.warmup_seconds > 0 ? options.warmup_seconds : 20 * base;
+  const double window = options.window_seconds > 0 ? options.window_seconds : 200 * base;
+  tally->window_end = tally->window_start + window;
+  const auto n = static_cast<NodeId>(t.size());
+  tally->created_at.resize(n);
+  tally->seen.resize(n);
+  tally->sources_running = n;
+
+  auto record = std::make_shared<csp::VirtualTimeRecord>();
+  csp::RuntimeOptions runtime_options;
+  runtime_options.threads = 1;
+  runtime_options.scheduler = csp::virtual_time_scheduler(record);
+  csp::Runtime runtime(runtime_options);
+  NetworkOptions net_options;
+  net_options.buffer_capacity = options.buffer_capacity;
+  net_options.link = options.link;
+  Network net(runtime, t, net_options);
+  const std::vector<NodeId> fixed = fixed_destinations(pattern, t);
+
+  for (NodeId node = 0; node < n; ++node) {
+    runtime.spawn("source " + std::to_string(node), 0, [&, node, out = net.injector(node)]() mutable {
+      std::mt19937_64 rng(options.seed * 0x9e3779b97f4a7c15ull + node);
+      std::exponential_distribution<double> gap(offered);
+      std::uniform_int_distribution<NodeId> other(0, n - 2);
+      std::uniform_real_distribution<double> share(0.0, 1.0);
+      Tally& k = *tally;
+      for (double next = gap(rng); next <= k.window_end; next += gap(rng)) {
+        const double at = seconds_of(virtual_of(next));  // an instant of the virtual clock
+        NodeId to = node;
+        if (!fixed.empty()) {
+          to = fixed[node];
+        } else if (pattern == TrafficPattern::hotspot && node != 0 && share(rng) < options.hotspot_fraction) {
+          to = 0;
+        } else {
+          to = other(rng);
+          to += to >= node;
+        }
+        if (to == node) break;  // a fixed pattern that maps this node to itself: it sends nothing
+        const double now = seconds_of(csp::this_process::now());
+        if (at > now) csp::this_process::advance(virtual_of(next) - csp::this_process::now());
+        Packet p;
+        p.destination = to;
+        p.kind = kind_traffic;
+        p.id = (std::uint64_t{node} << 32) | k.created_at[node].size();
+        p.payload.resize(options.payload_bytes);
+        // Created at `at`, though a full injection queue may have held the
+        // source until now: its wait counts as time in the network.
+        const double held = seconds_of(csp::this_process::now());
+        k.integrate_to(held);
+        k.area += std::max(0.0, std::min(held, k.window_end) - std::max(at, k.window_start));
+        ++k.in_flight;
+        ++k.created;
+        k.created_at[node].push_back(at);
+        k.seen[node].push_back(0);
+        if (at >= k.window_start) ++k.created_in_window;
+        out.write(std::move(p));
+      }
+      if (--k.sources_running == 0 && k.finished()) net.shutdown();
+    });
+    runtime.spawn("sink " + std::to_string(node), 0, [&, node, in = net.port(node)]() mutable {
+      Tally& k = *tally;
+      try {
+        for (;;) {
+          const Packet p = in.read();
+          const double now = seconds_of(csp::this_process::now());
+          const auto source = static_cast<NodeId>(p.id >> 32);
+          const auto sequence = static_cast<std::size_t>(p.id & 0xffffffffu);
+          if (p.destination != node || source >= n || sequence >= k.seen[source].size() ||
+              k.seen[source][sequence]++ != 0) {
+            ++k.misdelivered;
+          } else {
+            k.integrate_to(now);
+            --k.in_flight;
+            ++k.delivered;
+            const double created = k.created_at[source][sequence];
+            if (now >= k.window_start && now <= k.window_end) ++k.delivered_in_window;
+            if (created >= k.window_start && created <= k.window_end) {
+              k.latencies.push_back(now - created);
+              k.hops += p.hops;
+            }
+          }
+          if (k.finished()) net.shutdown();
+        }
+      } catch (const csp::Poisoned&) {
+        // the study is over
+      }
+    });
+  }
+  runtime.run();
+
+  Tally& k = *tally;
+  k.integrate_to(k.window_end);
+  LoadResult r;
+  r.offered = offered;
+  r.created = k.created;
+  r.delivered = k.delivered;
+  r.misdelivered = k.misdelivered;
+  r.measured = k.latencies.size();
+  r.accepted = static_cast<double>(k.delivered_in_window) / (window * n);
+  r.arrival_rate = static_cast<double>(k.created_in_window) / window;
+  r.mean_in_flight = k.area / window;
+  r.end_seconds = seconds_of(record->end());
+  if (!k.latencies.empty()) {
+    std::vector<double>& l = k.latencies;
+    double sum = 0;
+    for (const double x : l) sum += x;
+    r.mean_latency = sum / static_cast<double>(l.size());
+    r.mean_hops = static_cast<double>(k.hops) / static_cast<double>(l.size());
+    const auto at = [&l](double q) {
+      const auto i = static_cast<std::size_t>(std::ceil(q * static_cast<double>(l.size()))) - 1;
+      std::nth_element(l.begin(), l.begin() + static_cast<std::ptrdiff_t>(i), l.end());
+      return l[i];
+    };
+    r.p50_latency = at(0.5);
+    r.p99_latency = at(0.99);
+    r.max_latency = *std::max_element(l.begin(), l.end());
+  }
+  return r;
+}
+
+}  // namespace nodes
