@@ -28,6 +28,7 @@
 #include "app/machine_run.hpp"
 #include "app/manual.hpp"
 #include "app/memory_check.hpp"
+#include "app/network_study.hpp"
 #include "app/options.hpp"
 #include "app/output_check.hpp"
 #include "app/output_files.hpp"
@@ -194,6 +195,7 @@ int rank_main(int argc, char** argv, const vmpi::MpiSession& mpi) {
 
 int one_process(int argc, char** argv) {
   if (argc > 1 && std::string(argv[1]) == "sweep") return app::sweep_main(argc - 1, argv + 1);
+  if (argc > 1 && std::string(argv[1]) == "network") return app::network_main(argc - 1, argv + 1);
   app::Options options;
   try {
     options = app::parse_options(argc, argv);
