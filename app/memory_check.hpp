@@ -1,23 +1,16 @@
-// The up-front memory check of `vmpray`: once the scene is read and before
-// anything is built or traced, the bytes that the render's image-sized
-// buffers will take at their peak are estimated from the options and the
-// image size, and an image whose estimate exceeds the memory there is is
-// refused at once, rather than by std::bad_alloc or the OOM killer after
-// minutes of work. Once the database is built, the machine is checked the
-// same way: its nodes and links with the image (a complete graph of 4096
-// nodes has 16.8 million link queues, about 16 GB).
-//
-// The image's estimate counts what grows with the image (memory_check.cpp
-// lists each buffer): the float frames, the 8-bit copy the image writers
-// encode, the machine's pixel order, collected colours, pixel owners, the
-// pixel computers' tiles, tile records and their CSV text, and the
-// ownership picture. The machine's counts what grows with its nodes and
-// links (machine_memory_bytes below). The scene, its database (but for the
-// copy each of a sweep's side-by-side runs holds, jobs_that_fit below) and
-// the nodes' caches are left out, as is the process's own few megabytes.
-// Invariant: the estimates follow the renderers' allocations as they are;
-// a change to those buffers changes them too (memory_check_test.cpp holds
-// them to peak resident sizes measured on real runs).
+// The up-front memory check of `vmpray`: before anything is built or
+// traced, the peak bytes of the render's image-sized buffers are estimated
+// from the options and the image size, and once the database is built the
+// machine's (nodes, links, relays between threads, a replay's recording);
+// a run whose estimate exceeds the memory there is (the machine's, the
+// control group's, or under ulimit -v the address space, stacks counted
+// whole) is refused at once, rather than by std::bad_alloc or the OOM
+// killer after minutes of work. memory_check.cpp lists each buffer counted.
+// Left out: the scene, its database (but for the copy each of a sweep's
+// side-by-side runs holds), the nodes' caches and the process's own few
+// megabytes. Invariant: the estimates follow the allocations as they are;
+// scripts/memory-matrix.py holds them to peaks measured on real runs (CI
+// runs its quick rows), and memory_check_test.cpp to what they count.
 #pragma once
 
 #include <cstdint>

@@ -1,19 +1,15 @@
-// The files a command writes, removed again unless it finishes, so that a
-// failed run leaves no output behind. Every writer here puts a file in place
-// whole or not at all (tracer/atomic_file.hpp), and a path is added only
-// once its file is in place: a write that fails leaves whatever stood at
-// that path before, and what a failed command removes is only what it wrote.
-// Removal goes in reverse order, so a directory added before the files made
-// in it goes last, once it is empty (a directory that is not empty stays).
-//
+// The files a command writes, removed again unless it finishes, so a failed
+// run leaves no output behind. Every writer puts a file in place whole or
+// not at all (tracer/atomic_file.hpp), and a path is added only once its
+// file is in place, so what a failed command removes is only what it wrote;
+// removal goes in reverse order, a directory after the files made in it.
 // OutputPhase is a command writing its outputs: it holds back the signals
-// that would end the command half-way (SIGINT, SIGTERM, SIGHUP, and SIGPIPE
-// from a closed standard output) and owns the OutputFiles written meanwhile.
-// Once every file is in place, finish() checks the standard output and
-// keeps the files unless a signal came. Ending the phase removes the files
-// not kept, then lets a held signal through, so the command still ends as
-// it asked, leaving nothing behind.
-// Only for a single-threaded process: other threads would take the signals.
+// that would end it half-way (SIGINT, SIGTERM, SIGHUP, SIGPIPE) and owns
+// the OutputFiles written meanwhile; finish() checks the standard output
+// and keeps the files unless a signal came; ending the phase removes the
+// files not kept, then lets a held signal through, so the command still
+// ends as asked, leaving nothing behind. For a single-threaded process
+// only: other threads would take the signals.
 #pragma once
 
 #include <pthread.h>

@@ -1,5 +1,4 @@
 // Occam ALT: waits until one of several guards is ready and says which.
-//
 // - Guards: a channel input (ready when a read would not block), room in a
 //   buffered output (ready when a write would not block; for the channel's
 //   only writer), a timeout (ready `after` from the start of each select, in
@@ -14,19 +13,6 @@
 // - Program errors throw std::logic_error: a select with no enabled guard
 //   (occam STOP), an unbound end as a guard, a room guard on an unbuffered
 //   channel, and a second guard on one channel in a doorbell ALT.
-//
-// Example, a process that merges In<int>s a and b onto an Out<int> out and
-// stops after a quiet spell:
-//
-//   csp::Alt alt;
-//   const std::size_t left = alt.add_input(a), right = alt.add_input(b);
-//   const std::size_t quiet = alt.add_timeout(std::chrono::milliseconds(10));
-//   for (;;) {
-//     const std::size_t i = alt.select();
-//     if (i == left) out.write(a.read());
-//     else if (i == right) out.write(b.read());
-//     else if (i == quiet) break;  // 10 ms with neither ready
-//   }
 #pragma once
 
 #include <chrono>
@@ -40,6 +26,18 @@
 
 namespace csp {
 
+// Example, a process that merges In<int>s a and b onto an Out<int> out and
+// stops after a quiet spell:
+//
+//   csp::Alt alt;
+//   const std::size_t left = alt.add_input(a), right = alt.add_input(b);
+//   const std::size_t quiet = alt.add_timeout(std::chrono::milliseconds(10));
+//   for (;;) {
+//     const std::size_t i = alt.select();
+//     if (i == left) out.write(a.read());
+//     else if (i == right) out.write(b.read());
+//     else if (i == quiet) break;  // 10 ms with neither ready
+//   }
 class Alt {
  public:
   // How a select that finds nothing ready waits.

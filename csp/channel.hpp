@@ -1,34 +1,18 @@
 // Occam channels. Channel<T> owns the shared state and hands out its two
 // ends, In<T> (reading) and Out<T> (writing): cheap copyable handles. A
 // channel has one reading and one writing process.
-//
 // - Capacity 0 (the default) is a rendezvous: write() returns once a reader
 //   has the value. Capacity k is a bounded buffer: a writer waits only while
 //   k values are held, a reader only while none is. Values keep their order.
 // - try_read() and try_write() never wait; read_for() waits at most a duration.
-// - A buffer's first slots are allocated with its first value, unless it is
-//   made with Slots::up_front: then a write never allocates, as one made
-//   where an allocation must not fail (a scheduler's callback) needs.
+// - A buffer's first slots come with its first value, unless made with
+//   Slots::up_front, for where allocation must not fail: a write never does.
 // - Poison, from either end, is permanent and wakes every waiter: every later
 //   operation on either end throws Poisoned, even with values still buffered.
-// - A default-constructed or moved-from end is unbound: its operations throw
-//   std::logic_error, and an ALT (alt.hpp) refuses it as a guard.
+// - An unbound end (default-constructed or moved from) throws
+//   std::logic_error on every operation; an ALT (alt.hpp) refuses it.
 // - Waiting is for processes of a csp::Runtime (runtime.hpp); elsewhere a
 //   read or write that would wait throws std::logic_error.
-//
-// Example, a producer and a consumer (as csp::par processes):
-//
-//   csp::Channel<int> numbers("numbers");  // rendezvous
-//   csp::par({[out = numbers.writer()]() mutable {
-//               for (int i = 1; i <= 3; ++i) out.write(i);
-//               out.poison();  // the end of the stream
-//             },
-//             [in = numbers.reader()]() mutable {
-//               try {
-//                 for (;;) std::cout << in.read() << '\n';  // 1, 2, 3
-//               } catch (const csp::Poisoned&) {
-//               }
-//             }});
 #pragma once
 
 #include <algorithm>
@@ -302,6 +286,19 @@ class ChannelEnd {
 // When a buffer's slots are allocated (see the top of this file).
 enum class Slots { on_first_value, up_front };
 
+// Example, a producer and a consumer (as csp::par processes):
+//
+//   csp::Channel<int> numbers("numbers");  // rendezvous
+//   csp::par({[out = numbers.writer()]() mutable {
+//               for (int i = 1; i <= 3; ++i) out.write(i);
+//               out.poison();  // the end of the stream
+//             },
+//             [in = numbers.reader()]() mutable {
+//               try {
+//                 for (;;) std::cout << in.read() << '\n';  // 1, 2, 3
+//               } catch (const csp::Poisoned&) {
+//               }
+//             }});
 template <class T>
 class Channel {
  public:

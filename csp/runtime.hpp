@@ -10,11 +10,9 @@
 // for processes: a thread outside any Runtime that would block gets
 // std::logic_error instead of a wait nothing may end. It may still use
 // channels without blocking, and run processes with par(), whose children
-// may block.
-//
-// Who wakes whom: spawn() wakes the target thread's main fiber (it waits on an
-// inbox of new processes); the last process to end wakes every thread's main
-// fiber, which then joins its fibers and returns.
+// may block. Who wakes whom: spawn() wakes the target thread's main fiber (it
+// waits on an inbox of new processes); the last process to end wakes every
+// thread's main fiber, which then joins its fibers and returns.
 #pragma once
 
 #include <chrono>

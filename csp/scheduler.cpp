@@ -36,6 +36,8 @@ void Scheduler::make_room_for_fiber() { detail::reserve_properties(); }
 
 void detail::release_properties_reserve() noexcept { ::operator delete(std::exchange(properties_reserve, nullptr)); }
 
+// With more threads than hardware threads a spinning thread would take the
+// core from one that has work, so it does not spin.
 std::chrono::microseconds idle_spin(unsigned threads, unsigned hardware_threads) {
   if (hardware_threads != 0 && threads > hardware_threads) return std::chrono::microseconds{0};
   return std::chrono::microseconds{50};
@@ -43,6 +45,9 @@ std::chrono::microseconds idle_spin(unsigned threads, unsigned hardware_threads)
 
 // A process's fiber is bound to its record when it first runs, so its first
 // wake-up, at spawn, takes the high-priority queue.
+// Woken low-priority processes go before yielded ones: a process that waited
+// on a message has little left to do before it waits again, and the ones
+// that yielded are the long computations it would otherwise queue behind.
 void FifoScheduler::awakened(boost::fibers::context* ctx, ProcessProps& props) noexcept {
   const bool yielded = std::exchange(props.yielded, false);
   if (ctx->is_context(boost::fibers::type::dispatcher_context)) {
@@ -66,6 +71,10 @@ void FifoScheduler::take_arrivals() noexcept {
   arrivals_->marked_.store(false, std::memory_order_seq_cst);
 }
 
+// The dispatcher is kept aside rather than queued with the others: so a
+// process woken from another thread waits for one switch, not for a round
+// of the queue, a timer that fell due during a long computation fires when
+// the computation offers the thread, and most switches read no clock.
 boost::fibers::context* FifoScheduler::pick_next() noexcept {
   if (arrivals_ && arrivals_->marked_.load(std::memory_order_relaxed)) take_arrivals();
   const bool none_ready = ready_.empty() && ready_low_woken_.empty() && ready_low_.empty();
@@ -93,7 +102,9 @@ bool FifoScheduler::take_notification() noexcept {
 }
 
 // Spins, from `start`, until notified (true), the spin limit or `when`,
-// whichever first; with no spin limit, looks once.
+// whichever first; with no spin limit, looks once. The spin comes first
+// because waking a sleeping thread costs a system call on both sides,
+// several times a message's own cost.
 // Reads before it claims, so the spinning thread does not keep taking the
 // flag's cache line from the notifier.
 bool FifoScheduler::spin_until_notified(std::chrono::steady_clock::time_point start,

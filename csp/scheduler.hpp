@@ -4,41 +4,13 @@
 // SchedulerFactory. A Scheduler is a Boost.Fiber algorithm whose per-fiber
 // properties are ProcessProps, so the runtime can find the process a fiber
 // belongs to (and a virtual-time scheduler can keep a clock per process).
-// FifoScheduler is the default: ready fibers run in FIFO order, those of
-// high-priority processes before any of low priority (as a transputer runs
-// its two priority levels). Among low-priority processes, one woken by a
-// communication or a timer runs before those that gave the thread up with
-// csp::yield(): a process that waited on a message has little left to do
-// before it waits again, and the ones that yielded are the long computations
-// it would otherwise queue behind (so a process that yielded waits as long
-// as woken ones keep coming). A long computation that asks
-// yield_requested() between small steps is told to yield when a
-// high-priority process is ready or a wake from another thread is pending:
-// it then gives the thread up for one round and goes on, so it is delayed
-// by what is ready, never starved. When none is ready the thread first spins
-// for a few microseconds watching for notify() (a wake from another thread:
-// waking a sleeping thread costs a system call on both sides, several times
-// a message's own cost), then sleeps on a condition variable until notify()
-// or the next timer deadline. It does not spin when the runtime has more
-// threads than the machine has hardware threads: there the spinning thread
-// would take the core from one that has work (see idle_spin()). Boost's
-// dispatcher fiber (which moves timed-out and remotely woken fibers to the
-// ready queue, and reads the clock to do so) is kept aside and run at the
-// next switch after notify(), after a low-priority process yields, when
-// nothing else is ready, or after every `dispatch_period` picks: a process
-// woken from another thread waits for one switch, not for a round of the
-// queue, a timer that fell due during a long computation fires when the
-// computation offers the thread, and most switches read no clock.
-// Arrivals (below) hand a thread work outside its channels: the scheduler
-// runs their handler at its next switch, and an idle thread stops waiting.
-//
-// Accounting (ThreadTimes): a thread's time from the start of its accounts
-// is cut at every idle wait into running (processes, and the switches
-// between them), spinning and sleeping, so that the three add up to the
-// time since the start: an awake interval is closed at the clock reading
-// that opens the next wait, and each wait's phases at the readings that
-// end them. These readings are the ones the idle wait makes anyway (its
-// spin deadline, its end), so a busy thread pays no clock for its accounts.
+// FifoScheduler is the default: ready fibers in FIFO order, high priority
+// first, then a short spin and a sleep when idle (its rules at its class).
+// Arrivals hand a thread work outside its channels: the scheduler runs
+// their handler at its next switch, and an idle thread stops waiting.
+// A scheduler is used by its own thread only, but for notify() (a wake from
+// another thread) and Arrivals::signal(), which any thread may call; its
+// ThreadTimes accounts are written by that thread alone.
 #pragma once
 
 #include <atomic>
@@ -108,9 +80,15 @@ class Scheduler : public boost::fibers::algo::algorithm_with_properties<ProcessP
   virtual bool yield_requested() const noexcept { return false; }
 };
 
-// How one thread's time divides (see "Accounting" above); written by that
-// thread only. The clock reads awake_since as the start of the interval
-// now open, which is running time until the next wait.
+// How one thread's time divides; written by that thread only. From the
+// start of its accounts, the thread's time is cut at every idle wait into
+// running (processes, and the switches between them), spinning and
+// sleeping, so that the three add up to the time since the start: an awake
+// interval is closed at the clock reading that opens the next wait, and
+// each wait's phases at the readings that end them. These readings are the
+// ones the idle wait makes anyway (its spin deadline, its end), so a busy
+// thread pays no clock for its accounts. The clock reads awake_since as the
+// start of the interval now open, which is running time until the next wait.
 struct ThreadTimes {
   std::chrono::steady_clock::duration running{};   // processes and switches
   std::chrono::steady_clock::duration spinning{};  // idle, watching for a wake
@@ -186,6 +164,23 @@ class Arrivals {
   void* tracker_ = nullptr;  // the detail::Tracker it is registered with
 };
 
+// The default scheduler. Ready fibers run in FIFO order, those of
+// high-priority processes before any of low priority (as a transputer runs
+// its two priority levels). Among low-priority processes, one woken by a
+// communication or a timer runs before those that gave the thread up with
+// csp::yield(), so a process that yielded waits as long as woken ones keep
+// coming. yield_requested() tells a long computation that asks between
+// small steps to yield when a high-priority process is ready or a wake
+// from another thread is pending: it gives the thread up for one round and
+// goes on, delayed by what is ready, never starved. When none is ready the
+// thread first spins for a few microseconds watching for notify() or an
+// arrival, then sleeps on a condition variable until notify() or the next
+// timer deadline; it does not spin when the runtime has more threads than
+// the machine has hardware threads (idle_spin()). Boost's dispatcher fiber
+// (which moves timed-out and remotely woken fibers to the ready queue, and
+// reads the clock to do so) is kept aside and run at the next switch after
+// notify(), after a low-priority process yields, when nothing else is
+// ready, or after every `dispatch_period` picks.
 class FifoScheduler final : public Scheduler {
  public:
   // `idle`, if given, gathers the time the thread waits with nothing to

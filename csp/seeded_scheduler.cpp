@@ -63,6 +63,10 @@ void SeededScheduler::awakened(boost::fibers::context* ctx, ProcessProps& props)
   }
 }
 
+// A fiber that yields is not among the choices of its own yield (Boost
+// re-queues it after the pick), so a yield always switches when another
+// fiber is ready. High priority first is a transputer's rule, which
+// FifoScheduler keeps too.
 boost::fibers::context* SeededScheduler::pick_next() noexcept {
   const bool none_ready = high_.empty() && low_.empty();
   if (dispatcher_ && (none_ready || take_notification() || ++picks_since_dispatch_ >= dispatch_period)) {

@@ -1,23 +1,18 @@
 // SeededScheduler: a test scheduler that runs the ready processes in an
 // order drawn from a seeded pseudo-random sequence, so that a test can try a
 // program under many interleavings and replay any one of them by its seed.
-//
-// At every switch it takes one ready fiber uniformly at random (splitmix64,
-// the index by multiply-shift: the same draws on every standard library),
-// among the high-priority ones while any is ready, then among the low ones
-// (a transputer's rule, which FifoScheduler keeps too); `mix_priorities`
-// draws from both levels alike. A fiber that yields is not among the
-// choices of its own yield (Boost re-queues it after the pick), so a yield
-// always switches when another fiber is ready.
-// Determinism: on ONE runtime thread (RuntimeOptions{.threads = 1}) a
-// program that uses no timers runs the same schedule for a seed every time.
-// Timers (read_for, ALT timeouts, sleep_for) still fire, by the wall clock,
-// so they make the schedule depend on it; on several threads each thread
-// draws its own sequence but wakes between threads follow the OS. Boost's
-// dispatcher (timers, wakes from other threads, ended fibers) is not among
-// the draws: it runs when nothing else is ready, after a notify(), or every
-// dispatch_period picks. No Arrivals, no ThreadTimes accounts, no spinning:
-// an idle thread sleeps until notify() or its next timer.
+// At every switch it takes one ready fiber uniformly at random (splitmix64:
+// the same draws on every standard library), among the high-priority ones
+// while any is ready, then among the low ones; `mix_priorities` draws from
+// both levels alike. A yield always switches when another fiber is ready.
+// Determinism: on ONE runtime thread (RuntimeOptions{.threads = 1}) a program
+// that uses no timers runs the same schedule for a seed every time. Timers
+// (read_for, ALT timeouts, sleep_for) fire by the wall clock; on several
+// threads each draws its own sequence but wakes between them follow the OS.
+// Boost's dispatcher (timers, remote wakes, ended fibers) is not drawn: it
+// runs when nothing else is ready, after a notify(), or every dispatch_period
+// picks. No Arrivals, no ThreadTimes accounts, no spinning: an idle thread
+// sleeps until notify() or its next timer.
 #pragma once
 
 #include <atomic>

@@ -79,6 +79,22 @@ std::uint64_t Tracker::alive() const {
   return alive;
 }
 
+// Why the survey is sound. `blocked == alive > 0` over the whole run means
+// no process can run and nobody will wake one: the state is stable. Only a
+// process that makes its own thread's word all blocked (by blocking, or by
+// ending) can complete that state, so only it surveys the other words: it
+// reads them all twice, and if the versions of both reads add up the same,
+// no word changed between them, so all were true at one instant. The last
+// thread to reach the state sees the others', since its update precedes its
+// reads in the single order of sequentially consistent operations. A survey
+// that finds every word all blocked aborts the run; one that finds nothing
+// alive ends it (once, though the last processes of two threads may both
+// see it). Work that threads hand each other outside channels
+// (csp::Arrivals) is seen too: a survey that finds an Arrivals pending
+// between its two reads says the run goes on, since the handler will wake a
+// process for it. Since a process's own block and end touch only its
+// thread's word, threads that each wake their own processes never contend.
+//
 // Two reads of every thread's words whose versions add up to the same sum
 // saw the same words, all true at one instant: a word changes only by
 // adding one to its version (until, some four million changes on, the

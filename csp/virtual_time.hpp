@@ -1,37 +1,17 @@
 // Virtual time: run a csp program as a discrete-event simulation whose
 // processes are the real fibers, so it reports what the run would take on a
-// machine with given costs, whatever the host's speed.
+// machine with given costs, whatever the host's speed (the model and why it
+// holds: docs/architecture.md, "Virtual time").
 //
-// Model. There is one global virtual clock, "now". A process spends virtual
-// time only by this_process::advance(d) (this_process::delay(d) does the same
-// under this scheduler; csp::sleep_for always sleeps in wall time); every
-// channel operation takes zero virtual time, and a
-// process that blocks resumes at the virtual time of the process that woke it.
-//
-// VirtualTimeScheduler keeps every ready fiber under a key and always resumes
-// the one with the smallest key, ties in the order they became ready (FIFO):
-//   - advance(d): key = clock + d; it goes on at once if no other fiber is
-//     due before then, else it yields;
-//   - woken by another fiber (channel, ALT, PAR end): key = max(own clock,
-//     waker's clock);
-//   - on resumption the fiber's clock becomes its key.
-// Invariant: the running fiber's clock is the smallest key of all fibers that
-// can run, and it never decreases ("now" is monotone). Hence every message is
-// sent at "now", messages are sent in non-decreasing time order, and a
-// receiver reads each message at a time no earlier than it was sent (a receive
-// completes at the later of the receiver's clock and the send): no process
-// ever sees the future, and a process that merges several inputs (ALT) sees
-// only messages already sent by then. Contention falls out of the processes
-// themselves: a link process that carries one packet for latency + size/bw is
-// busy meanwhile, so the next packet waits in its queue.
-//
-// Determinism: the whole simulated program must run on ONE scheduler thread
-// (RuntimeOptions{.threads = 1}). The ready order is then a function of the
-// program alone — no OS scheduling, no cross-thread wake — so the same program
-// gives the same virtual times and statistics on every run. Wall time is not
-// the point of this mode. Real timers (read_for and read_until deadlines, ALT
-// timeout guards, csp::sleep_for) still use the wall clock and would break
-// determinism: virtual-time programs must not use them.
+// A process spends virtual time only by this_process::advance(d) (delay(d)
+// does the same here; csp::sleep_for always sleeps in wall time); a channel
+// operation takes none. VirtualTimeScheduler resumes the ready fiber with the
+// smallest key, FIFO among equals: advance(d) keys it at clock + d, a wake by
+// another fiber at max(own clock, waker's clock), and on resumption its clock
+// becomes its key. Invariant: the running fiber's clock is the smallest key
+// of all that can run, and never decreases. Determinism needs ONE runtime
+// thread (RuntimeOptions{.threads = 1}) and no wall-clock timers (read_for and
+// read_until deadlines, ALT timeouts, sleep_for): its programs use none.
 #pragma once
 
 #include <atomic>

@@ -25,6 +25,10 @@ bool launched_by_mpi() {
   return false;
 }
 
+// MPI_THREAD_SERIALIZED: during the run the MPI calls come from the bridge,
+// a fiber on one of the runtime's threads, which is not the main thread, so
+// FUNNELED is not enough; the main thread waits for the runtime meanwhile,
+// and never two threads call at once, so MULTIPLE is not needed.
 MpiSession::MpiSession(int& argc, char**& argv) {
   int provided = MPI_THREAD_SINGLE;
   check(MPI_Init_thread(&argc, &argv, MPI_THREAD_SERIALIZED, &provided), "MPI_Init_thread");
@@ -49,6 +53,8 @@ void MpiSession::abort(int code) {
   std::_Exit(code);
 }
 
+// A communicator of its own, so that nothing else in the process can match
+// the transport's messages.
 MpiTransport::MpiTransport() {
   check(MPI_Comm_dup(MPI_COMM_WORLD, &comm_), "MPI_Comm_dup");
   MPI_Comm_set_errhandler(comm_, MPI_ERRORS_RETURN);
@@ -78,6 +84,10 @@ void MpiTransport::post(int to, nodes::Tag tag, nodes::Bytes message) {
   buffers_.push_back(std::move(message));
 }
 
+// Open MPI moves messages only inside MPI calls (no asynchronous progress
+// thread), so the bridge calls this often enough: after every packet it
+// takes and at least every millisecond while idle. The message is there once
+// MPI_Improbe finds it, so MPI_Mrecv of the probed size returns at once.
 std::optional<nodes::Incoming> MpiTransport::poll(nodes::Tag tag) {
   int found = 0;
   MPI_Message message;

@@ -3,22 +3,14 @@
 //
 // Thread level: MPI_THREAD_SERIALIZED. MPI_Init_thread and MPI_Finalize run
 // on the main thread (MpiSession); during the run every other call comes
-// from the rank's bridge process (nodes/bridge.hpp), a fiber on one of the
-// runtime's threads, which is not the main thread — so FUNNELED is not
-// enough — while the main thread waits for the runtime; never two threads
-// at once, so MULTIPLE is not needed.
-//
-// Progress: Open MPI moves messages only inside MPI calls (no asynchronous
-// progress thread), and a fiber blocked in MPI would stall its whole OS
-// thread, so only non-blocking calls are made: MPI_Isend, MPI_Improbe with
-// MPI_Mrecv of the probed size (the message is there, so Mrecv returns at
-// once), and MPI_Testsome. The bridge calls them often enough: after every
-// packet it takes and at least every millisecond while idle.
-//
-// Order: one communicator (a duplicate of MPI_COMM_WORLD, so nothing else
-// in the process can match our messages), one tag per Tag; MPI does not let
-// messages between one pair of ranks on one communicator and tag overtake
-// one another, which is the order Transport promises.
+// from the rank's bridge process (nodes/ranks/bridge.hpp), a fiber on a
+// runtime thread, never two threads at once. Only non-blocking calls are
+// made (MPI_Isend, MPI_Improbe with MPI_Mrecv of the probed size,
+// MPI_Testsome): a fiber blocked in MPI would stall its whole OS thread.
+// Order: one communicator (a duplicate of MPI_COMM_WORLD), one tag per Tag;
+// MPI keeps the messages between one pair of ranks on one communicator and
+// tag in order, which is the order Transport promises. Why these choices:
+// mpi_transport.cpp.
 #pragma once
 
 #include <mpi.h>

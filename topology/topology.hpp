@@ -1,6 +1,5 @@
 // Interconnection graphs of a distributed-memory machine: hypercube, 2-D mesh,
 // 2-D torus, bidirectional ring and complete graph, as small value types.
-//
 // Invariants:
 // - Nodes are 0..size()-1; size() is between 1 and max_nodes.
 // - Ports of node n are dense, 0..degree(n)-1, and neighbour(n, p) names the

@@ -1,30 +1,18 @@
 // The paged scene database: the seam between the tracer and a (distributed)
-// shared virtual memory.
-//
-// build_database() triangulates the Scene, builds the acceleration structure
-// (BVH or uniform grid) and packs everything the tracer reads while tracing —
-// primitives, smooth-shading normals, materials, BVH nodes, grid cells and
-// their object lists — into fixed-size pages. What every processor needs
-// before tracing (camera, background, lights, layout of the arrays, counts)
-// is the small DatabaseHeader, replicated everywhere and read directly.
-//
+// shared virtual memory. build_database() triangulates the Scene, builds the
+// acceleration structure (BVH or uniform grid) and packs everything the
+// tracer reads while tracing (primitives, smooth-shading normals, materials,
+// BVH nodes, grid cells and their object lists) into fixed-size pages; the
+// small DatabaseHeader (camera, background, lights, array layout, counts) is
+// replicated everywhere and read directly. The tracer reads pages through a
+// PageSource, whose contract is at its class.
 // Layout invariants:
-//  - Each array (see Section) holds fixed-size records whose size is a power
-//    of two <= 256 bytes, and begins on a page boundary; page_size is a power
-//    of two >= 256, so no record ever straddles two pages.
-//  - References between records are array indices (global object ids), never
-//    pointers; record i of a section lives in page first_page + i*size/page_size
-//    at offset (i*size) % page_size.
-//  - Packing is deterministic and the acceleration structure is built before
-//    packing, so the floats the tracer computes with do not depend on page size
-//    (the treelet layout numbers BVH nodes by pages, but the tree is the same),
-//    nor on BuildOptions::threads: every thread count gives the same pages.
-//
-// PageSource contract: the pointer returned by page(id) is valid only until
-// the next call to page() on the same source; readers copy out (memcpy) what
-// they need before their next page() call and never keep a page pointer
-// across one. So a source may evict any page inside page() (a one-page cache
-// is enough), and fibers sharing a node's cache may switch inside page().
+//  - Each array (Section) holds fixed-size records of a power of two <= 256
+//    bytes and begins on a page boundary; page_size is a power of two >= 256,
+//    so no record straddles two pages: record i of a section lives in page
+//    first_page + i*size/page_size at offset (i*size) % page_size.
+//  - References between records are array indices, never pointers; packing
+//    is deterministic (details at build_database()).
 #pragma once
 
 #include <cstddef>
@@ -42,6 +30,11 @@ namespace tracer {
 using PageId = std::uint32_t;
 
 // Where the tracer's reads go; the only access to the packed database.
+// Contract: the pointer returned by page(id) is valid only until the next
+// call to page() on the same source; readers copy out (memcpy) what they
+// need before their next page() call and never keep a page pointer across
+// one. So a source may evict any page inside page() (a one-page cache is
+// enough), and fibers sharing a node's cache may switch inside page().
 class PageSource {
  public:
   virtual ~PageSource() = default;
@@ -193,6 +186,11 @@ struct Database {
 
 // Builds and packs; throws DatabaseError for a bad page size or a scene too
 // large for 32-bit references, std::invalid_argument for an empty camera.
+// References between records are array indices (global object ids). Packing
+// is deterministic and the acceleration structure is built before packing,
+// so the floats the tracer computes with do not depend on page size (the
+// treelet layout numbers BVH nodes by pages, but the tree is the same), nor
+// on BuildOptions::threads: every thread count gives the same pages.
 Database build_database(const Scene& scene, const BuildOptions& options = {});
 
 // The single-process page source: every page in memory, shared read-only.

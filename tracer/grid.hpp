@@ -11,10 +11,7 @@
 //  - A list cell's primitives are lists[first .. first + count), ascending ids.
 //  - Primitives are renumbered in the order the cells first list them
 //    (`order`), so the primitives of a cell lie side by side in their pages.
-//  - A cell's box is grid_cell_box(parent box, parent dims, its coordinates),
-//    the same float arithmetic in the builder and the tracer; a primitive is
-//    listed in every cell of a level that its box overlaps by grid_cell_range
-//    and that the primitive itself may overlap (a conservative test).
+//  - Builder and tracer compute a cell's box alike (grid_cell_box, below).
 //  - The build is sequential and depends only on its inputs.
 #pragma once
 
@@ -47,7 +44,11 @@ GridBuild build_grid(const std::vector<PrimRecord>& prims, const std::vector<Box
 // The cell index range [lo, hi] along each axis overlapped by box b.
 void grid_cell_range(const Box3f& bounds, const int dims[3], const Box3f& b, int lo[3], int hi[3]);
 
-// The box of cell `cell` of a grid of `dims` cells over `bounds`.
+// The box of cell `cell` of a grid of `dims` cells over `bounds`: a cell's
+// box is grid_cell_box(parent box, parent dims, its coordinates), the same
+// float arithmetic in the builder and the tracer; a primitive is listed in
+// every cell of a level that its box overlaps by grid_cell_range and that
+// the primitive itself may overlap (a conservative test).
 inline Box3f grid_cell_box(const Box3f& bounds, const int dims[3], const int cell[3]) {
   Box3f b;
   for (int a = 0; a < 3; ++a) {

@@ -3,24 +3,7 @@
 // invariant listed in scene.hpp or throws SceneError with one line
 // "SOURCE:LINE: expected ..., got ...". It never pre-allocates from a count
 // read from the input, so a lying count costs nothing but an error at EOF.
-// Choices where the format is silent:
-//  - objects before any "f" get a default material (white, Kd 1, nothing else);
-//  - a polygon or patch whose first three vertices are collinear (or
-//    coincide), or form a reflex corner (turning against the winding of the
-//    whole polygon, by its area normal), is an error, since those vertices fix
-//    its normal;
-//  - a polygon or patch with a vertex farther than kPlanarityTolerance times
-//    its bounding-box diagonal from its plane (through its first vertex, with
-//    its area normal) is an error: it is not planar;
-//  - a transmitting material (T > 0) needs an index of refraction above 0;
-//  - a second "v" is an error (a scene has one camera);
-//  - a cone may have one zero radius (a true cone), not both;
-//  - resolution is capped at kMaxResolution per axis;
-//  - numbers and counts may carry one leading '+'; a number too small for a
-//    double is read as zero, one too large is an error;
-//  - a lone CR ends a line (old Mac files), as do LF and CRLF;
-//  - gzip input (by magic bytes) is inflated as it is read, up to
-//    kMaxInflatedBytes; zero bytes after it (block padding) are ignored.
+// Where the format is silent, the choices made are listed at parse_nff().
 #pragma once
 
 #include <cstddef>
@@ -43,6 +26,25 @@ inline constexpr int kMaxResolution = 16384;
 inline constexpr std::size_t kMaxInflatedBytes = std::size_t{1} << 30;
 inline constexpr double kPlanarityTolerance = 1e-3;
 
+// Choices where the format is silent:
+//  - objects before any "f" get a default material (white, Kd 1, nothing else);
+//  - a polygon or patch whose first three vertices are collinear (or
+//    coincide), or form a reflex corner (turning against the winding of the
+//    whole polygon, by its area normal), is an error, since those vertices fix
+//    its normal;
+//  - a polygon or patch with a vertex farther than kPlanarityTolerance times
+//    its bounding-box diagonal from its plane (through its first vertex, with
+//    its area normal) is an error: it is not planar;
+//  - a transmitting material (T > 0) needs an index of refraction above 0;
+//  - a second "v" is an error (a scene has one camera);
+//  - a cone may have one zero radius (a true cone), not both;
+//  - resolution is capped at kMaxResolution per axis;
+//  - numbers and counts may carry one leading '+'; a number too small for a
+//    double is read as zero, one too large is an error;
+//  - a lone CR ends a line (old Mac files), as do LF and CRLF;
+//  - gzip input (by magic bytes) is inflated as it is read, up to
+//    kMaxInflatedBytes; zero bytes after it (block padding) are ignored.
+//
 // Parses NFF text (or gzip-compressed NFF text) held in memory.
 Scene parse_nff(std::string_view text, const std::string& source_name);
 

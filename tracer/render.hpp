@@ -1,5 +1,6 @@
 // Whitted ray tracing over a paged database: the code a processor runs to turn
-// a pixel (or an SPD corner sample) into a colour.
+// a pixel (or an SPD corner sample) into a colour; the shading model is
+// described at class Tracer.
 //
 // Invariants:
 //  - A Tracer reads the scene only through its PageSource (plus the replicated
@@ -10,18 +11,6 @@
 //    contents: no global state, no random numbers, so an image is identical
 //    however its pixels are distributed over tracers, and for every page size.
 //  - A Tracer is single-threaded; use one per fiber or thread.
-//
-// Shading (NFF): per positional light, Kd * colour * (N.L) + Ks * (R.V)^Shine,
-// no ambient term; light intensity 1/sqrt(#lights) (SPD's convention).
-// Shadow rays: every object, transmitting ones included, blocks light fully
-// (as SPD-style renderers do); no shadow ray where N.L <= 0 unless
-// shadow_rays_to_all_lights (which changes the counts, never the image).
-// Reflection (weight Ks) when Ks > 0; refraction (weight T, Snell's law, IOR
-// of the material inside, 1 outside) when T > 0; under total internal
-// reflection the T weight goes to the reflection ray. Surfaces are two-sided:
-// the shading normal is turned to face the incoming ray. Outside SPD mode a
-// secondary ray is skipped when its weight along the path falls below
-// min_contribution.
 #pragma once
 
 #include <functional>
@@ -49,6 +38,17 @@ struct Hit {
   PrimRecord prim{};
 };
 
+// Shading (NFF): per positional light, Kd * colour * (N.L) + Ks * (R.V)^Shine,
+// no ambient term; light intensity 1/sqrt(#lights) (SPD's convention).
+// Shadow rays: every object, transmitting ones included, blocks light fully
+// (as SPD-style renderers do); no shadow ray where N.L <= 0 unless
+// shadow_rays_to_all_lights (which changes the counts, never the image).
+// Reflection (weight Ks) when Ks > 0; refraction (weight T, Snell's law, IOR
+// of the material inside, 1 outside) when T > 0; under total internal
+// reflection the T weight goes to the reflection ray. Surfaces are two-sided:
+// the shading normal is turned to face the incoming ray. Outside SPD mode a
+// secondary ray is skipped when its weight along the path falls below
+// min_contribution.
 class Tracer {
  public:
   // header and pages must outlive the Tracer.

@@ -1,20 +1,16 @@
 // A picture of the machine after a render, drawn with cairo and written as
-// SVG, PNG or PDF: every processor as a node
-// filled by the pixels it computed, ringed by the page requests it served, and
-// every directed link coloured and sized by the traffic it carried.
-// Layouts: hypercube bits alternate between x (even bits) and y (odd bits)
-// with gaps growing per level, so sub-cubes stand apart; mesh and torus on a
-// grid with node id = y * W + x (wrap links as arcs leaving the border); ring
-// and complete graph on a circle, node 0 at the top, ids clockwise.
-// The picture grows with the layout, up to a bound, so that node labels stay
-// legible (at least 10 px for every kind up to 64 nodes).
-// Invariants: one disk per node, filled by the work scale. Up to 4096 listed
-// links (every machine of up to 64 nodes): one stroke per directed link that
-// carried packets (the two directions of a link are drawn side by side, each
-// offset to the right of its direction of travel), heaviest on top, and a
-// thin grey one per listed link that carried none. More links than that are
-// drawn in bulk: busy links grouped by traffic into at most 16 strokes, idle
-// links left out and counted in the legend.
+// SVG, PNG or PDF: every processor a disk filled by the pixels it computed
+// and ringed by the page requests it served, every directed link coloured
+// and sized by its traffic. Layouts: a hypercube's even bits along x and
+// odd bits along y, gaps growing per level; mesh and torus on their grid
+// (id = y * W + x, wrap links as arcs leaving the border); ring and complete
+// graph on a circle, node 0 at the top, ids clockwise. The picture grows
+// with the layout, up to a bound, so labels stay legible (10 px at least up
+// to 64 nodes). Invariants: one disk per node; up to 4096 listed links, one
+// stroke per directed link that carried packets (the two directions side by
+// side, heaviest on top) and a thin grey one per idle link; more links are
+// drawn in bulk, busy ones grouped by traffic into at most 16 strokes, idle
+// ones left out and counted in the legend.
 #pragma once
 
 #include <cstdint>

@@ -6,26 +6,13 @@
 // advances. A process is counted blocked just before it parks (under the
 // lock of a channel it waits on); the party that claims it uncounts it
 // before waking it, in the word of the process's thread. Timed waits are
-// never counted. A process's own block and end touch only its thread's
-// word, so threads that each wake their own processes never contend for it.
-//
-// Work that threads hand each other outside channels (csp::Arrivals) is
-// seen too: a survey that finds an Arrivals pending between its two reads
-// says the run goes on, since the handler will wake a process for it.
-//
-// `blocked == alive > 0` over the whole run means no process can run and
-// nobody will wake one: the state is stable. Only a process that makes its
-// own thread's word all blocked (by blocking, or by ending) can complete
-// that state, so only it surveys the other words: it reads them all twice,
-// and if the versions of both reads add up the same, no word changed between
-// them, so all were true at one instant. The last thread to reach the state sees the
-// others', since its update precedes its reads in the single order of
-// sequentially consistent operations. A survey that finds every word all
-// blocked aborts the run; one that finds nothing alive ends it (once,
-// though the last processes of two threads may both see it). Abort is
-// one-shot: it writes the dump, then claims every parked abortable waiter
-// with `aborted`; from then on every park returns `aborted` at once, so all
-// processes unwind.
+// never counted, and a pending csp::Arrivals counts as a process able to run.
+// `blocked == alive > 0` over the whole run is a deadlock: the process that
+// completes that state finds it (survey(), in tracker.cpp) and aborts the
+// run, once: the dump is written, every parked abortable waiter is claimed
+// with `aborted`, and every later park returns `aborted` at once, so all
+// processes unwind. Nothing alive ends the run. Every thread updates the
+// words with atomics; a process's own block and end touch only its own.
 #pragma once
 
 #include <atomic>

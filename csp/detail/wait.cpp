@@ -142,6 +142,10 @@ void ChannelBase::wake_all_locked(RecordQueue& q, WaitState outcome) {
   while (Record* r = claim_front_locked(q)) complete(*r->waiter, outcome, r->guard);
 }
 
+// A CAS from `waiting`, so exactly one party wins even when several channels
+// fire at once. Claims happen under the lock of the channel whose queue holds
+// the record, so a woken waiter that relocks its channels knows every
+// claimer has finished with it.
 bool try_claim(Waiter& w) {
   WaitState expected = WaitState::waiting;
   return w.state.compare_exchange_strong(expected, WaitState::claiming, std::memory_order_acq_rel);
@@ -198,6 +202,13 @@ namespace {
 
 // For a timed wait, or an untimed one of no process: false, with w refused,
 // for a thread outside any Runtime; fibers there (par()'s children) may park.
+// Who may park: the fibers of a runtime thread, and outside any Runtime the
+// fibers that par() starts, which wake each other. A thread outside any
+// Runtime (main(), a std::thread) may not: no process can be relied on to
+// wake it, and no deadlock detector sees it, so it would hang. The check sits
+// on the branch arm() takes anyway for a wait of no process (and for timed
+// waits), so that a process's untimed wait pays nothing for it; the caller
+// then unlinks and throws std::logic_error (unwind_wait()).
 bool may_park(Waiter& w, boost::fibers::context* ctx) {
   if (runtime_scheduler || !ctx->is_context(boost::fibers::type::main_context)) return true;
   w.state.store(WaitState::refused, std::memory_order_relaxed);

@@ -2,30 +2,17 @@
 //
 // A fiber that must block builds one Waiter on its stack and links one Record
 // per channel it waits on into that channel's reader or writer queue (a plain
-// read or write: one record; an ALT: one record per enabled input guard).
-// Whoever makes the wait succeed — a writer, a reader, poison, the deadlock
-// detector — must *claim* the Waiter first: a CAS from `waiting`, so exactly
-// one party wins even when several channels fire at once. The winner fills
-// the payload, then complete() publishes the outcome and reschedules the
-// waiter's context (locally, or through Boost's remote-ready queue when the
-// waiter lives on another thread).
-//
-// Locking contract: records are linked, unlinked and claimed only under the
-// lock of the channel whose queue holds them, so a woken waiter that relocks
-// its channels knows every claimer has finished with it. The deadlock
-// detector claims without a channel lock but only untimed waiters, which
-// cannot run before they are rescheduled.
-//
-// Deadlock accounting: an untimed park of a process counts it as blocked; the
-// claimer uncounts it before rescheduling (see Tracker in detail/process.hpp).
-//
-// Who may park: the fibers of a runtime thread, and outside any Runtime the
-// fibers that par() starts, which wake each other. A thread outside any
-// Runtime (main(), a std::thread) may not: no process can be relied on to
-// wake it, and no deadlock detector sees it, so it would hang. arm() refuses
-// it (on the branch it takes anyway for a wait of no process, so that a
-// process's untimed wait pays nothing for the check, and for timed waits),
-// and the caller unlinks and throws std::logic_error (unwind_wait()).
+// read or write: one record; an ALT: one per enabled input guard). Whoever
+// makes the wait succeed (a writer, a reader, poison, the deadlock detector)
+// must *claim* the Waiter first, by a CAS from `waiting`: exactly one wins,
+// fills the payload, and complete() publishes the outcome and reschedules the
+// waiter (locally, or through Boost's remote-ready queue from another thread).
+// Locking: records are linked, unlinked and claimed only under the lock of
+// the channel whose queue holds them; the deadlock detector claims without
+// one, but only untimed waiters, which cannot run before they are
+// rescheduled. An untimed park counts the process as blocked; its claimer
+// uncounts it (Tracker, detail/process.hpp). Only fibers may park: a thread
+// outside any Runtime is refused (arm()) and gets std::logic_error.
 #pragma once
 
 #include <atomic>

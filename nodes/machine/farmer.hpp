@@ -1,21 +1,16 @@
 // The farmer (pixel server) on node 0: hands out tiles on request, passes
-// results on to the frame collector and runs the orderly end of the machine
-// (the protocol is in machine.hpp).
+// results on to the frame collector and runs the orderly end of the machine.
 //
-// Reads Ports::farmer on node 0:
-//   work_request {port, t} from (s, port) -> t answers, each work {tile} or
-//                                            stop, to (s, port)
-//   result {port, tile, colours}          -> one answer to (s, port), then
-//                                            the packet to the collector
-//   worker_done                           -> count; after the last one,
-//                                            server_stop to every page server
-//   server_done                           -> count
-// Answers to one worker go out in the order asked, and once the plan has no
-// tile for a worker it never has one again: after a stop only stops follow.
-// Ends once every worker and every page server is done: then nothing is in
-// flight and every result has gone to the collector (a worker's results
-// precede its worker_done on the same route). It checks that the results
-// cover the frame, and calls on_quiet (the network's shutdown).
+// Reads Ports::farmer on node 0: a work_request for t tiles gets t answers
+// and a result one (each work, or stop once the plan has no tile for that
+// worker), sent to the asking port; each result then goes on to the
+// collector. It counts worker_done, sends server_stop to every page server
+// after the last one, and counts server_done. Answers to one worker go out
+// in the order asked, and after a stop only stops follow. It ends once every
+// worker and every page server is done, when nothing is in flight and every
+// result has gone to the collector: it checks that the results cover the
+// frame and calls on_quiet (the network's shutdown). The protocol:
+// docs/architecture.md, "Messages" and "The orderly end".
 #pragma once
 
 #include <cstdint>

@@ -1,4 +1,4 @@
-// The VM_pRAY machine (see machine.hpp for the protocol). A run is three
+// The VM_pRAY machine (its protocol: docs/architecture.md). A run is three
 // steps, each a few functions below: build (the pages moved to their owners,
 // the runtime, the network and every process on it), run (the runtime to its
 // end, and what ended it in the machine's terms: ResourceError, RankFailure)
@@ -123,7 +123,8 @@ struct Wiring {
   }
 };
 
-// The packets the protocol lets be outstanding (machine.hpp): for a page
+// The packets the protocol lets be outstanding (docs/architecture.md, "Why
+// the network cannot deadlock"): for a page
 // server, one request per sending process of the machine and its
 // server_stop; for the farmer, P + 1 per worker and one per page server.
 std::size_t page_requests_bound(std::size_t nodes, int workers_per_node) {

@@ -2,42 +2,16 @@
 // over them as object pages in a shared virtual memory, pixels farmed out on
 // demand, everything carried by the store-and-forward network.
 //
-// Processes of processor n, all on the OS thread of n's router:
-//   page server                      Ports::page_server
-//   pixel computers w = 0..k-1       Ports::first_worker + w
-// and on node 0 only:
-//   farmer                           Ports::farmer
-//   frame collector                  fed by the farmer over a local channel
-// The host's copy of the database is moved into the owners before the run:
-// page p lives only on its owner and in caches.
-//
-// Work (pixel_computer.hpp): a worker asks for P + 1 tiles at start (P =
-// prefetch) and each result it sends asks for one more, so it always has the
-// next tile coming while it traces: two messages per tile, plus one request
-// per worker.
-//
-// Orderly end (no message lost, none left in flight, no fiber blocked):
-//  1. The farmer answers every tile asked for with work until the plan is
-//     exhausted, then with stop, and passes each result to the collector.
-//  2. A worker ends once all P + 1 answers it is owed are in; by then its
-//     results are sent and all its page requests answered. It sends
-//     worker_done, which reaches the farmer after its results (packets
-//     between two processes keep their order).
-//  3. After the last worker_done no page request exists anywhere, so the
-//     farmer sends server_stop to every page server; each answers
-//     server_done and ends.
-//  4. With N*k worker_done and N server_done received, every packet sent
-//     has been read and every result passed on: the farmer checks that the
-//     results cover the frame and calls Network::shutdown(), which ends
-//     routers, links and the mailboxes; the collector ends with the frame.
-// Buffer bounds: each packet of a worker not yet read by the farmer carries
-// a tile still owed to it, so at most P + 1 per worker and one per page
-// server are outstanding for the farmer (N*k*(P+1) + N); at most N*k page
-// requests for a page server (one per worker, plus its server_stop), which
-// size their ports (with a link model, their mailboxes). Whenever a worker
-// does not read its port (it traces, or sends), at most P answers and one
-// page reply are on their way to it, which must fit the network's delivery
-// buffer (so P < buffer capacity).
+// Processes of processor n, all on the OS thread of n's router: the page
+// server (Ports::page_server) and pixel computers w = 0..k-1
+// (Ports::first_worker + w); on node 0 also the farmer (Ports::farmer) and
+// the frame collector, fed by the farmer over a local channel. The host's
+// copy of the database is moved into the owners before the run: page p lives
+// only on its owner and in caches. A run ends in order, with no packet lost
+// or in flight and no fiber blocked, and P (prefetch) < the network's buffer
+// capacity keeps every delivery port draining. The protocol, its end and the
+// buffer bounds are in docs/architecture.md: "One processor", "The path of
+// one pixel", "The orderly end" and "Why the network cannot deadlock".
 #pragma once
 
 #include <cstdint>
@@ -108,7 +82,8 @@ constexpr std::uint32_t max_grain = 1u << 20;
 constexpr int max_workers_per_node = 64;
 
 // The most tiles a worker may keep asked for ahead: its answers and a page
-// reply must fit the network's delivery buffer (see the buffer bounds above).
+// reply must fit the network's delivery buffer (docs/architecture.md, "Why
+// the network cannot deadlock").
 inline std::uint16_t max_prefetch(const MachineOptions& options) {
   return static_cast<std::uint16_t>(options.buffer_capacity - 1);
 }

@@ -9,20 +9,7 @@
 // with no padding and no counts; a result's colours and a page reply's
 // bytes run to the end of the payload. Decoding checks sizes and throws
 // std::runtime_error on a malformed payload rather than reading out of
-// bounds.
-//
-// Who sends what (see machine.hpp for the whole protocol):
-//   worker    -> farmer     work_request {reply port, tiles}   (once, at start)
-//   farmer    -> worker     work {first, count} | stop {}      (one per tile asked)
-//   worker    -> farmer     result {reply port, first, count, count x RGB
-//                           floats}: the colours, and a request for one tile
-//   worker    -> owner's page server  page_request {page, reply port}
-//   page srv  -> worker     page_reply {page, page bytes}
-//   worker    -> farmer     worker_done {}
-//   farmer    -> page srv   server_stop {}
-//   page srv  -> farmer     server_done {}
-// The farmer hands each result on to the frame collector over a local
-// channel of node 0 (not the network).
+// bounds. Who sends what, and when: docs/architecture.md, "Messages".
 #pragma once
 
 #include <cstddef>

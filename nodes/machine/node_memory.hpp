@@ -1,26 +1,16 @@
 // A processor's share of the scene database: its own pages (the pages it
 // owns) and an LRU cache of copies of remote pages. No fibers here; the
-// blocking part of the shared virtual memory is in svm.hpp.
-//
-// Pages are read-only while rendering, so a cached copy never goes stale and
-// no coherence protocol is needed: a page is fetched from its owner at most
-// once per residence in the cache, and the owner never has to invalidate it.
-//
+// blocking part of the shared virtual memory is in svm.hpp. Pages are
+// read-only while rendering, so a cached copy never goes stale: a page is
+// fetched at most once per residence in the cache, and never invalidated.
 // Invariants:
-//  - entry_[p] says where page p lives on this node, so one array load
-//    answers every access: >= 0 own page (its index among the own pages,
-//    which lie end to end in one block), -1 not here, <= -2 cache slot
-//    (-2 - entry).
-//  - the occupied slots form one list in order of use, most recent first
-//    (each slot links to its neighbours by index): a hit on the most recent
-//    slot changes nothing, any other hit moves its slot to the front, and an
-//    install into a full cache evicts from the back, all in O(1).
-//  - a slot named in install()'s `in_use` is never evicted: the node's
-//    workers each name the slot whose bytes they are using, so one worker's
-//    install cannot pull them away from another; the victim is the least
-//    recently used slot not named (at most |in_use| + 1 steps from the back).
-//  - resident bytes = own pages + occupied slots; slots are allocated on
-//    first use and never exceed the cache capacity.
+//  - entry_[p] says where page p lives on this node, in one array load:
+//    >= 0 own page (its index among the own pages, which lie end to end in
+//    one block), -1 not here, <= -2 cache slot (-2 - entry).
+//  - the occupied slots form one list by use, most recent first: a hit and
+//    an install (evicting from the back) take O(1).
+//  - a slot named in install()'s `in_use` is never evicted; resident bytes
+//    = own pages + occupied slots, allocated on first use, at most capacity.
 // A node's workers are fibers on one OS thread and run one at a time, and no
 // member function suspends, so no lock is needed.
 #pragma once
@@ -80,8 +70,11 @@ class NodeMemory {
 
   // Copies a fetched remote page into a free slot or the least recently
   // used one not named in `in_use`, and returns that slot, now the most
-  // recently used. Throws std::logic_error if every slot is in use (cannot
-  // happen: see svm.hpp).
+  // recently used. The node's workers each name in `in_use` the slot whose
+  // bytes they are using, so one worker's install cannot pull them away from
+  // another; the victim is found at most |in_use| + 1 steps from the back.
+  // Throws std::logic_error if every slot is in use (cannot happen: see
+  // docs/architecture.md, "The path of one page request").
   int install(std::uint32_t page, std::span<const std::byte> bytes, std::span<const int> in_use = {});
 
   // Miss coalescing: begin_fetch is true for the first worker to miss on a
@@ -101,6 +94,9 @@ class NodeMemory {
   struct Slot {
     std::unique_ptr<std::byte[]> bytes;  // page_size_ bytes, allocated on first use
     std::uint32_t page = 0;
+    // The use list links slots by index: a hit on the most recent slot
+    // changes nothing, any other hit moves its slot to the front, and an
+    // install into a full cache evicts from the back.
     int newer = -1;  // the slot used just after this one; -1: this is the front
     int older = -1;  // the slot used just before; -1: this is the back
   };

@@ -1,30 +1,17 @@
 // A pixel computer: one fiber that asks the farmer for work, traces it
 // through its node's shared virtual memory and sends the colours back. A
-// processor runs one or more (MachineOptions::workers_per_node), so page waits of one
-// overlap with tracing by another.
+// processor runs one or more (MachineOptions::workers_per_node), so page
+// waits of one overlap with tracing by another.
 //
-// Protocol, on its own local port (Ports::first_worker + w), with prefetch P:
-//   -> farmer     work_request {my port, P + 1 tiles}       (once)
-//   <- farmer     work {first, count}  |  stop              (one per tile asked)
-//   -> farmer     result {my port, first, count, colours}   (after each work;
-//                 it also asks for one more tile)
-//   -> farmer     worker_done                               (once every answer
-//                 is in; then ends)
-// So P + 1 answers are always owed to the worker: with P >= 1 the next tile
-// is already on its way while it traces the current one. The farmer answers
-// in order and never sends work after a stop, so after the first stop only
-// stops follow and every result is sent before worker_done.
-// While tracing, a cache miss sends page_request to the page's owner and
-// reads this same port for the page_reply (make_page_fetch); answers of the
-// farmer that arrive meanwhile are kept, in order, for later. While the
-// worker traces or sends, at most P answers and one page reply are on their
-// way to the port; the machine keeps that within the network's delivery
-// buffer, so the port drains whenever the worker blocks.
-// On several threads the machine runs pixel computers at low priority and
-// the processes that move messages at high priority, as on a transputer,
-// and a pixel computer yields every `timeslice` items, so that a long run of
-// pixels free of misses does not hold up the routers and page servers of its
-// thread while pixel computers on other threads wait for them.
+// It reads only its own local port (Ports::first_worker + w): the farmer's
+// work and stop answers, P + 1 always owed to it (P = prefetch), and the
+// page_reply to each of its misses (make_page_fetch); answers that arrive
+// while it waits for a page are kept, in order, for later. It sends a result
+// after each tile and worker_done once every answer is in, then ends. On
+// several threads it runs at low priority and yields every `timeslice`
+// items. The protocol and why the port drains: docs/architecture.md ("The
+// path of one pixel", "The path of one page request", "Messages", "Why the
+// network cannot deadlock").
 #pragma once
 
 #include <cstdint>

@@ -2,14 +2,12 @@
 // numbered, and so the shape of a tile: a tile is always a contiguous run of
 // item numbers (work_plan.hpp), and the order decides where on the frame
 // that run lies.
-//
 //  - scanline: item i is pixel (i mod W, i div W), as in the paper; a tile
 //    is a piece of a row.
 //  - hilbert: items follow a generalised Hilbert curve over the W x H frame,
 //    so that any run of items — a dynamic tile, a static or affinity share —
 //    is a compact patch of the frame rather than a band. Neighbouring rays
 //    then share more pages, and a processor's cache holds its patch.
-//
 // Invariants: item_positions() is a permutation of 0 .. W*H-1 (each
 // scanline position exactly once); consecutive hilbert items are at most one
 // step apart (a diagonal step only where W or H is odd); on a 2^k x 2^k

@@ -3,26 +3,15 @@
 // on, the pages each page server served, and (from the tile spans) what each
 // pixel computer traced when.
 //
-// Recording: one NodeLog per node, written only by that node's processes
-// (its router through the RouteLog it extends, net/route_log.hpp, its page
-// server and pixel computers, all on the node's thread), so the hot path
-// takes no lock. A process that records nothing pays one branch on a null
-// pointer (the router's log_, the page server's recorder_).
-//
-// Bound: the first max_packets packets injected are recorded hop by hop
-// (under virtual time the first in virtual time; in real time the first
-// each router's thread got to, which on several threads is not quite the
-// order of their times); later packets are only counted, per kind, with
-// their hops, where they are delivered. Waits for pages and serves are
-// recorded while that budget lasts (begun in the window), later ones only
-// counted; hit samples go one per tile, as the tiles themselves.
-//
+// One NodeLog per node, written only by that node's processes (its router
+// through the RouteLog it extends, net/route_log.hpp, its page server and
+// pixel computers, all on the node's thread): no lock. The first max_packets
+// packets injected are recorded hop by hop, later ones only counted per kind.
 // Invariants of a merged Recording (merge_recording checks them and throws
-// std::logic_error otherwise): each packet's route starts at its source and
-// ends at its destination, consecutive nodes are neighbours, and its times
-// (injected, then a departure and an arrival per hop, then delivered) never
-// decrease. Packets recorded and packets counted together are every packet
-// delivered, which the tests hold against the routers' own counters.
+// std::logic_error otherwise): each packet's route runs from its source to
+// its destination through neighbours, its times never decrease, and packets
+// recorded and counted together are every packet delivered. What is recorded
+// and what it costs: docs/architecture.md, "The recorder and the replay".
 #pragma once
 
 #include <array>

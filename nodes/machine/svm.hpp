@@ -5,25 +5,13 @@
 // by a page request to the owner's page server: only the requesting fiber
 // blocks (inside PageFetch, on the network) until the page arrives and is
 // installed in the cache, evicting the least recently used unpinned page.
-// Pages are read-only during rendering: no coherence protocol.
-//
-// Who wakes whom: the first worker of a node to miss on page p fetches it;
-// a second worker missing on p while that fetch is pending does not send
-// another request but waits on its own wake channel (capacity 1), which the
-// fetcher writes once p is installed; the woken worker looks p up again
-// (and fetches it itself if it was evicted in between).
-//
-// Page lifetime: a worker's pin is the cache slot it last returned, so
-// another worker's install never evicts bytes still in use (the page()
-// contract is "valid until the next page() call on this source"): an install
-// passes the node's pinned slots to NodeMemory, which evicts none of them. A
-// worker drops its pin before it blocks — at a miss, and by release() before
-// it talks to the farmer or collector. Since a node's fibers share one OS
-// thread and only the running fiber can hold a pin it is using, an
-// installing worker always finds a slot no one has pinned.
-//
-// A pin is one store into the worker's own source, so a cache hit costs a
-// table load, a stamp of the slot's last use and that store.
+// A second worker missing on a page already being fetched sends no request:
+// it waits on its own wake channel (capacity 1) for the fetcher to install
+// it. Pages are read-only during rendering: no coherence protocol. A
+// worker's pin is the cache slot it last returned, so no install evicts
+// bytes still in use; it drops the pin before it blocks. A node's fibers
+// share one OS thread, so nothing here is locked. The protocol, step by
+// step: docs/architecture.md, "The path of one page request".
 #pragma once
 
 #include <cstdint>

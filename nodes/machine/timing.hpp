@@ -1,26 +1,17 @@
 // Virtual timing of the machine: what a run would take on a real
 // distributed-memory computer with given per-operation costs.
 //
-// CostModel: the costs. Compute time is counted work times cost — BVH box
-// tests, ray-primitive tests, rays (set-up and shading), page-table
-// operations (PageSource accesses) — all scaled by one factor `unit`, the
-// constant fitted to a published time. A message costs, on every link it
-// crosses and on the delivery stage into the receiving process (store and
-// forward), hop + bytes / bandwidth; a link carries one message at a time.
-// A page server spends `serve` per request, and that time is taken from its
-// node's pixel computers too (on the iPSC/2 the handler interrupts them).
-// Every message sent or received by a pixel computer or a page server also
-// costs its processor `msg` (the message-passing kernel's software): two
-// per tile for a pixel computer (the work, and the result that asks for the
-// next), two per page request on each side (request and page).
-//
-// MachineTiming: the hooks that make a nodes::run_machine run charge those
-// costs under csp's virtual-time scheduler (csp/virtual_time.hpp): the whole
-// machine runs on one thread, each pixel computer advances its clock by the
-// cost of the work it counted since its last charge — before every page
-// request and after every tile — and links and page servers delay packets by
-// their costs. The predicted synthesis time is the virtual time at which the
-// run ends. Deterministic: the same run gives the same time and statistics.
+// CostModel holds the costs: counted work (BVH box tests, ray-primitive
+// tests, rays, page-table operations) scaled by one factor `unit`, the
+// constant fitted to a published time; per message, hop + bytes / bandwidth
+// on every link and on the delivery stage, and `msg` at each end in a pixel
+// computer or page server; `serve` per page request served, taken from its
+// node's pixel computers too. MachineTiming holds the hooks that make a
+// nodes::run_machine run charge those costs under csp's virtual-time
+// scheduler (csp/virtual_time.hpp): the whole machine runs on one thread, and
+// the predicted synthesis time is the virtual time at which the run ends.
+// Deterministic: the same run gives the same time and statistics. What is
+// charged when: docs/architecture.md, "Virtual time".
 #pragma once
 
 #include <cstdint>

@@ -58,7 +58,10 @@ Tile WorkPlan::take_front(Tile& share, std::uint32_t most) {
 }
 
 // What a steal may take of share i: all of it once its owner has started,
-// else all but the first tile its owner will take.
+// else all but the first tile its owner will take. Where shares are a tile
+// or two (small frames on many processors), a worker asking ahead would
+// otherwise take whole shares from processors that have not started, and
+// leave them idle.
 std::uint32_t WorkPlan::stealable(std::size_t i) const {
   const std::uint32_t count = shares_[i].count;
   if (started_[i]) return count;

@@ -4,9 +4,25 @@
 // Items are pixels, or SPD corner samples in SPD procedure mode, numbered in
 // the machine's pixel order (pixel_order.hpp). A tile is a run of numbers
 // so that its result is one contiguous range (a compact message); the order
-// decides whether that run is a piece of a row or a compact patch.
+// decides whether that run is a piece of a row or a compact patch. The
+// schedules (dynamic, static, affinity) are described at Schedule below.
 //
-// Schedules:
+// Invariants: every item is handed out exactly once over the plan's life
+// (every worker asks at least once, and its first request takes from its own
+// share); a share is always one contiguous run; dynamic tiles are at most
+// `grain` items; the plan's answers depend only on the order of requests.
+// A plan is used by the farmer alone and is not thread-safe.
+#pragma once
+
+#include <cstdint>
+#include <optional>
+#include <vector>
+
+#include "nodes/machine/messages.hpp"
+
+namespace nodes {
+
+// How tiles are handed out:
 //  - dynamic: tiles of `grain` items, in frame order, to whoever asks (the
 //    paper's pixel farming);
 //  - static: worker (node, w) gets one fixed share, the frame in N equal
@@ -19,24 +35,7 @@
 //    holds their pages, and big early tiles save farming messages; a worker
 //    whose share is used up takes 1/P of the largest share left, from its
 //    back. A share whose owner has not asked yet keeps the owner's first
-//    tile: where shares are a tile or two (small frames on many
-//    processors), a worker asking ahead would otherwise take whole shares
-//    from processors that have not started, and leave them idle.
-//
-// Invariants: every item is handed out exactly once over the plan's life
-// (every worker asks at least once, and its first request takes from its own
-// share); a share is always one contiguous run; dynamic tiles are at most
-// `grain` items; the plan's answers depend only on the order of requests.
-#pragma once
-
-#include <cstdint>
-#include <optional>
-#include <vector>
-
-#include "nodes/machine/messages.hpp"
-
-namespace nodes {
-
+//    tile (see WorkPlan::stealable in work_plan.cpp).
 enum class Schedule { dynamic, static_split, affinity };
 
 // The schedule's name: dynamic, static or affinity.

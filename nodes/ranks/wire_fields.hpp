@@ -1,28 +1,11 @@
 // Wire formats named once for both directions. A format is a field list in
-// namespace nodes, in wire order:
-//
-//   template <class V>
-//   void wire_fields(V& v, WireView<Tile> auto& t) { v(t.first); v(t.count); }
-//
-// put_fields() writes a value with it (FieldWriter, over a const value) and
-// get_fields() reads one back (FieldReader), so the two directions cannot
-// disagree and a field added to the list travels both ways.
-//
-// How one field travels (the encodings of WireWriter, transport.hpp):
-//  - a type with its own wire_fields: its fields in their order, no framing
-//    (a list wins over the raw bytes of a trivially copyable type);
-//  - bool: one uint8, 1 or 0 (any non-zero byte reads as true);
-//  - std::string, std::vector<T>: a uint64 count, then the elements: the
-//    bytes of trivially copyable T without a list as one block, others one
-//    by one by these rules;
-//  - a C array: its elements in turn, no count;
-//  - wire_as<W>(field): the field converted to W, read back and converted;
-//  - wire_joined(bytes, more): two runs of bytes as one counted sequence,
-//    read back into the first (the second left empty);
-//  - wire_rest(span): the bytes to the end of the message, no count; last
-//    only, and read as a view into the message;
-//  - any other trivially copyable type: its sizeof bytes as in memory.
-// Reading throws std::runtime_error (WireReader) where a message ends early.
+// namespace nodes, in wire order: a function template wire_fields(v, x) that
+// passes each field of x to v (an example at WireView below). put_fields()
+// writes a value with it (FieldWriter, over a const value) and get_fields()
+// reads one back (FieldReader), so the two directions cannot disagree and a
+// field added to the list travels both ways. How each kind of field travels
+// is listed below; reading throws std::runtime_error (WireReader) where a
+// message ends early.
 #pragma once
 
 #include <concepts>
@@ -37,7 +20,26 @@
 
 namespace nodes {
 
+// How one field travels (the encodings of WireWriter, transport.hpp):
+//  - a type with its own wire_fields: its fields in their order, no framing
+//    (a list wins over the raw bytes of a trivially copyable type);
+//  - bool: one uint8, 1 or 0 (any non-zero byte reads as true);
+//  - std::string, std::vector<T>: a uint64 count, then the elements: the
+//    bytes of trivially copyable T without a list as one block, others one
+//    by one by these rules;
+//  - a C array: its elements in turn, no count;
+//  - wire_as<W>(field): the field converted to W, read back and converted;
+//  - wire_joined(bytes, more): two runs of bytes as one counted sequence,
+//    read back into the first (the second left empty);
+//  - wire_rest(span): the bytes to the end of the message, no count; last
+//    only, and read as a view into the message;
+//  - any other trivially copyable type: its sizeof bytes as in memory.
+
 // The parameter of a field list: a T, const when written, not when read.
+// A field list, for example:
+//
+//   template <class V>
+//   void wire_fields(V& v, WireView<Tile> auto& t) { v(t.first); v(t.count); }
 template <class T, class Of>
 concept WireView = std::same_as<std::remove_const_t<T>, Of>;
 

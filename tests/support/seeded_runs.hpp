@@ -2,7 +2,6 @@
 // to run, the line that tells how to replay a failing one, a watchdog that
 // turns a hang into a failure, and seeded pauses for the processes at the
 // ends of what is tested.
-//
 // Invariants: the seeds follow the convention of
 // tests/nodes/machine/seeded_schedule_test.cpp: VMPRAY_SCHEDULE_SEEDS=N runs
 // N seeds per case (each test has its own default, a quarter of it in a
