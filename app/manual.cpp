@@ -11,6 +11,7 @@
 #include <utility>
 #include <vector>
 
+#include "app/network_study.hpp"
 #include "app/options.hpp"
 #include "app/sweep.hpp"
 #include "nodes/machine/pixel_order.hpp"
@@ -83,6 +84,9 @@ void write_head(std::ostream& out) {
          ".B vmpray sweep\n"
          "\\fBnodes\\fR|\\fBcache\\fR [\\fISCENE\\fR] [\\fIoptions\\fR]\n"
          ".br\n"
+         ".B vmpray network\n"
+         "[\\fIoptions\\fR]\n"
+         ".br\n"
          ".B mpirun\n"
          "[\\fImpirun options\\fR] \\fBvmpray\\fR [\\fISCENE\\fR] [\\fIoptions\\fR]\n"
          ".SH DESCRIPTION\n"
@@ -116,6 +120,20 @@ void write_sweep(std::ostream& out) {
   for (const SweepKindDoc& kind : sweep_kinds())
     out << ".TP\n.B " << roff(kind.name) << "\n" << roff(kind.description) << "\n";
   write_group(out, sweep_option_group());
+}
+
+void write_network(std::ostream& out) {
+  out << ".SH NETWORK\n"
+         ".B vmpray network\n"
+         "[\\fIoptions\\fR]\n"
+         ".PP\n"
+      << roff_lines(network_summary());
+  std::istringstream patterns(nodes::pattern_descriptions());
+  for (std::string line; std::getline(patterns, line);) {
+    const std::size_t colon = line.find(':');
+    out << ".TP\n.B " << roff(line.substr(0, colon)) << "\n" << roff(line.substr(colon + 2)) << "\n";
+  }
+  write_group(out, network_option_group());
 }
 
 // What the README's tour starts with; tests/app checks each one parses.
@@ -156,6 +174,12 @@ void write_tail(std::ostream& out) {
 // ---- The completion script ----
 
 // The words of a value, for the options whose value is one of a fixed set.
+std::vector<std::string> pattern_words() {
+  std::vector<std::string> names;
+  for (const nodes::TrafficPattern p : nodes::traffic_patterns()) names.emplace_back(nodes::pattern_name(p));
+  return names;
+}
+
 std::vector<std::pair<std::string, std::vector<std::string>>> value_words() {
   std::vector<std::string> kinds;
   using topology::Kind;
@@ -174,7 +198,8 @@ std::vector<std::pair<std::string, std::vector<std::string>>> value_words() {
            {nodes::pixel_order_name(nodes::PixelOrder::hilbert), nodes::pixel_order_name(nodes::PixelOrder::scanline)}},
           {"distribution", {"modulo", "block"}},
           {"timing", {"real", "virtual"}},
-          {"profile", {"ipsc2", "native"}}};  // or a profile file
+          {"profile", {"ipsc2", "native"}},  // or a profile file
+          {"pattern", pattern_words()}};
 }
 
 std::string joined(const std::vector<std::string>& words) {
@@ -237,15 +262,17 @@ std::string manual_page() {
   for (const OptionGroup& group : render_option_groups()) write_group(out, group);
   write_scenes(out);
   write_sweep(out);
+  write_network(out);
   write_tail(out);
   return out.str();
 }
 
 std::string bash_completion() {
-  const std::vector<OptionGroup> render = render_option_groups(), sweep{sweep_option_group()};
+  const std::vector<OptionGroup> render = render_option_groups(), sweep{sweep_option_group()},
+                                 network{network_option_group()};
   std::ostringstream out;
   out << "# bash completion for vmpray(1), made by `vmpray --completion bash` from the\n"
-         "# option descriptions --help prints: the options of vmpray and of vmpray sweep,\n"
+         "# option descriptions --help prints: the options of vmpray, vmpray sweep and vmpray network,\n"
          "# the words of options that take one of a set, the subcommand, the built-in\n"
          "# scenes, and file names otherwise. Needs bash alone.\n\n"
          "# COMPREPLY: the words of $1 that start with $2, and file names too if $3 is given.\n"
@@ -262,18 +289,20 @@ std::string bash_completion() {
       << scene_words() << "\"\n"
       << "  ((COMP_CWORD > 0)) && prev=${COMP_WORDS[COMP_CWORD - 1]}\n"
          "  [[ ${COMP_WORDS[1]-} == sweep ]] && ((COMP_CWORD > 1)) && command=sweep\n"
+         "  [[ ${COMP_WORDS[1]-} == network ]] && ((COMP_CWORD > 1)) && command=network\n"
          "  case \"$command:$prev\" in\n"
-      << value_cases("render", render) << value_cases("sweep", sweep)
+      << value_cases("render", render) << value_cases("sweep", sweep) << value_cases("network", network)
       << "  esac\n"
          "  if [[ $cur == -* ]]; then\n"
          "    if [[ $command == sweep ]]; then _vmpray_offer \""
-      << option_words(sweep) << "\" \"$cur\"\n    else _vmpray_offer \"" << option_words(render)
+      << option_words(sweep) << "\" \"$cur\"\n    elif [[ $command == network ]]; then _vmpray_offer \""
+      << option_words(network) << "\" \"$cur\"\n    else _vmpray_offer \"" << option_words(render)
       << "\" \"$cur\"; fi\n"
          "  elif [[ $command == sweep ]] && ((COMP_CWORD == 2)); then\n"
          "    _vmpray_offer \""
       << sweep_kind_words() << "\" \"$cur\"\n"
          "  elif ((COMP_CWORD == 1)); then\n"
-         "    _vmpray_offer \"sweep $scenes\" \"$cur\" files\n"
+         "    _vmpray_offer \"sweep network $scenes\" \"$cur\" files\n"
          "  else\n"
          "    _vmpray_offer \"$scenes\" \"$cur\" files\n"
          "  fi\n"

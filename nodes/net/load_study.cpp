@@ -21,11 +21,6 @@ using topology::Kind;
 using topology::NodeId;
 using topology::Topology;
 
-constexpr TrafficPattern all_patterns[] = {TrafficPattern::uniform,      TrafficPattern::transpose,
-                                           TrafficPattern::bit_complement, TrafficPattern::bit_reversal,
-                                           TrafficPattern::shuffle,      TrafficPattern::tornado,
-                                           TrafficPattern::neighbour,    TrafficPattern::hotspot};
-
 // A node id as digits, lowest first, with each digit's radix: the
 // hypercube's bits, the grid's x then y, the ring's or complete graph's index.
 std::vector<unsigned> radices(const Topology& t) {
@@ -122,6 +117,14 @@ struct Tally {
 
 }  // namespace
 
+const std::vector<TrafficPattern>& traffic_patterns() {
+  static const std::vector<TrafficPattern> all{TrafficPattern::uniform,      TrafficPattern::transpose,
+                                               TrafficPattern::bit_complement, TrafficPattern::bit_reversal,
+                                               TrafficPattern::shuffle,      TrafficPattern::tornado,
+                                               TrafficPattern::neighbour,    TrafficPattern::hotspot};
+  return all;
+}
+
 const char* pattern_name(TrafficPattern pattern) {
   switch (pattern) {
     case TrafficPattern::uniform: return "uniform";
@@ -138,7 +141,7 @@ const char* pattern_name(TrafficPattern pattern) {
 
 TrafficPattern parse_traffic_pattern(const std::string& name) {
   std::string known;
-  for (const TrafficPattern p : all_patterns) {
+  for (const TrafficPattern p : traffic_patterns()) {
     if (name == pattern_name(p)) return p;
     known += (known.empty() ? "" : ", ") + std::string(pattern_name(p));
   }

@@ -24,6 +24,8 @@ namespace nodes {
 // and torus's coordinates, the ring's and complete graph's index).
 enum class TrafficPattern { uniform, transpose, bit_complement, bit_reversal, shuffle, tornado, neighbour, hotspot };
 
+// Every pattern, in the order --help lists them.
+const std::vector<TrafficPattern>& traffic_patterns();
 const char* pattern_name(TrafficPattern pattern);
 // std::invalid_argument naming the pattern and the known ones.
 TrafficPattern parse_traffic_pattern(const std::string& name);

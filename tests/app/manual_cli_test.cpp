@@ -100,6 +100,9 @@ TEST_F(ManualCli, ThePageNamesEveryOptionOfBothCommandsAndNoOther) {
   EXPECT_GT(sweep.size(), 15u);
   EXPECT_EQ(page_options(section(page, "OPTIONS")), render);
   EXPECT_EQ(page_options(section(page, "SWEEP")), sweep);
+  const Names network = help_options(output_of("network --help"));
+  EXPECT_GT(network.size(), 10u);
+  EXPECT_EQ(page_options(section(page, "NETWORK")), network);
   EXPECT_EQ(render.count("--manpage") + render.count("--completion"), 0u) << "hidden options stay out of --help";
   for (const char* title : {"NAME", "SYNOPSIS", "DESCRIPTION", "\"BUILT\\-IN SCENES\"", "EXAMPLES", "\"SEE ALSO\""})
     EXPECT_NE(section(page, title), "") << title;
@@ -149,12 +152,16 @@ TEST_F(ManualCli, TheCompletionOffersEveryOptionAndTheTopologyKinds) {
   EXPECT_EQ(complete({"vmpray", "--topology", ""}), kinds);
   EXPECT_EQ(complete({"vmpray", "sweep", "cache", "--topology", ""}), kinds);
   EXPECT_EQ(complete({"vmpray", "--schedule", ""}), (Names{"affinity", "dynamic", "static"}));
+  EXPECT_EQ(complete({"vmpray", "network", "-"}), help_options(output_of("network --help")));
+  EXPECT_EQ(complete({"vmpray", "network", "--pattern", "b"}), (Names{"bit-complement", "bit-reversal"}));
+  EXPECT_EQ(complete({"vmpray", "network", "--topology", "to"}), Names{"torus"});
 }
 
 TEST_F(ManualCli, TheCompletionOffersSubcommandScenesAndFiles) {
   ASSERT_EQ(run_vmpray("--completion bash", "completion.bash").exit_code, 0);
   std::ofstream(dir_ / "scene.nff") << "";
   EXPECT_EQ(complete({"vmpray", "sw"}), Names{"sweep"});
+  EXPECT_EQ(complete({"vmpray", "netw"}), Names{"network"});
   EXPECT_EQ(complete({"vmpray", "sweep", ""}), (Names{"nodes", "cache"}));
   EXPECT_EQ(complete({"vmpray", "tetra"}), (Names{"tetra", "tetra9", "tetra10"}));
   EXPECT_EQ(complete({"vmpray", "sc"}), Names{"scene.nff"});
