@@ -218,48 +218,45 @@ OptionGroup network_option_group() {
   return option_group(describe(o, raw));
 }
 
-NetworkTable run_network_study(const NetworkStudyOptions& o, std::ostream* progress) {
-  NetworkTable table;
-  table.options = o;
-  struct Curve {
-    topology::Topology topology;
-    nodes::TrafficPattern pattern;
-    double bound, zero_load;
-  };
-  std::vector<Curve> curves;
+namespace {
+
+// The mean distance of a pattern's packets on `t`: a fixed pattern's over
+// the nodes that send, else the average distance.
+double pattern_distance(const topology::Topology& t, nodes::TrafficPattern p) {
+  const auto to = nodes::fixed_destinations(p, t);
+  if (to.empty()) return t.average_distance();
+  double sum = 0;
+  std::size_t senders = 0;
+  for (topology::NodeId n = 0; n < to.size(); ++n)
+    if (to[n] != n) sum += t.distance(n, to[n]), ++senders;
+  return senders ? sum / static_cast<double>(senders) : 0;
+}
+
+// Every point of every curve, with its bound and zero-load latency, not run.
+void plan_points(const NetworkStudyOptions& o, NetworkTable& table) {
+  const double message = nodes::zero_load_latency(o.study.link, o.study.payload_bytes, 0);
   for (const std::string& spec : o.topologies) {
     const topology::Topology t = topology::parse_topology(spec);
     table.costs.push_back(topology_cost(t));
-    const double message = nodes::zero_load_latency(o.study.link, o.study.payload_bytes, 0);
     for (const nodes::TrafficPattern p : o.patterns) {
-      double distance = t.average_distance();
-      if (const auto to = nodes::fixed_destinations(p, t); !to.empty()) {
-        double sum = 0;
-        std::size_t senders = 0;
-        for (topology::NodeId n = 0; n < to.size(); ++n)
-          if (to[n] != n) sum += t.distance(n, to[n]), ++senders;
-        distance = senders ? sum / static_cast<double>(senders) : 0;
-      }
-      curves.push_back({t, p, 1.0 / (message * nodes::max_channel_load(t, p, o.study.hotspot_fraction)),
-                        (distance + 1) * message});
+      const double bound = 1.0 / (message * nodes::max_channel_load(t, p, o.study.hotspot_fraction));
+      for (const double load : o.loads)
+        table.points.push_back({.topology = t.spec(), .pattern = p, .load = load, .bound = bound,
+                                .zero_load = (pattern_distance(t, p) + 1) * message, .saturated = false,
+                                .result = {}, .wall_seconds = 0});
     }
   }
-  for (const Curve& c : curves)
-    for (const double load : o.loads) {
-      NetworkPoint point;
-      point.topology = c.topology.spec();
-      point.pattern = c.pattern;
-      point.load = load;
-      point.bound = c.bound;
-      point.zero_load = c.zero_load;
-      table.points.push_back(point);
-    }
+}
+
+// Runs the points on `jobs` threads, each taking the next point not run;
+// the first failure stops the others' taking and is rethrown.
+void run_points(const NetworkStudyOptions& o, std::vector<NetworkPoint>& points, std::ostream* progress) {
   std::atomic<std::size_t> next{0}, done{0};
   std::mutex report;
   std::exception_ptr failure;
   const auto work = [&] {
-    for (std::size_t i; (i = next++) < table.points.size();) {
-      NetworkPoint& p = table.points[i];
+    for (std::size_t i; (i = next++) < points.size();) {
+      NetworkPoint& p = points[i];
       try {
         const auto start = std::chrono::steady_clock::now();
         p.result = nodes::run_load(topology::parse_topology(p.topology), p.pattern, p.load * p.bound, o.study);
@@ -268,19 +265,27 @@ NetworkTable run_network_study(const NetworkStudyOptions& o, std::ostream* progr
       } catch (...) {
         const std::lock_guard lock(report);
         if (!failure) failure = std::current_exception();
-        next = table.points.size();
+        next = points.size();
       }
       const std::lock_guard lock(report);
-      if (progress)
-        *progress << "\rnetwork: " << ++done << " of " << table.points.size() << " points" << std::flush;
+      if (progress) *progress << "\rnetwork: " << ++done << " of " << points.size() << " points" << std::flush;
     }
   };
   std::vector<std::thread> threads;
-  for (unsigned j = 1; j < std::min<std::size_t>(o.jobs, table.points.size()); ++j) threads.emplace_back(work);
+  for (unsigned j = 1; j < std::min<std::size_t>(o.jobs, points.size()); ++j) threads.emplace_back(work);
   work();
   for (std::thread& t : threads) t.join();
   if (progress) *progress << "\n";
   if (failure) std::rethrow_exception(failure);
+}
+
+}  // namespace
+
+NetworkTable run_network_study(const NetworkStudyOptions& o, std::ostream* progress) {
+  NetworkTable table;
+  table.options = o;
+  plan_points(o, table);
+  run_points(o, table.points, progress);
   return table;
 }
 

@@ -93,6 +93,33 @@ po::options_description describe(SweepOptions& o, RawSweep& raw) {
 }
 // clang-format on
 
+// Every machine of the sweep exists, and the machine's own rules for what
+// every run shares hold, before the first run.
+void check_machines(const SweepOptions& o, bool nodes_given) {
+  for (const std::string& topology : o.topologies)
+    for (const std::size_t n : o.nodes) {
+      try {
+        topology::parse_topology(topology, n);
+      } catch (const std::invalid_argument& e) {
+        if (!nodes_given && topology.find(':') != std::string::npos)
+          throw UsageError("--topology: " + topology + " has a size of its own, which the default --nodes list "
+                           "does not fit; give --nodes with its node count, or the bare kind");
+        throw UsageError(std::string("--topology: ") + e.what());
+      }
+      check_grid_shape(topology, n);
+    }
+  nodes::MachineOptions machine;
+  machine.grain = o.grain;
+  machine.prefetch = o.prefetch;
+  machine.schedule = o.schedule;
+  machine.pixel_order = o.pixel_order;
+  try {
+    nodes::check_options(machine, o.page_size);
+  } catch (const nodes::OptionError& e) {
+    throw usage_error(e);
+  }
+}
+
 void check_sweep(SweepOptions& o, const RawSweep& raw, const po::variables_map& vm) {
   if (raw.kind == "nodes") o.kind = SweepOptions::Kind::nodes;
   else if (raw.kind == "cache") o.kind = SweepOptions::Kind::cache;
@@ -127,30 +154,7 @@ void check_sweep(SweepOptions& o, const RawSweep& raw, const po::variables_map& 
     throw UsageError("--nodes: a cache sweep runs one machine size, got " + raw.nodes);
   if (o.kind == SweepOptions::Kind::nodes && o.cache_pages.size() > 1)
     throw UsageError("--cache-pages: a nodes sweep runs one cache size, got " + raw.cache);
-  // Every machine of the sweep must exist before the first one runs.
-  for (const std::string& topology : o.topologies)
-    for (const std::size_t n : o.nodes) {
-      try {
-        topology::parse_topology(topology, n);
-      } catch (const std::invalid_argument& e) {
-        if (!nodes_given && topology.find(':') != std::string::npos)
-          throw UsageError("--topology: " + topology + " has a size of its own, which the default --nodes list "
-                           "does not fit; give --nodes with its node count, or the bare kind");
-        throw UsageError(std::string("--topology: ") + e.what());
-      }
-      check_grid_shape(topology, n);
-    }
-  // The machine's own rules for what every run shares, before the first run.
-  nodes::MachineOptions machine;
-  machine.grain = o.grain;
-  machine.prefetch = o.prefetch;
-  machine.schedule = o.schedule;
-  machine.pixel_order = o.pixel_order;
-  try {
-    nodes::check_options(machine, o.page_size);
-  } catch (const nodes::OptionError& e) {
-    throw usage_error(e);
-  }
+  check_machines(o, nodes_given);
   o.out_dir = raw.out.empty() ? "sweep-" + raw.kind : raw.out;
   // Found out now rather than after the runs, when the tables are written.
   check_writable_directory("--out", o.out_dir);
@@ -220,6 +224,37 @@ OptionGroup sweep_option_group() {
   return option_group(describe(o, raw));
 }
 
+namespace {
+
+// T1's setup (one node, the fitted unit if asked), then the table's points
+// in its order.
+std::vector<ExperimentSetup> sweep_setups(const SweepOptions& o, const tracer::Database& db) {
+  ExperimentSetup setup;
+  setup.grain = o.grain;
+  setup.prefetch = o.prefetch;
+  setup.schedule = o.schedule;
+  setup.pixel_order = o.pixel_order;
+  setup.model = o.model;
+  setup.trace = o.trace;
+  setup.nodes = 1;
+  if (o.fit_seconds > 0) setup.model.unit = fit_unit(db, setup, o.fit_seconds, o.jobs);
+  if (!o.cache_pages.empty()) setup.cache_pages = o.cache_pages.front();
+  std::vector<ExperimentSetup> setups{setup};
+  const bool by_nodes = o.kind == SweepOptions::Kind::nodes;
+  for (const std::string& topology : o.topologies) {
+    const std::size_t count = by_nodes ? o.nodes.size() : o.cache_pages.size();
+    for (std::size_t i = 0; i < count; ++i) {
+      setup.topology = topology;
+      setup.nodes = by_nodes ? o.nodes[i] : o.nodes.front();
+      if (!by_nodes) setup.cache_pages = o.cache_pages[i];
+      setups.push_back(setup);
+    }
+  }
+  return setups;
+}
+
+}  // namespace
+
 SweepTable run_sweep(const SweepOptions& o, std::ostream* progress) {
   const tracer::Database db = load_database(o);
   SweepTable table;
@@ -234,29 +269,8 @@ SweepTable run_sweep(const SweepOptions& o, std::ostream* progress) {
                   (o.schedule == nodes::Schedule::static_split ? "" : ", grain " + std::to_string(o.grain)) +
                   ", prefetch " + std::to_string(o.prefetch) + ", " + nodes::pixel_order_name(o.pixel_order) +
                   " order";
-  ExperimentSetup setup;
-  setup.grain = o.grain;
-  setup.prefetch = o.prefetch;
-  setup.schedule = o.schedule;
-  setup.pixel_order = o.pixel_order;
-  setup.model = o.model;
-  setup.trace = o.trace;
-  setup.nodes = 1;
-  if (o.fit_seconds > 0) setup.model.unit = fit_unit(db, setup, o.fit_seconds, o.jobs);
-  table.model = setup.model;
-  if (!o.cache_pages.empty()) setup.cache_pages = o.cache_pages.front();
-  // T1 first, then the table's points in its order.
-  std::vector<ExperimentSetup> setups{setup};
-  const bool by_nodes = o.kind == SweepOptions::Kind::nodes;
-  for (const std::string& topology : o.topologies) {
-    const std::size_t count = by_nodes ? o.nodes.size() : o.cache_pages.size();
-    for (std::size_t i = 0; i < count; ++i) {
-      setup.topology = topology;
-      setup.nodes = by_nodes ? o.nodes[i] : o.nodes.front();
-      if (!by_nodes) setup.cache_pages = o.cache_pages[i];
-      setups.push_back(setup);
-    }
-  }
+  const std::vector<ExperimentSetup> setups = sweep_setups(o, db);
+  table.model = setups.front().model;
   // A machine too large for the memory is refused before any runs; runs go
   // side by side only as far as they fit together.
   std::vector<nodes::MachineOptions> machines;

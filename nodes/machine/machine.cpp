@@ -538,6 +538,27 @@ RankReport rank_report(const Share& share, std::size_t local_nodes, unsigned thr
 // nodes[n] is null for the nodes another process runs; the result's
 // per_node entries for those stay empty and its image is empty unless this
 // process runs node 0.
+// The run's recording: the nodes' logs merged, with each node's tiles.
+std::shared_ptr<const Recording> recording_of(const Recorder& recorder, const topology::Topology& topology,
+                                              const MachineReport& report) {
+  std::vector<std::vector<TileSpan>> tiles;
+  for (const NodeReport& n : report.per_node) tiles.push_back(n.work.spans);
+  return std::make_shared<const Recording>(merge_recording(recorder, topology, std::move(tiles)));
+}
+
+// What a rank of a split run adds to its report: its own figures and the
+// cut links; the routers' counters travel to rank 0 with the node reports.
+void add_rank_figures(Executed& executed, const Share& share, std::size_t local_nodes, unsigned threads,
+                      const SplitState& split, const Network& net,
+                      const std::vector<std::unique_ptr<NodeState>>& nodes, double cpu) {
+  MachineReport& report = executed.result.report;
+  report.ranks.push_back(rank_report(share, local_nodes, threads, split, report, cpu));
+  report.cut_links = share.plan->cut_links();
+  executed.routers.resize(nodes.size());
+  for (std::size_t n = 0; n < nodes.size(); ++n)
+    if (nodes[n]) executed.routers[n] = net.router_counters(static_cast<NodeId>(n));
+}
+
 Executed execute(const tracer::DatabaseHeader& header, const topology::Topology& topology,
                  const PagePlacement& placement, std::uint32_t cache_pages,
                  std::vector<std::unique_ptr<NodeState>>& nodes, const MachineOptions& options, const Share& share) {
@@ -553,11 +574,10 @@ Executed execute(const tracer::DatabaseHeader& header, const topology::Topology&
 
   Network* network = nullptr;  // for the runtime's failure handler, once it exists
   csp::Runtime runtime(runtime_options(options, local_nodes, timing, split, share.rank, network));
-  std::unique_ptr<Recorder> recorder;
-  if (options.record) {
-    if (share.plan) throw std::invalid_argument("record: a run over several processes cannot be recorded");
-    recorder = std::make_unique<Recorder>(topology.size(), options.record_packets, timing != nullptr, started);
-  }
+  if (options.record && share.plan) throw std::invalid_argument("record: a run over several processes cannot be recorded");
+  const std::unique_ptr<Recorder> recorder =
+      options.record ? std::make_unique<Recorder>(topology.size(), options.record_packets, timing != nullptr, started)
+                     : nullptr;
   Network net(runtime, topology,
               network_options(options, timing, share, topology.size(), local_nodes, runtime.threads(), recorder.get()));
   network = &net;
@@ -585,20 +605,9 @@ Executed execute(const tracer::DatabaseHeader& header, const topology::Topology&
   MachineReport& report = result.report;
   report = machine_report(runtime, net, timing, header, options, cache_pages, items.count, nodes);
   report.wall_seconds = wall_seconds;
-  if (recorder) {
-    std::vector<std::vector<TileSpan>> tiles;
-    for (const NodeReport& n : report.per_node) tiles.push_back(n.work.spans);
-    report.recording = std::make_shared<const Recording>(merge_recording(*recorder, topology, std::move(tiles)));
-  }
-  if (split) {
-    report.ranks.push_back(
-        rank_report(share, local_nodes, runtime.threads(), *split, report, cpu_seconds() - cpu_started));
-    report.cut_links = share.plan->cut_links();
-    // The routers' counters travel to rank 0 with the node reports.
-    executed.routers.resize(nodes.size());
-    for (std::size_t n = 0; n < nodes.size(); ++n)
-      if (nodes[n]) executed.routers[n] = net.router_counters(static_cast<NodeId>(n));
-  }
+  if (recorder) report.recording = recording_of(*recorder, topology, report);
+  if (split)
+    add_rank_figures(executed, share, local_nodes, runtime.threads(), *split, net, nodes, cpu_seconds() - cpu_started);
   if (share.runs(0)) {
     report.farmer = host.farmer;
     report.farmer.steals = host.plan->steals();

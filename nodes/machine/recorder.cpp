@@ -32,7 +32,7 @@ constexpr NodeId no_node = std::numeric_limits<NodeId>::max();
   throw std::logic_error("recording: packet " + std::to_string(id) + " " + what);
 }
 
-PacketTrace& trace_of(std::unordered_map<std::uint64_t, std::size_t>& index, std::vector<PacketTrace>& packets,
+PacketTrace& trace_of(const std::unordered_map<std::uint64_t, std::size_t>& index, std::vector<PacketTrace>& packets,
                       std::uint64_t id) {
   const auto at = index.find(id);
   if (at == index.end()) broken(id, "was seen in the network but never injected");
@@ -63,20 +63,13 @@ void check(const PacketTrace& p, const topology::Topology& topology, NodeId dest
 
 }  // namespace
 
-Recording merge_recording(const Recorder& recorder, const topology::Topology& topology,
-                          std::vector<std::vector<TileSpan>> tiles) {
-  const std::size_t nodes = recorder.nodes();
-  if (topology.size() != nodes)
-    throw std::invalid_argument("recording: " + std::to_string(nodes) + " node logs for a machine of " +
-                                std::to_string(topology.size()));
-  tiles.resize(nodes);
-  Recording r;
-  r.virtual_time = recorder.virtual_time();
-  r.max_packets = recorder.max_packets();
-  // A packet's length is known where it is delivered; size every trace then.
-  std::unordered_map<std::uint64_t, std::size_t> index;
-  std::vector<NodeId> destination;
-  for (NodeId n = 0; n < nodes; ++n)
+namespace {
+
+// Every packet injected, with its first node and time; `index` finds a
+// packet's trace by id, `destination` holds where each was sent.
+void add_injections(const Recorder& recorder, Recording& r, std::unordered_map<std::uint64_t, std::size_t>& index,
+                    std::vector<NodeId>& destination) {
+  for (NodeId n = 0; n < recorder.nodes(); ++n)
     for (const InjectEvent& e : recorder.log(n).injected) {
       if (!index.emplace(e.id, r.packets.size()).second) broken(e.id, "was injected twice");
       PacketTrace p;
@@ -88,7 +81,12 @@ Recording merge_recording(const Recorder& recorder, const topology::Topology& to
       r.packets.push_back(std::move(p));
       destination.push_back(e.destination);
     }
-  for (NodeId n = 0; n < nodes; ++n)
+}
+
+// A packet's length is known where it is delivered: size every trace then.
+void add_deliveries(const Recorder& recorder, Recording& r,
+                    const std::unordered_map<std::uint64_t, std::size_t>& index) {
+  for (NodeId n = 0; n < recorder.nodes(); ++n)
     for (const DeliverEvent& e : recorder.log(n).delivered) {
       PacketTrace& p = trace_of(index, r.packets, e.id);
       if (p.times.size() != 1) broken(e.id, "was delivered twice");
@@ -101,8 +99,14 @@ Recording merge_recording(const Recorder& recorder, const topology::Topology& to
       p.times.front() = injected;
       p.times.back() = e.time;
     }
+}
+
+// Every hop's departure and arrival into its trace, and what each node
+// counted without recording.
+void add_hops(const Recorder& recorder, const topology::Topology& topology, Recording& r,
+              const std::unordered_map<std::uint64_t, std::size_t>& index) {
   const unsigned classes = topology.buffer_classes();
-  for (NodeId n = 0; n < nodes; ++n) {
+  for (NodeId n = 0; n < recorder.nodes(); ++n) {
     const NodeLog& log = recorder.log(n);
     const auto neighbours = topology.neighbours(n);
     for (const HopEvent& e : log.departed) {
@@ -132,16 +136,12 @@ Recording merge_recording(const Recorder& recorder, const topology::Topology& to
     r.unrecorded_fetches += log.unrecorded_fetches;
     r.unrecorded_serves += log.unrecorded_serves;
   }
-  for (std::size_t i = 0; i < r.packets.size(); ++i) {
-    if (r.packets[i].times.size() != 2 * r.packets[i].route.size()) broken(r.packets[i].id, "was never delivered");
-    check(r.packets[i], topology, destination[i]);
-    r.end = std::max(r.end, r.packets[i].delivered());
-  }
-  std::sort(r.packets.begin(), r.packets.end(), [](const PacketTrace& a, const PacketTrace& b) {
-    return std::tie(a.times.front(), a.id) < std::tie(b.times.front(), b.id);
-  });
-  r.nodes.resize(nodes);
-  for (NodeId n = 0; n < nodes; ++n) {
+}
+
+// Each node's waits, serves, hits and tiles, and the recording's end.
+void add_node_traces(const Recorder& recorder, Recording& r, std::vector<std::vector<TileSpan>>& tiles) {
+  r.nodes.resize(recorder.nodes());
+  for (NodeId n = 0; n < recorder.nodes(); ++n) {
     NodeTrace& t = r.nodes[n];
     t.fetches = recorder.log(n).fetches;
     t.serves = recorder.log(n).serves;
@@ -153,15 +153,48 @@ Recording merge_recording(const Recorder& recorder, const topology::Topology& to
     for (const ServeEvent& e : t.serves) r.end = std::max(r.end, e.end);
     for (const TileSpan& s : t.tiles) r.end = std::max(r.end, s.end);
   }
-  r.window = r.end;
-  if (r.unrecorded_packets + r.unrecorded_fetches + r.unrecorded_serves > 0) {
-    r.window = 0;
-    for (const PacketTrace& p : r.packets) r.window = std::max(r.window, p.injected());
-    for (const NodeTrace& t : r.nodes) {
-      for (const FetchEvent& e : t.fetches) r.window = std::max(r.window, e.start);
-      for (const ServeEvent& e : t.serves) r.window = std::max(r.window, e.start);
-    }
+}
+
+// What was recorded in full: the whole run, or up to the last packet,
+// wait or serve begun before the budget ran out.
+double recorded_window(const Recording& r) {
+  if (r.unrecorded_packets + r.unrecorded_fetches + r.unrecorded_serves == 0) return r.end;
+  double window = 0;
+  for (const PacketTrace& p : r.packets) window = std::max(window, p.injected());
+  for (const NodeTrace& t : r.nodes) {
+    for (const FetchEvent& e : t.fetches) window = std::max(window, e.start);
+    for (const ServeEvent& e : t.serves) window = std::max(window, e.start);
   }
+  return window;
+}
+
+}  // namespace
+
+Recording merge_recording(const Recorder& recorder, const topology::Topology& topology,
+                          std::vector<std::vector<TileSpan>> tiles) {
+  const std::size_t nodes = recorder.nodes();
+  if (topology.size() != nodes)
+    throw std::invalid_argument("recording: " + std::to_string(nodes) + " node logs for a machine of " +
+                                std::to_string(topology.size()));
+  tiles.resize(nodes);
+  Recording r;
+  r.virtual_time = recorder.virtual_time();
+  r.max_packets = recorder.max_packets();
+  std::unordered_map<std::uint64_t, std::size_t> index;
+  std::vector<NodeId> destination;
+  add_injections(recorder, r, index, destination);
+  add_deliveries(recorder, r, index);
+  add_hops(recorder, topology, r, index);
+  for (std::size_t i = 0; i < r.packets.size(); ++i) {
+    if (r.packets[i].times.size() != 2 * r.packets[i].route.size()) broken(r.packets[i].id, "was never delivered");
+    check(r.packets[i], topology, destination[i]);
+    r.end = std::max(r.end, r.packets[i].delivered());
+  }
+  std::sort(r.packets.begin(), r.packets.end(), [](const PacketTrace& a, const PacketTrace& b) {
+    return std::tie(a.times.front(), a.id) < std::tie(b.times.front(), b.id);
+  });
+  add_node_traces(recorder, r, tiles);
+  r.window = recorded_window(r);
   return r;
 }
 

@@ -214,117 +214,132 @@ double zero_load_latency(const LinkModel& link, std::size_t payload_bytes, unsig
   return (distance + 1) * message;
 }
 
-LoadResult run_load(const Topology& t, TrafficPattern pattern, double offered, const LoadStudyOptions& options) {
-  if (const std::string why = pattern_unfit(pattern, t); !why.empty()) throw std::invalid_argument(why);
-  if (!options.link.enabled()) throw std::invalid_argument("a load study needs a link model: a latency or a bandwidth");
-  if (!(offered > 0)) throw std::invalid_argument("an offered load must be above 0");
-  const double base = zero_load_latency(options.link, options.payload_bytes,
-                                        static_cast<unsigned>(std::ceil(t.average_distance())));
-  auto tally = std::make_shared<Tally>();
-  tally->window_start = options.warmup_seconds > 0 ? options.warmup_seconds : 20 * base;
-  const double window = options.window_seconds > 0 ? options.window_seconds : 200 * base;
-  tally->window_end = tally->window_start + window;
-  const auto n = static_cast<NodeId>(t.size());
-  tally->created_at.resize(n);
-  tally->seen.resize(n);
-  tally->sources_running = n;
+namespace {
 
-  auto record = std::make_shared<csp::VirtualTimeRecord>();
-  csp::RuntimeOptions runtime_options;
-  runtime_options.threads = 1;
-  runtime_options.scheduler = csp::virtual_time_scheduler(record);
-  csp::Runtime runtime(runtime_options);
-  NetworkOptions net_options;
-  net_options.buffer_capacity = options.buffer_capacity;
-  net_options.link = options.link;
-  Network net(runtime, t, net_options);
-  const std::vector<NodeId> fixed = fixed_destinations(pattern, t);
-
-  for (NodeId node = 0; node < n; ++node) {
-    runtime.spawn("source " + std::to_string(node), 0, [&, node, out = net.injector(node)]() mutable {
-      std::mt19937_64 rng(options.seed * 0x9e3779b97f4a7c15ull + node);
-      std::exponential_distribution<double> gap(offered);
-      std::uniform_int_distribution<NodeId> other(0, n - 2);
-      std::uniform_real_distribution<double> share(0.0, 1.0);
-      Tally& k = *tally;
-      for (double next = gap(rng); next <= k.window_end; next += gap(rng)) {
-        const double at = seconds_of(virtual_of(next));  // an instant of the virtual clock
-        NodeId to = node;
-        if (!fixed.empty()) {
-          to = fixed[node];
-        } else if (pattern == TrafficPattern::hotspot && node != 0 && share(rng) < options.hotspot_fraction) {
-          to = 0;
-        } else {
-          to = other(rng);
-          to += to >= node;
-        }
-        if (to == node) break;  // a fixed pattern that maps this node to itself: it sends nothing
-        const double now = seconds_of(csp::this_process::now());
-        if (at > now) csp::this_process::advance(virtual_of(next) - csp::this_process::now());
-        Packet p;
-        p.destination = to;
-        p.kind = kind_traffic;
-        p.id = (std::uint64_t{node} << 32) | k.created_at[node].size();
-        p.payload.resize(options.payload_bytes);
-        // Created at `at`, though a full injection queue may have held the
-        // source until now: its wait counts as time in the network.
-        const double held = seconds_of(csp::this_process::now());
-        k.integrate_to(held);
-        k.area += std::max(0.0, std::min(held, k.window_end) - std::max(at, k.window_start));
-        ++k.in_flight;
-        ++k.created;
-        k.created_at[node].push_back(at);
-        k.seen[node].push_back(0);
-        if (at >= k.window_start) ++k.created_in_window;
-        out.write(std::move(p));
-      }
-      if (--k.sources_running == 0 && k.finished()) net.shutdown();
-    });
-    runtime.spawn("sink " + std::to_string(node), 0, [&, node, in = net.port(node)]() mutable {
-      Tally& k = *tally;
-      try {
-        for (;;) {
-          const Packet p = in.read();
-          const double now = seconds_of(csp::this_process::now());
-          const auto source = static_cast<NodeId>(p.id >> 32);
-          const auto sequence = static_cast<std::size_t>(p.id & 0xffffffffu);
-          if (p.destination != node || source >= n || sequence >= k.seen[source].size() ||
-              k.seen[source][sequence]++ != 0) {
-            ++k.misdelivered;
-          } else {
-            k.integrate_to(now);
-            --k.in_flight;
-            ++k.delivered;
-            const double created = k.created_at[source][sequence];
-            if (now >= k.window_start && now <= k.window_end) ++k.delivered_in_window;
-            if (created >= k.window_start && created <= k.window_end) {
-              k.latencies.push_back(now - created);
-              k.hops += p.hops;
-            }
-          }
-          if (k.finished()) net.shutdown();
-        }
-      } catch (const csp::Poisoned&) {
-        // the study is over
-      }
-    });
+// One load point's processes: a source and a sink per node, over the
+// network of a virtual-time runtime; what they share is the Tally.
+class LoadRun {
+ public:
+  LoadRun(const Topology& t, TrafficPattern pattern, double offered, const LoadStudyOptions& options)
+      : t_(t), pattern_(pattern), offered_(offered), options_(options), fixed_(fixed_destinations(pattern, t)) {
+    const double base = zero_load_latency(options.link, options.payload_bytes,
+                                          static_cast<unsigned>(std::ceil(t.average_distance())));
+    tally_.window_start = options.warmup_seconds > 0 ? options.warmup_seconds : 20 * base;
+    window_ = options.window_seconds > 0 ? options.window_seconds : 200 * base;
+    tally_.window_end = tally_.window_start + window_;
+    tally_.created_at.resize(t.size());
+    tally_.seen.resize(t.size());
+    tally_.sources_running = static_cast<unsigned>(t.size());
   }
-  runtime.run();
 
-  Tally& k = *tally;
-  k.integrate_to(k.window_end);
-  LoadResult r;
-  r.offered = offered;
-  r.created = k.created;
-  r.delivered = k.delivered;
-  r.misdelivered = k.misdelivered;
-  r.measured = k.latencies.size();
-  r.accepted = static_cast<double>(k.delivered_in_window) / (window * n);
-  r.arrival_rate = static_cast<double>(k.created_in_window) / window;
-  r.mean_in_flight = k.area / window;
-  r.end_seconds = seconds_of(record->end());
-  if (!k.latencies.empty()) {
+  LoadResult run() {
+    auto record = std::make_shared<csp::VirtualTimeRecord>();
+    csp::RuntimeOptions runtime_options;
+    runtime_options.threads = 1;
+    runtime_options.scheduler = csp::virtual_time_scheduler(record);
+    csp::Runtime runtime(runtime_options);
+    NetworkOptions net_options;
+    net_options.buffer_capacity = options_.buffer_capacity;
+    net_options.link = options_.link;
+    Network net(runtime, t_, net_options);
+    for (NodeId node = 0; node < t_.size(); ++node) {
+      runtime.spawn("source " + std::to_string(node), 0,
+                    [this, &net, node, out = net.injector(node)]() mutable { source(net, node, out); });
+      runtime.spawn("sink " + std::to_string(node), 0,
+                    [this, &net, node, in = net.port(node)]() mutable { sink(net, node, in); });
+    }
+    runtime.run();
+    return summary(seconds_of(record->end()));
+  }
+
+ private:
+  NodeId destination(NodeId node, std::mt19937_64& rng) const {
+    if (!fixed_.empty()) return fixed_[node];
+    std::uniform_real_distribution<double> share(0.0, 1.0);
+    if (pattern_ == TrafficPattern::hotspot && node != 0 && share(rng) < options_.hotspot_fraction) return 0;
+    std::uniform_int_distribution<NodeId> other(0, static_cast<NodeId>(t_.size() - 2));
+    const NodeId to = other(rng);
+    return to + (to >= node);
+  }
+
+  // Creates packets at exponential gaps until the window ends; a packet is
+  // created at its instant even if a full injection queue holds the source.
+  void source(Network& net, NodeId node, csp::Out<Packet>& out) {
+    std::mt19937_64 rng(options_.seed * 0x9e3779b97f4a7c15ull + node);
+    std::exponential_distribution<double> gap(offered_);
+    Tally& k = tally_;
+    for (double next = gap(rng); next <= k.window_end; next += gap(rng)) {
+      const double at = seconds_of(virtual_of(next));  // an instant of the virtual clock
+      const NodeId to = destination(node, rng);
+      if (to == node) break;  // a fixed pattern that maps this node to itself: it sends nothing
+      if (at > seconds_of(csp::this_process::now()))
+        csp::this_process::advance(virtual_of(next) - csp::this_process::now());
+      Packet p;
+      p.destination = to;
+      p.kind = kind_traffic;
+      p.id = (std::uint64_t{node} << 32) | k.created_at[node].size();
+      p.payload.resize(options_.payload_bytes);
+      // Its wait for a full injection queue counts as time in the network.
+      const double held = seconds_of(csp::this_process::now());
+      k.integrate_to(held);
+      k.area += std::max(0.0, std::min(held, k.window_end) - std::max(at, k.window_start));
+      ++k.in_flight;
+      ++k.created;
+      k.created_at[node].push_back(at);
+      k.seen[node].push_back(0);
+      if (at >= k.window_start) ++k.created_in_window;
+      out.write(std::move(p));
+    }
+    if (--k.sources_running == 0 && k.finished()) net.shutdown();
+  }
+
+  // Checks and times every packet delivered to `node`; the last delivery of
+  // the run shuts the network down.
+  void sink(Network& net, NodeId node, csp::In<Packet>& in) {
+    Tally& k = tally_;
+    const auto n = static_cast<NodeId>(t_.size());
+    try {
+      for (;;) {
+        const Packet p = in.read();
+        const double now = seconds_of(csp::this_process::now());
+        const auto source = static_cast<NodeId>(p.id >> 32);
+        const auto sequence = static_cast<std::size_t>(p.id & 0xffffffffu);
+        if (p.destination != node || source >= n || sequence >= k.seen[source].size() ||
+            k.seen[source][sequence]++ != 0) {
+          ++k.misdelivered;
+        } else {
+          k.integrate_to(now);
+          --k.in_flight;
+          ++k.delivered;
+          const double created = k.created_at[source][sequence];
+          if (now >= k.window_start && now <= k.window_end) ++k.delivered_in_window;
+          if (created >= k.window_start && created <= k.window_end) {
+            k.latencies.push_back(now - created);
+            k.hops += p.hops;
+          }
+        }
+        if (k.finished()) net.shutdown();
+      }
+    } catch (const csp::Poisoned&) {
+      // the study is over
+    }
+  }
+
+  LoadResult summary(double end_seconds) {
+    Tally& k = tally_;
+    k.integrate_to(k.window_end);
+    LoadResult r;
+    r.offered = offered_;
+    r.created = k.created;
+    r.delivered = k.delivered;
+    r.misdelivered = k.misdelivered;
+    r.measured = k.latencies.size();
+    r.accepted = static_cast<double>(k.delivered_in_window) / (window_ * static_cast<double>(t_.size()));
+    r.arrival_rate = static_cast<double>(k.created_in_window) / window_;
+    r.mean_in_flight = k.area / window_;
+    r.end_seconds = end_seconds;
     std::vector<double>& l = k.latencies;
+    if (l.empty()) return r;
     double sum = 0;
     for (const double x : l) sum += x;
     r.mean_latency = sum / static_cast<double>(l.size());
@@ -337,8 +352,25 @@ LoadResult run_load(const Topology& t, TrafficPattern pattern, double offered, c
     r.p50_latency = at(0.5);
     r.p99_latency = at(0.99);
     r.max_latency = *std::max_element(l.begin(), l.end());
+    return r;
   }
-  return r;
+
+  const Topology& t_;
+  const TrafficPattern pattern_;
+  const double offered_;
+  const LoadStudyOptions& options_;
+  const std::vector<NodeId> fixed_;
+  double window_ = 0;
+  Tally tally_;
+};
+
+}  // namespace
+
+LoadResult run_load(const Topology& t, TrafficPattern pattern, double offered, const LoadStudyOptions& options) {
+  if (const std::string why = pattern_unfit(pattern, t); !why.empty()) throw std::invalid_argument(why);
+  if (!options.link.enabled()) throw std::invalid_argument("a load study needs a link model: a latency or a bandwidth");
+  if (!(offered > 0)) throw std::invalid_argument("an offered load must be above 0");
+  return LoadRun(t, pattern, offered, options).run();
 }
 
 }  // namespace nodes
