@@ -17,17 +17,6 @@ namespace app {
 
 namespace {
 
-viz::MachineKind drawing_kind(topology::Kind kind) {
-  switch (kind) {
-    case topology::Kind::hypercube: return viz::MachineKind::hypercube;
-    case topology::Kind::mesh: return viz::MachineKind::mesh;
-    case topology::Kind::torus: return viz::MachineKind::torus;
-    case topology::Kind::ring: return viz::MachineKind::ring;
-    case topology::Kind::complete: return viz::MachineKind::complete;
-  }
-  throw std::logic_error("unknown topology kind");
-}
-
 // Which colour the ownership picture gives each processor.
 std::vector<viz::KeyEntry> ownership_key(int nodes) {
   std::vector<viz::KeyEntry> key;
@@ -43,13 +32,23 @@ std::string fixed(double v, int digits) {
 
 }  // namespace
 
-viz::MachineDrawing machine_drawing(const nodes::MachineReport& report) {
-  const topology::Topology topo = topology::parse_topology(report.topology);
+viz::MachineDrawing machine_shape(const topology::Topology& topo) {
   viz::MachineDrawing m;
-  m.kind = drawing_kind(topo.kind());
+  switch (topo.kind()) {
+    case topology::Kind::hypercube: m.kind = viz::MachineKind::hypercube; break;
+    case topology::Kind::mesh: m.kind = viz::MachineKind::mesh; break;
+    case topology::Kind::torus: m.kind = viz::MachineKind::torus; break;
+    case topology::Kind::ring: m.kind = viz::MachineKind::ring; break;
+    case topology::Kind::complete: m.kind = viz::MachineKind::complete; break;
+  }
   const bool grid = topo.kind() == topology::Kind::mesh || topo.kind() == topology::Kind::torus;
   m.dim_a = static_cast<int>(topo.kind() == topology::Kind::hypercube ? topo.dimension() : topo.width());
   m.dim_b = grid ? static_cast<int>(topo.height()) : 1;
+  return m;
+}
+
+viz::MachineDrawing machine_drawing(const nodes::MachineReport& report) {
+  viz::MachineDrawing m = machine_shape(topology::parse_topology(report.topology));
   m.title = report.topology + ": pixels computed (fill), pages served (ring), link traffic";
   for (const nodes::NodeReport& n : report.per_node)
     m.nodes.push_back(viz::NodeWork{.pixels = n.work.items, .page_requests_served = n.served.pages_served});

@@ -14,12 +14,15 @@
 #include "app/viz/report.hpp"
 #include "app/viz/timeline.hpp"
 #include "nodes/machine/machine.hpp"
+#include "topology/topology.hpp"
 #include "tracer/image.hpp"
 
 namespace app {
 
 // Nodes filled by pixels computed and ringed by page requests served; links by traffic.
 viz::MachineDrawing machine_drawing(const nodes::MachineReport& report);
+// A drawing of the topology's shape, with no nodes' work or links yet.
+viz::MachineDrawing machine_shape(const topology::Topology& topology);
 
 // The node that computed each of width x height pixels (row-major). With SPD
 // corner samples ((W+1) x (H+1) items) a pixel belongs to its top-left corner.

@@ -16,12 +16,14 @@
 #include <boost/program_options.hpp>
 
 #include "app/cpu_count.hpp"
+#include "app/machine_pictures.hpp"
 #include "app/machine_report.hpp"
 #include "app/output_check.hpp"
 #include "app/output_files.hpp"
 #include "app/progress.hpp"
 #include "app/report.hpp"
 #include "app/timing_options.hpp"
+#include "app/viz/machine.hpp"
 #include "app/viz/plot.hpp"
 #include "app/viz/plot_raster.hpp"
 #include "app/viz/report.hpp"
@@ -44,7 +46,7 @@ struct RawNetwork {
   std::string topologies = "hypercube:6,torus:8x8,mesh:8x8,ring:64,complete:64", patterns = "uniform",
               loads = "0.1,0.2,0.3,0.4,0.5,0.6,0.7,0.8,0.9,1,1.1,1.2", out = "network";
   std::int64_t payload = 64, buffers = 4, jobs = 0, seed = 1;
-  double hotspot = 0.2;
+  double hotspot = 0.2, links_at = 0.5;
   TimingChoice model;
 };
 
@@ -64,7 +66,10 @@ po::options_description describe(NetworkStudyOptions& o, RawNetwork& raw) {
       ("payload", po::value(&raw.payload), "bytes a packet carries, 1..1048576 (default 64)")
       ("buffers", po::value(&raw.buffers), "packets per link queue, 1..64 (default 4)")
       ("hotspot", po::value(&raw.hotspot), "hotspot: the share of packets sent to node 0, above 0 and below 1 (default 0.2)")
-      ("seed", po::value(&raw.seed), "seed of the packets' times and destinations (default 1)");
+      ("seed", po::value(&raw.seed), "seed of the packets' times and destinations (default 1)")
+      ("links-at", po::value(&raw.links_at),
+       "draw each topology's links by their traffic at the load of --loads nearest this one, under the first "
+       "pattern (default 0.5)");
   add_model_options(d, raw.model);
   d.add_options()
       ("out", po::value(&raw.out), "output directory (default network)")
@@ -136,6 +141,9 @@ void check_network(NetworkStudyOptions& o, const RawNetwork& raw) {
   o.study.seed = whole_in<std::uint32_t>(raw.seed, 0, UINT32_MAX, "--seed");
   if (!(raw.hotspot > 0 && raw.hotspot < 1)) throw UsageError("--hotspot: expected a share above 0 and below 1");
   o.study.hotspot_fraction = raw.hotspot;
+  if (!(raw.links_at > 0) || !std::isfinite(raw.links_at))
+    throw UsageError("--links-at: expected a load above 0, as a fraction of the bound");
+  o.links_at = raw.links_at;
   o.jobs = whole_in<unsigned>(raw.jobs, 0, 1024, "--jobs");
   if (o.jobs == 0) o.jobs = usable_cpus();
   o.out_dir = raw.out;
@@ -402,6 +410,27 @@ viz::Table points_table(const NetworkTable& t) {
   return table;
 }
 
+// Each topology's links drawn by what they carried at the load nearest
+// --links-at, under the first pattern.
+std::vector<viz::MachineDrawing> link_pictures(const NetworkTable& t) {
+  std::vector<viz::MachineDrawing> pictures;
+  for (const TopologyCost& c : t.costs) {
+    const NetworkPoint* nearest = nullptr;
+    for (const NetworkPoint& p : t.points)
+      if (p.topology == c.spec && p.pattern == t.options.patterns.front() &&
+          (!nearest || std::abs(p.load - t.options.links_at) < std::abs(nearest->load - t.options.links_at)))
+        nearest = &p;
+    viz::MachineDrawing m = machine_shape(topology::parse_topology(c.spec));
+    m.title = c.spec + ": link traffic, " + nodes::pattern_name(nearest->pattern) + " traffic at load " +
+              fixed(nearest->load, 2) + " of the bound";
+    m.nodes.assign(c.nodes, viz::NodeWork{});
+    for (const nodes::LinkStats& l : nearest->result.links)
+      m.links.push_back(viz::LinkTraffic{static_cast<int>(l.from), static_cast<int>(l.to), l.packets, l.bytes});
+    pictures.push_back(std::move(m));
+  }
+  return pictures;
+}
+
 std::vector<std::filesystem::path> write_network(const NetworkTable& t, OutputFiles& outputs) {
   const std::filesystem::path& dir = t.options.out_dir;
   if (!std::filesystem::exists(dir)) outputs.add(dir);
@@ -428,6 +457,12 @@ std::vector<std::filesystem::path> write_network(const NetworkTable& t, OutputFi
   section.blocks.push_back(viz::SvgFigure{.caption = "latency and throughput against offered load",
                                           .svg = viz::plots_svg(plots, 2)});
   section.blocks.push_back(points_table(t));
+  const auto pictures = link_pictures(t);
+  for (std::size_t i = 0; i < pictures.size(); ++i) {
+    const std::string svg = viz::machine_svg(pictures[i]);
+    files.push_back(outputs.write_text(dir / ("network-links-" + std::to_string(i + 1) + ".svg"), svg));
+    section.blocks.push_back(viz::SvgFigure{.caption = pictures[i].title, .svg = svg});
+  }
   report.sections.push_back(section);
   files.push_back(outputs.write_text(dir / "network.html", viz::html_report(report)));
   return files;

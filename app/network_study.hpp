@@ -5,8 +5,9 @@
 // topology's channel-load bound for the pattern (1: the busiest link, the
 // delivery channels counted, is offered its capacity). Writes DIR/network.csv,
 // DIR/network.json (schema version, command line, each topology's cost
-// table and every point), DIR/network.svg with one PNG a panel, and
-// DIR/network.html; prints the table. Points run side by side on --jobs
+// table and every point), DIR/network.svg with one PNG a panel, a picture
+// of each topology's link traffic at one load (DIR/network-links-K.svg),
+// and DIR/network.html; prints the table. Points run side by side on --jobs
 // threads; every file is the same whatever --jobs, but for the wall time.
 #pragma once
 
@@ -27,6 +28,7 @@ struct NetworkStudyOptions {
   std::vector<double> loads{0.1, 0.2, 0.3, 0.4, 0.5, 0.6, 0.7, 0.8, 0.9, 1.0, 1.1, 1.2};
   nodes::CostModel model = nodes::ipsc2_profile();  // its hop and bandwidth make the link model
   nodes::LoadStudyOptions study;                    // payload, buffers, hotspot share, seed
+  double links_at = 0.5;  // the load whose link traffic each topology's picture shows (the nearest run)
   std::filesystem::path out_dir = "network";
   unsigned jobs = 1;
   bool quiet = false;

@@ -249,7 +249,9 @@ class LoadRun {
                     [this, &net, node, in = net.port(node)]() mutable { sink(net, node, in); });
     }
     runtime.run();
-    return summary(seconds_of(record->end()));
+    LoadResult r = summary(seconds_of(record->end()));
+    r.links = net.stats().links;
+    return r;
   }
 
  private:

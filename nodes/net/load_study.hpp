@@ -16,6 +16,7 @@
 #include <vector>
 
 #include "nodes/net/link.hpp"
+#include "nodes/net/network.hpp"
 #include "topology/topology.hpp"
 
 namespace nodes {
@@ -67,6 +68,7 @@ struct LoadResult {
   double mean_in_flight = 0;  // packets created and not yet delivered, averaged over the window
   double arrival_rate = 0;    // packets created per second in the window, whole network (Little's law's λ)
   double end_seconds = 0;     // virtual time when the last packet was delivered
+  std::vector<LinkStats> links;  // what each directed link carried over the whole run
 };
 
 // Zero-load latency of a packet over `distance` links: store and forward,

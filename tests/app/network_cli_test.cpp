@@ -36,6 +36,7 @@ TEST_F(NetworkCli, BadInputIsRefusedBeforeAnyRunNamingTheOption) {
       {"--topology star:8", "vmpray network: --topology: "},
       {"--payload 0", "vmpray network: --payload: expected 1..1048576, got 0"},
       {"--hotspot 1", "vmpray network: --hotspot: expected a share above 0 and below 1"},
+      {"--links-at 0", "vmpray network: --links-at: expected a load above 0, as a fraction of the bound"},
       {"--cost hop=0,bw=0", "vmpray network: --cost: a network study needs a link cost: hop= or bw= above 0"},
       {"--out /dev/null/out", "vmpray network: --out: cannot write in '/dev/null/out'"},
   };
@@ -73,6 +74,15 @@ TEST_F(NetworkCli, AStudyWritesItsTablesPlotsAndPageWithEveryPacketDelivered) {
   EXPECT_FALSE(j["points"][0]["saturated"].get<bool>());
   EXPECT_TRUE(j["points"][2]["saturated"].get<bool>());
   EXPECT_TRUE(j["points"][11]["saturated"].get<bool>());
+  // One link picture a topology, at the load nearest --links-at (0.5: the
+  // run at 0.3) under the first pattern, named on the page.
+  for (const char* file : {"network-links-1.svg", "network-links-2.svg"})
+    EXPECT_EQ(test::read_file(dir_ / "out" / file).rfind("<svg", 0), 0u) << file;
+  EXPECT_FALSE(fs::exists(dir_ / "out" / "network-links-3.svg"));
+  const std::string page = test::read_file(dir_ / "out" / "network.html");
+  for (const char* caption : {"hypercube:4: link traffic, uniform traffic at load 0.30 of the bound",
+                              "ring:16: link traffic, uniform traffic at load 0.30 of the bound"})
+    EXPECT_NE(page.find(caption), std::string::npos) << caption;
 }
 
 // The CSV without its last column (each point's wall time).
