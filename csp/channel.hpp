@@ -323,6 +323,10 @@ class In : private detail::ChannelEnd<T> {
   std::optional<T> read_for(std::chrono::steady_clock::duration d) {
     return state_->read_until(detail::deadline_after(std::chrono::steady_clock::now(), d));
   }
+  // Without the lock: true if a read would not wait (or the channel is
+  // poisoned), as last published. Exact when the writer runs on the
+  // caller's thread.
+  bool ready_hint() const { return state_->ready_hint(); }
   bool poisoned() const {
     state_->require_bound("In::poisoned");
     return state_->poisoned();
@@ -349,6 +353,10 @@ class Out : private detail::ChannelEnd<T> {
   Out() = default;  // unbound: assign an end from a Channel before use; moving one leaves it unbound
   void write(T value) { state_->write(std::move(value)); }
   bool try_write(T& value) { return state_->try_write(value); }
+  // Without the lock: true if a write would not wait (or the channel is
+  // poisoned), as last published. To a buffered channel's only writer a
+  // true hint stays true until it writes: only the writer fills slots.
+  bool room_hint() const { return state_->room_hint(); }
   bool poisoned() const {
     state_->require_bound("Out::poisoned");
     return state_->poisoned();

@@ -119,7 +119,7 @@ struct Wiring {
 
   Outbox outbox(NodeId n, std::uint16_t port) const {
     const std::uint64_t ports = Ports::count(options.workers_per_node);
-    return Outbox(net.injector(n, port), n * ports + port, processes);
+    return Outbox(net.in_place_injector(n, port), n * ports + port, processes);
   }
 };
 
@@ -392,6 +392,7 @@ NetworkOptions network_options(const MachineOptions& options, const MachineTimin
     net.port_capacity[Ports::farmer] = farmer_bound(nodes, options.workers_per_node, options.prefetch);
   }
   net.relay_between_threads = options.relay_between_threads && !timing;
+  net.forward_in_place = options.forward_in_place && !timing;
   if (share.plan) {
     net.local = [share](NodeId n) { return share.runs(n); };
     net.placement = [first = share.first_node(), local_nodes, threads](NodeId n) {

@@ -47,6 +47,7 @@ struct MachineOptions {
   std::optional<std::size_t> nodes = 16;  // with a bare kind; must agree with a full spec
   unsigned threads = 0;                // 0: hardware cores; never more than the nodes
   bool relay_between_threads = true;   // links between threads through relays (NetworkOptions)
+  bool forward_in_place = true;        // routers of one thread route in place (NetworkOptions); real time only
   bool shared_cores = false;           // other processes share the cores (csp::RuntimeOptions::shared_cores)
   std::optional<std::uint32_t> cache_pages;  // remote pages cached per node
   std::optional<std::uint64_t> cache_kb;     // the same in KB; default (neither): default_cache_pages()

@@ -21,6 +21,7 @@
 
 #include "csp/csp.hpp"
 #include "nodes/net/packet.hpp"
+#include "nodes/net/router.hpp"
 #include "nodes/ranks/wire_fields.hpp"
 #include "tracer/vec.hpp"
 
@@ -138,7 +139,7 @@ Packet make_packet(NodeId destination, std::uint16_t port, MessageKind kind, std
 // what route tracing (NetworkOptions::trace_routes) selects.
 class Outbox {
  public:
-  Outbox(csp::Out<Packet> out, std::uint64_t index, std::uint64_t processes)
+  Outbox(Injector out, std::uint64_t index, std::uint64_t processes)
       : out_(std::move(out)), next_id_(index), step_(processes) {}
   void send(Packet packet) {
     packet.id = next_id_;
@@ -147,7 +148,7 @@ class Outbox {
   }
 
  private:
-  csp::Out<Packet> out_;
+  Injector out_;
   std::uint64_t next_id_;
   std::uint64_t step_;
 };

@@ -74,6 +74,7 @@ void wire_fields(V& v, WireView<RouterCounters> auto& c) {
   v(c.injected);
   v(c.forwarded);
   v(c.delivered);
+  v(c.in_place);
   v(c.peak_pending);
   v(c.sent);
   v(c.hops);

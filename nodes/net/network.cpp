@@ -58,8 +58,10 @@ Network::Network(csp::Runtime& runtime, topology::Topology topology, NetworkOpti
                                 asked > 0 ? std::max(asked, queue_capacity()) : queue_capacity());
     }
   }
+  routers_.resize(n);
   for (NodeId node = 0; node < n; ++node)
     if (is_local(node)) wire_node(runtime, node);
+  if (in_place()) forward_in_place();
   if (relays_) relays_->spawn(runtime);
 }
 
@@ -106,7 +108,24 @@ void Network::wire_node(csp::Runtime& runtime, NodeId node) {
                       options_.trace_kinds.empty() ? nullptr : &kinds_to_trace_, options_.recorder};
   auto router = std::make_shared<Router>(topology_, node, std::move(ends), config,
                                          *router_counters_[node]);
+  routers_[node] = router;
   runtime.spawn("router " + std::to_string(node), thread_of(node), [router] { router->run(); });
+}
+
+// Every link queue between two routers of this process and thread, by the
+// numbering of wire_node.
+void Network::forward_in_place() {
+  for (NodeId node = 0; node < topology_.size(); ++node) {
+    if (!is_local(node)) continue;
+    const auto neighbours = topology_.neighbours(node);
+    for (topology::Port p = 0; p < neighbours.size(); ++p) {
+      const NodeId m = neighbours[p];
+      if (!is_local(m) || thread_of(m) != thread_of(node)) continue;
+      const std::size_t back = topology_.port_to(m, node);
+      for (unsigned c = 0; c < classes_; ++c)
+        routers_[node]->forward_in_place(p * classes_ + c, *routers_[m], back * classes_ + c);
+    }
+  }
 }
 
 // The channel a router of `node` writes to reach `next`: `next` itself, or
@@ -124,6 +143,11 @@ csp::Out<Packet> Network::injector(NodeId node, unsigned port) const {
   if (port >= options_.ports_per_node)
     throw std::out_of_range("network: node " + std::to_string(node) + " has no port " + std::to_string(port));
   return injections_.at(node).writer();
+}
+
+Injector Network::in_place_injector(NodeId node, unsigned port) const {
+  csp::Out<Packet> out = injector(node, port);
+  return Injector(std::move(out), in_place() ? routers_.at(node).get() : nullptr);
 }
 
 csp::In<Packet> Network::port(NodeId node, unsigned port) const {
@@ -206,13 +230,16 @@ std::string format_summary(const NetworkStats& stats, const topology::Topology& 
     out << "  busiest link (most packets) " << busiest->from << " -> " << busiest->to << ": " << busiest->packets
         << " packets, " << busiest->bytes << " bytes\n";
   std::uint32_t peak = 0;
-  std::uint64_t forwarded = 0;
+  std::uint64_t forwarded = 0, in_place = 0;
   for (const auto& r : stats.routers) {
     peak = std::max(peak, r.peak_pending);
     forwarded += r.forwarded;
+    in_place += r.in_place;
   }
   out << "  packets forwarded by routers " << forwarded
       << ", most packets held back by one router (its output queues full) " << peak << "\n";
+  if (in_place)
+    out << "  router steps taken in place, by the sender on the router's thread " << in_place << "\n";
   return out.str();
 }
 

@@ -49,6 +49,10 @@ struct NetworkOptions {
   // relays (thread_relay.hpp) instead of channels shared by two threads.
   // Real time only (the relays need FifoScheduler); not with a link model.
   bool relay_between_threads = false;
+  // Routers route their same-thread neighbours' packets in place when the
+  // neighbour could take them at once, and in_place_injector() routes a
+  // local process's packet so (router.hpp). Without a link model only.
+  bool forward_in_place = false;
 };
 
 // One direction and buffer class of a link whose ends run in different processes.
@@ -90,6 +94,7 @@ class Network {
   const NetworkOptions& options() const { return options_; }
 
   csp::Out<Packet> injector(NodeId node, unsigned port = 0) const;
+  Injector in_place_injector(NodeId node, unsigned port = 0) const;
   csp::In<Packet> port(NodeId node, unsigned port = 0) const;
   unsigned thread_of(NodeId node) const;
 
@@ -116,6 +121,8 @@ class Network {
 
  private:
   void wire_node(csp::Runtime& runtime, NodeId node);
+  void forward_in_place();
+  bool in_place() const { return options_.forward_in_place && !options_.link.enabled(); }
   csp::Out<Packet> output_queue(csp::Runtime& runtime, NodeId node, const csp::Channel<Packet>& next);
   std::size_t queue_capacity() const;
 
@@ -135,6 +142,7 @@ class Network {
   // Counters live here so they outlive the processes; each is written by
   // exactly one process and read only after run().
   std::vector<std::unique_ptr<RouterCounters>> router_counters_;
+  std::vector<std::shared_ptr<Router>> routers_;  // per node; null for a node of another process
   std::atomic<std::uint64_t> routes_to_trace_;  // RouterConfig::routes_to_trace
   std::array<bool, 256> kinds_to_trace_{};      // RouterConfig::kinds_to_trace, from trace_kinds
 };

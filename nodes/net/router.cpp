@@ -30,7 +30,8 @@ Router::Router(topology::Topology topology, NodeId self, RouterEnds ends, Router
       log_(config.recorder ? &config.recorder->route_log(self) : nullptr),
       link_queues_(ends_.inputs.size()),
       pending_(ends_.inputs.size() + ends_.injections.size()),
-      held_for_(ends_.outputs.size(), 0) {
+      held_for_(ends_.outputs.size(), 0),
+      in_place_(ends_.outputs.size()) {
   counters_.sent.assign(ends_.outputs.size(), LinkCounters{});
 }
 
@@ -61,22 +62,47 @@ void Router::build_alt() {
   for (const auto& in : ends_.injections) source_guard_.push_back(alt_.add_input(in));
 }
 
+void Router::forward_in_place(std::size_t queue, Router& next, std::size_t input) {
+  if (queue >= link_queues_ || input >= next.ends_.inputs.size())
+    throw std::logic_error("router " + std::to_string(self_) + ": no link queue " + std::to_string(queue) +
+                           " into input " + std::to_string(input) + " of router " + std::to_string(next.self_));
+  in_place_[queue] = InPlace{&next, input};
+}
+
+bool Router::inject_in_place(Packet& packet) {
+  const std::size_t source = ends_.inputs.size();  // the injection channel
+  std::size_t queue = 0;
+  if (!valid_injection(packet) || !takes_at_once(source, packet, queue)) return false;
+  accept_injection(packet);
+  ++counters_.in_place;
+  if (!try_send(queue, packet))
+    throw std::logic_error("router " + std::to_string(self_) + ": an output with room refused a packet");
+  return true;
+}
+
 void Router::receive(std::size_t source, Packet& packet) {
-  if (source >= ends_.inputs.size()) {
+  if (source >= ends_.inputs.size())
     accept_injection(packet);
-  } else {
-    ++packet.hops;
-    if (packet.traced) packet.route.push_back(self_);
-    if (log_ && packet.recorded) log_->arrived.push_back({packet.id, config_.recorder->now(), 0, packet.hops});
-  }
+  else
+    arrive(packet);
   const std::size_t queue = output_queue(packet);
   // Packets already held back for this output go first.
   if (held_for_[queue] > 0 || !try_send(queue, packet)) hold(source, packet, queue);
 }
 
+// A packet read from a link input: one more hop.
+void Router::arrive(Packet& packet) {
+  ++packet.hops;
+  if (packet.traced) packet.route.push_back(self_);
+  if (log_ && packet.recorded) log_->arrived.push_back({packet.id, config_.recorder->now(), 0, packet.hops});
+}
+
+bool Router::valid_injection(const Packet& packet) const {
+  return packet.destination < topology_.size() && packet.port < ends_.outputs.size() - link_queues_;
+}
+
 void Router::accept_injection(Packet& packet) const {
-  const std::size_t ports = ends_.outputs.size() - link_queues_;
-  if (packet.destination >= topology_.size() || packet.port >= ports)
+  if (!valid_injection(packet))
     throw std::out_of_range("node " + std::to_string(self_) + ": packet " +
                             std::to_string(packet.id) + " sent to node " +
                             std::to_string(packet.destination) + " port " +
@@ -108,32 +134,75 @@ std::size_t Router::output_queue(const Packet& packet) const {
   return hop.port * topology_.buffer_classes() + hop.buffer_class;
 }
 
+// Whether this router's own step would send the packet, arriving now by
+// `source`, straight on: nothing from that source ahead of it (queued or
+// held back), nothing held back for its output, and room there, which
+// stays until this router writes (it is the output's only writer). Both
+// ends of `source` run on the caller's thread, so its hint is exact.
+bool Router::takes_at_once(std::size_t source, const Packet& packet, std::size_t& queue) const {
+  if (pending_[source]) return false;
+  const csp::In<Packet>& in =
+      source < ends_.inputs.size() ? ends_.inputs[source] : ends_.injections[source - ends_.inputs.size()];
+  if (in.ready_hint()) return false;  // values ahead of it, or poison
+  queue = output_queue(packet);
+  const csp::Out<Packet>& out = ends_.outputs[queue];
+  return held_for_[queue] == 0 && out.room_hint() && !out.poisoned();
+}
+
 // Writes the packet into its output queue if that has room; false (packet
-// untouched) if it is full.
+// untouched) if it is full. Where the queue leads to a router of this
+// thread that would send the packet straight on, the packet goes through
+// that router's step in place instead, with the same counts, and so on:
+// only the first queue can be full.
 bool Router::try_send(std::size_t queue, Packet& packet) {
+  Router* at = this;
+  for (;;) {
+    const InPlace next = at->in_place_[queue];
+    std::size_t next_queue = 0;
+    if (!next.router || !next.router->takes_at_once(next.input, packet, next_queue)) {
+      if (at->write_out(queue, packet)) return true;
+      if (at == this) return false;
+      throw std::logic_error("router " + std::to_string(at->self_) + ": an output with room refused a packet");
+    }
+    const double left_at = at->log_ && packet.recorded ? at->config_.recorder->now() : 0.0;
+    std::optional<RouteRecord> no_route;
+    at->count_sent(queue, packet.bytes(), packet.hops, packet.kind, packet.recorded, packet.id, left_at, no_route);
+    next.router->arrive(packet);
+    ++next.router->counters_.in_place;
+    at = next.router;
+    queue = next_queue;
+  }
+}
+
+// The channel write of try_send, and its counts.
+bool Router::write_out(std::size_t queue, Packet& packet) {
   const std::size_t bytes = packet.bytes();
-  const bool delivery = queue >= link_queues_;
-  const std::uint32_t hops = packet.hops;
+  const std::uint16_t hops = packet.hops;
   const std::uint8_t kind = packet.kind;
   const bool recorded = packet.recorded;
   const std::uint64_t id = packet.id;
   // Before the write: on another thread the next router may read it at once.
   const double left_at = log_ && recorded ? config_.recorder->now() : 0.0;
   std::optional<RouteRecord> route;
-  if (delivery && packet.traced) route = RouteRecord{packet.id, packet.kind, packet.route};
+  if (queue >= link_queues_ && packet.traced) route = RouteRecord{packet.id, packet.kind, packet.route};
   if (!ends_.outputs[queue].try_write(packet)) return false;
+  count_sent(queue, bytes, hops, kind, recorded, id, left_at, route);
+  return true;
+}
+
+void Router::count_sent(std::size_t queue, std::size_t bytes, std::uint16_t hops, std::uint8_t kind, bool recorded,
+                        std::uint64_t id, double left_at, std::optional<RouteRecord>& route) {
   ++counters_.sent[queue].packets;
   counters_.sent[queue].bytes += bytes;
-  if (log_) record_sent(recorded, id, static_cast<std::uint16_t>(hops), kind, queue, left_at);
-  if (!delivery) {
+  if (log_) record_sent(recorded, id, hops, kind, queue, left_at);
+  if (queue < link_queues_) {
     ++counters_.forwarded;
-    return true;
+    return;
   }
   ++counters_.delivered;
   counters_.hops.add(hops);
   counters_.hops_by_kind[kind].add(hops);
   if (route) counters_.routes.push_back(std::move(*route));
-  return true;
 }
 
 // Off the hot path: only a recorded run calls it.

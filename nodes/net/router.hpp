@@ -10,6 +10,9 @@
 // try_write at once, or waits in its input's pending slot (that input off,
 // the output's room guard on); held-back packets are admitted in rotation.
 // So each (link, class) owns at most K queued + 1 pending packets.
+// In place: a packet that a router on the same thread could read and send
+// on at once (nothing ahead of it on that input, room in its output) is
+// routed by the sender through that router's step, with the same counts.
 // Consumption assumption: a delivery queue drains while its reader reads,
 // so a process that both receives and sends reads its port in a fiber of
 // its own (or never blocks on injection while packets for it may wait).
@@ -50,6 +53,7 @@ struct RouterCounters {
   std::uint64_t injected = 0;
   std::uint64_t forwarded = 0;  // packets sent on into a link queue
   std::uint64_t delivered = 0;
+  std::uint64_t in_place = 0;   // packets taken without a channel read: routed in place by a sender
   std::uint32_t peak_pending = 0;  // most packets held back at once (outputs full)
   std::vector<LinkCounters> sent;  // per output queue: packets and payload bytes
   HopSummary hops;                 // of packets delivered here
@@ -82,10 +86,24 @@ class Router {
          RouterCounters& counters);
   void run();
 
+  // Before run(): output queue `queue` is input `input` of `next`, which
+  // runs on this router's thread; packets then go through next's step in
+  // place when it could take them at once.
+  void forward_in_place(std::size_t queue, Router& next, std::size_t input);
+  // From a process on this router's thread: routes an injected packet at
+  // once, as if the router had read it, when nothing is ahead of it and its
+  // output has room; false, the packet untouched, otherwise (write it to
+  // the injection channel then).
+  bool inject_in_place(Packet& packet);
+
  private:
   struct Pending {
     Packet packet;
     std::size_t queue;
+  };
+  struct InPlace {
+    Router* router = nullptr;  // null: the queue is only a channel
+    std::size_t input = 0;
   };
 
   void build_alt();
@@ -95,6 +113,12 @@ class Router {
                    double time);
   bool take_route_to_trace(std::uint8_t kind) const;
   bool try_send(std::size_t queue, Packet& packet);
+  bool write_out(std::size_t queue, Packet& packet);
+  void count_sent(std::size_t queue, std::size_t bytes, std::uint16_t hops, std::uint8_t kind, bool recorded,
+                  std::uint64_t id, double left_at, std::optional<RouteRecord>& route);
+  bool takes_at_once(std::size_t source, const Packet& packet, std::size_t& queue) const;
+  void arrive(Packet& packet);
+  bool valid_injection(const Packet& packet) const;
   void hold(std::size_t source, Packet& packet, std::size_t queue);
   void admit_pending(std::size_t queue);
   std::size_t output_queue(const Packet& packet) const;
@@ -108,10 +132,30 @@ class Router {
   std::size_t link_queues_;  // degree * classes; delivery queues follow
   std::vector<std::optional<Pending>> pending_;  // per input, then per injection
   std::vector<std::uint32_t> held_for_;          // per output: pending packets waiting for it
+  std::vector<InPlace> in_place_;                // per output
   std::uint32_t pending_count_ = 0;
   std::size_t next_admit_ = 0;  // rotates which pending packet is admitted first
   csp::Alt alt_{csp::Alt::Waiting::doorbell};
   std::vector<std::size_t> room_guard_, source_guard_;
+};
+
+// A local process's way into the network at its node, used only by
+// processes on the node's thread: a write routes the packet in place when
+// the router could take it at once (network.hpp, NetworkOptions::forward_in_place),
+// else writes it to the node's injection channel.
+class Injector {
+ public:
+  Injector() = default;
+  // NOLINTNEXTLINE(google-explicit-constructor): a channel end is an injector that never routes in place
+  Injector(csp::Out<Packet> out, Router* router = nullptr) : out_(std::move(out)), router_(router) {}
+  void write(Packet packet) {
+    if (router_ && router_->inject_in_place(packet)) return;
+    out_.write(std::move(packet));
+  }
+
+ private:
+  csp::Out<Packet> out_;
+  Router* router_ = nullptr;
 };
 
 }  // namespace nodes

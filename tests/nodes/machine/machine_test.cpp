@@ -17,6 +17,7 @@
 #include <tuple>
 
 #include "tests/nodes/machine/test_database.hpp"
+#include "topology/spec.hpp"
 #include "tracer/generators.hpp"
 
 namespace {
@@ -63,6 +64,7 @@ struct Case {
   PixelOrder order = PixelOrder::scanline;
   bool spd = false;  // SPD procedure: items are the (size + 1)^2 pixel corners
   bool record_tiles = false;
+  bool forward_in_place = true;
 };
 
 nodes::MachineResult run_case(const Case& c) {
@@ -79,6 +81,7 @@ nodes::MachineResult run_case(const Case& c) {
   options.pixel_order = c.order;
   options.trace.spd_procedure = c.spd;
   options.record_tiles = c.record_tiles;
+  options.forward_in_place = c.forward_in_place;
   return nodes::run_machine(std::move(db), options);
 }
 
@@ -179,6 +182,31 @@ TEST(Machine, RelaysCarryEveryPacketBetweenThreadsOnce) {
   EXPECT_EQ(plain.report.relayed_links, 0u);
   EXPECT_TRUE(same_bits(plain.image.pixels(), relayed.image.pixels()));
   EXPECT_TRUE(same_bits(relayed.image.pixels(), cached_reference(c.scene, c.size)));
+}
+
+// Router steps taken in place by the senders on the router's thread (the
+// default) or only by the routers: the same image, and each packet's hops
+// within the topology's diameter; in place only where a sender shares the thread.
+TEST(Machine, RoutingInPlaceComputesWhatTheRoutersAloneCompute) {
+  for (const unsigned threads : {1u, 2u})
+    for (const char* topology : {"hypercube", "ring", "torus"}) {
+      Case c{topology, 16, 2, 256, 4, Schedule::dynamic, 2, threads};
+      SCOPED_TRACE(describe(c));
+      c.forward_in_place = false;
+      const auto alone = run_case(c);
+      c.forward_in_place = true;
+      const auto in_place = run_case(c);
+      EXPECT_TRUE(same_bits(alone.image.pixels(), in_place.image.pixels()));
+      EXPECT_TRUE(same_bits(in_place.image.pixels(), cached_reference(c.scene, c.size)));
+      std::uint64_t taken = 0, taken_alone = 0;
+      for (const auto& r : in_place.report.network.routers) taken += r.in_place;
+      for (const auto& r : alone.report.network.routers) taken_alone += r.in_place;
+      EXPECT_EQ(taken_alone, 0u);
+      EXPECT_GT(taken, 0u);
+      const auto t = topology::parse_topology(in_place.report.topology);
+      EXPECT_LE(in_place.report.network.hops.max_hops, t.diameter());
+      EXPECT_GT(in_place.report.network.hops.packets, 0u);
+    }
 }
 
 TEST(Machine, ImageIsBitIdenticalOn256Nodes) {

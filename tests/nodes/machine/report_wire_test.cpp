@@ -83,6 +83,7 @@ nodes::RouterCounters router_counters() {
   nodes::RouterCounters c;
   c.injected = 31;
   c.forwarded = 32;
+  c.in_place = 21;
   c.delivered = 33;
   c.peak_pending = 34;
   c.sent = {patterned<nodes::LinkCounters>(1), patterned<nodes::LinkCounters>(20)};
@@ -211,10 +212,10 @@ TEST(ReportWire, RouterCountersRoundTrip) {
   const Bytes bytes = encoded([&](WireWriter& w) { nodes::put_router_counters(w, c); });
   // Each route: its id, its kind (one byte), its counted nodes.
   const std::size_t routes = 8 + (8 + 1 + 8 + 3 * 4) + (8 + 1 + 8) + (8 + 1 + 8 + 4);
-  EXPECT_EQ(bytes.size(), 3 * 8 + 4 + 8 + 2 * sizeof(nodes::LinkCounters) + sizeof(c.hops) +
+  EXPECT_EQ(bytes.size(), 4 * 8 + 4 + 8 + 2 * sizeof(nodes::LinkCounters) + sizeof(c.hops) +
                               sizeof(c.hops_by_kind) + routes);
   WireWriter layout;
-  for (std::uint64_t x : {c.injected, c.forwarded, c.delivered}) layout.put(x);
+  for (std::uint64_t x : {c.injected, c.forwarded, c.delivered, c.in_place}) layout.put(x);
   layout.put(c.peak_pending);
   layout.put_vector(c.sent);
   layout.put(c.hops);
@@ -232,6 +233,7 @@ TEST(ReportWire, RouterCountersRoundTrip) {
   EXPECT_EQ(back.injected, c.injected);
   EXPECT_EQ(back.forwarded, c.forwarded);
   EXPECT_EQ(back.delivered, c.delivered);
+  EXPECT_EQ(back.in_place, c.in_place);
   EXPECT_EQ(back.peak_pending, c.peak_pending);
   ASSERT_EQ(back.sent.size(), 2u);
   for (std::size_t i = 0; i < 2; ++i) EXPECT_TRUE(same_bytes(back.sent[i], c.sent[i]));

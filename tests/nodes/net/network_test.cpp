@@ -37,6 +37,7 @@ Plan all_to_all_plan(std::size_t nodes) {
 
 struct Received {
   std::vector<std::uint64_t> ids;
+  std::vector<NodeId> sources;  // of each id
   std::uint64_t hops = 0;
   bool misrouted = false;
 };
@@ -46,8 +47,8 @@ struct Received {
 // the last receiver to finish shuts the network down.
 std::vector<Received> run_plan(const topology::Topology& t, const Plan& plan,
                                NetworkOptions options, NetworkStats* stats = nullptr,
-                               std::size_t payload = 16) {
-  csp::Runtime runtime(2);
+                               std::size_t payload = 16, unsigned threads = 2) {
+  csp::Runtime runtime(threads);
   Network net(runtime, t, options);
   std::vector<std::size_t> expected(t.size(), 0);
   for (const auto& dsts : plan)
@@ -66,7 +67,7 @@ std::vector<Received> run_plan(const topology::Topology& t, const Plan& plan,
       packets.push_back(std::move(p));
     }
     runtime.spawn("send " + std::to_string(n), net.thread_of(n),
-                  [out = net.injector(n), packets = std::move(packets)]() mutable {
+                  [out = net.in_place_injector(n), packets = std::move(packets)]() mutable {
                     for (auto& p : packets) out.write(std::move(p));
                   });
     runtime.spawn("receive " + std::to_string(n), net.thread_of(n),
@@ -74,6 +75,7 @@ std::vector<Received> run_plan(const topology::Topology& t, const Plan& plan,
                     for (std::size_t i = 0; i < expected[n]; ++i) {
                       Packet p = in.read();
                       received[n].ids.push_back(p.id);
+                      received[n].sources.push_back(p.source);
                       received[n].hops += p.hops;
                       received[n].misrouted |= p.destination != n || p.hops != t.distance(p.source, n);
                     }
@@ -96,6 +98,18 @@ void expect_each_delivered_once(const topology::Topology& t, const Plan& plan,
   }
   for (std::size_t id = 0; id < total; ++id)
     ASSERT_EQ(seen[id], 1) << t.spec() << " packet " << id;
+  // One route per pair and queues kept in order: a sender's packets (ids
+  // rising) arrive in the order sent.
+  for (NodeId n = 0; n < t.size(); ++n) {
+    std::vector<std::uint64_t> last(t.size(), 0);
+    std::vector<bool> any(t.size(), false);
+    for (std::size_t i = 0; i < received[n].ids.size(); ++i) {
+      const NodeId from = received[n].sources[i];
+      EXPECT_TRUE(!any[from] || received[n].ids[i] > last[from]) << t.spec() << " " << from << " -> " << n;
+      any[from] = true;
+      last[from] = received[n].ids[i];
+    }
+  }
 }
 
 std::string name_kind(std::uint8_t kind) { return kind == kind_traffic ? "traffic" : "other"; }
@@ -113,9 +127,47 @@ TEST(Network, RandomStormWithBuffersOfOneDeliversEveryPacketOnce) {
     const auto t = topology::parse_topology(spec);
     const std::size_t per_node = std::max<std::size_t>(8, 1000 / t.size());
     const Plan plan = random_plan(t.size(), per_node, 1234);
-    NetworkOptions options;
-    options.buffer_capacity = 1;
-    expect_each_delivered_once(t, plan, run_plan(t, plan, options));
+    for (const bool in_place : {false, true}) {
+      NetworkOptions options;
+      options.buffer_capacity = 1;
+      options.forward_in_place = in_place;
+      expect_each_delivered_once(t, plan, run_plan(t, plan, options));
+    }
+  }
+}
+
+// Routing in place changes who runs a router's step, not the step: the same
+// links carry the same packets, every packet arrives once and in order, on
+// one thread (every router in place) and two (in place within each, relays
+// or shared channels between), with full and roomy buffers.
+TEST(Network, RoutingInPlaceTakesTheSameLinksAsTheRoutersThemselves) {
+  for (const char* spec : {"hypercube:4", "torus:5x3", "mesh:4x4", "ring:9", "complete:7"}) {
+    const auto t = topology::parse_topology(spec);
+    const Plan plan = random_plan(t.size(), 200, 99);
+    for (const unsigned threads : {1u, 2u})
+      for (const std::size_t buffers : {std::size_t{1}, std::size_t{4}})
+        for (const bool relays : {false, true}) {
+          SCOPED_TRACE(std::string(spec) + " threads " + std::to_string(threads) + " buffers " +
+                       std::to_string(buffers) + (relays ? " relays" : ""));
+          NetworkOptions options;
+          options.buffer_capacity = buffers;
+          options.relay_between_threads = relays;
+          NetworkStats by_routers, in_place;
+          expect_each_delivered_once(t, plan, run_plan(t, plan, options, &by_routers, 16, threads));
+          options.forward_in_place = true;
+          expect_each_delivered_once(t, plan, run_plan(t, plan, options, &in_place, 16, threads));
+          ASSERT_EQ(in_place.links.size(), by_routers.links.size());
+          for (std::size_t l = 0; l < in_place.links.size(); ++l) {
+            EXPECT_EQ(in_place.links[l].packets, by_routers.links[l].packets) << l;
+            EXPECT_EQ(in_place.links[l].bytes, by_routers.links[l].bytes) << l;
+          }
+          EXPECT_EQ(in_place.hops.total_hops, by_routers.hops.total_hops);
+          std::uint64_t taken = 0, taken_by_routers = 0;
+          for (const auto& r : in_place.routers) taken += r.in_place;
+          for (const auto& r : by_routers.routers) taken_by_routers += r.in_place;
+          EXPECT_EQ(taken_by_routers, 0u);
+          EXPECT_GT(taken, 0u);
+        }
   }
 }
 
@@ -158,8 +210,9 @@ TEST(Network, TracedRoutesFollowLinksHopByHop) {
   const auto t = topology::parse_topology("hypercube:4");
   NetworkOptions options;
   options.trace_routes = 10;
+  options.forward_in_place = true;  // a route taken in place is traced as one the routers took
   NetworkStats stats;
-  run_plan(t, all_to_all_plan(t.size()), options, &stats);
+  run_plan(t, all_to_all_plan(t.size()), options, &stats, 16, 1);
   ASSERT_EQ(stats.routes.size(), 10u);
   for (const auto& r : stats.routes) {
     ASSERT_GE(r.route.size(), 2u);
