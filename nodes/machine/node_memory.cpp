@@ -66,7 +66,7 @@ NodeMemory::NodeMemory(const PagePlacement& placement, int node, std::size_t pag
 
 int NodeMemory::take_slot(std::span<const int> in_use) {
   if (slots_.size() < capacity_) {
-    slots_.push_back(Slot{std::make_unique<std::byte[]>(page_size_)});
+    slots_.emplace_back();
     const int slot = static_cast<int>(slots_.size() - 1);
     push_front(slot);
     return slot;
@@ -80,13 +80,20 @@ int NodeMemory::take_slot(std::span<const int> in_use) {
   return victim;
 }
 
-int NodeMemory::install(std::uint32_t page, std::span<const std::byte> bytes, std::span<const int> in_use) {
+int NodeMemory::install(std::uint32_t page, std::span<const std::byte> bytes, std::span<const int> in_use,
+                        Holding holding) {
   if (bytes.size() != page_size_) throw std::runtime_error("page " + std::to_string(page) + " arrived with a wrong size");
   if (entry_[page] != -1) throw std::logic_error("page " + std::to_string(page) + " installed twice");
   if (capacity_ == 0) throw std::logic_error("page cache has no slot for remote page " + std::to_string(page));
   const int slot = take_slot(in_use);
   Slot& s = slots_[static_cast<std::size_t>(slot)];
-  std::memcpy(s.bytes.get(), bytes.data(), page_size_);
+  if (holding == Holding::reference) {
+    s.data = bytes.data();
+  } else {
+    if (!s.bytes) s.bytes = std::make_unique<std::byte[]>(page_size_);
+    std::memcpy(s.bytes.get(), bytes.data(), page_size_);
+    s.data = s.bytes.get();
+  }
   s.page = page;
   entry_[page] = -2 - slot;
   use(slot);

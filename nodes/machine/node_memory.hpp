@@ -10,7 +10,10 @@
 //  - the occupied slots form one list by use, most recent first: a hit and
 //    an install (evicting from the back) take O(1).
 //  - a slot named in install()'s `in_use` is never evicted; resident bytes
-//    = own pages + occupied slots, allocated on first use, at most capacity.
+//    = own pages + occupied slots, at most capacity. A slot holds a copy
+//    (its buffer allocated on first use) or, for a page that another node
+//    of this process owns, refers to the owner's page, which nothing
+//    writes while the machine runs (Holding).
 // A node's workers are fibers on one OS thread and run one at a time, and no
 // member function suspends, so no lock is needed.
 #pragma once
@@ -60,13 +63,17 @@ class NodeMemory {
   const std::byte* own_page(std::int32_t index) const {
     return own_.get() + static_cast<std::size_t>(index) * page_size_;
   }
-  const std::byte* slot_bytes(int slot) const { return slots_[static_cast<std::size_t>(slot)].bytes.get(); }
+  const std::byte* slot_bytes(int slot) const { return slots_[static_cast<std::size_t>(slot)].data; }
 
   // The slot's bytes, making it the most recently used.
   const std::byte* use(int slot) {
     if (slot != front_) to_front(slot);
-    return slots_[static_cast<std::size_t>(slot)].bytes.get();
+    return slots_[static_cast<std::size_t>(slot)].data;
   }
+
+  // How a slot holds a page: a copy of the bytes, or the bytes themselves,
+  // which must then stay unchanged and alive while the machine runs.
+  enum class Holding { copy, reference };
 
   // Copies a fetched remote page into a free slot or the least recently
   // used one not named in `in_use`, and returns that slot, now the most
@@ -75,7 +82,8 @@ class NodeMemory {
   // another; the victim is found at most |in_use| + 1 steps from the back.
   // Throws std::logic_error if every slot is in use (cannot happen: see
   // docs/architecture.md, "The path of one page request").
-  int install(std::uint32_t page, std::span<const std::byte> bytes, std::span<const int> in_use = {});
+  int install(std::uint32_t page, std::span<const std::byte> bytes, std::span<const int> in_use = {},
+              Holding holding = Holding::copy);
 
   // Miss coalescing: begin_fetch is true for the first worker to miss on a
   // page (it fetches); later ones add_waiter and are woken by the fetcher
@@ -92,7 +100,8 @@ class NodeMemory {
 
  private:
   struct Slot {
-    std::unique_ptr<std::byte[]> bytes;  // page_size_ bytes, allocated on first use
+    std::unique_ptr<std::byte[]> bytes;  // page_size_ bytes, allocated on the first copy
+    const std::byte* data = nullptr;     // the page: bytes, or the owner's (Holding::reference)
     std::uint32_t page = 0;
     // The use list links slots by index: a hit on the most recent slot
     // changes nothing, any other hit moves its slot to the front, and an

@@ -65,7 +65,10 @@ const std::byte* SvmSource::fetch_and_install(tracer::PageId id) {
     throw std::logic_error("asked for page " + std::to_string(id) + ", got page " +
                            std::to_string(page_reply_id(reply)));
   // Pin before waking anyone, so the page stays until this worker moves on.
-  const std::byte* bytes = from_slot(node_.install(id, page_reply_bytes(reply)));
+  // A reply that carries the owner's page by reference (inside one process)
+  // is held so: the page never changes while the machine runs.
+  const auto holding = reply.shared.empty() ? NodeMemory::Holding::copy : NodeMemory::Holding::reference;
+  const std::byte* bytes = from_slot(node_.install(id, page_reply_bytes(reply), holding));
   for (int waiter : memory_.end_fetch(id)) node_.worker(waiter).wake_.writer().write(1);
   return bytes;
 }
@@ -75,11 +78,11 @@ SvmSource& NodeSvm::add_worker(PageFetch fetch) {
   return *workers_.back();
 }
 
-int NodeSvm::install(std::uint32_t page, std::span<const std::byte> bytes) {
+int NodeSvm::install(std::uint32_t page, std::span<const std::byte> bytes, NodeMemory::Holding holding) {
   std::vector<int> pinned;  // empty, and so never allocated, unless a worker holds a pin
   for (const auto& w : workers_)
     if (w->pinned_ >= 0) pinned.push_back(w->pinned_);
-  return memory_.install(page, bytes, pinned);
+  return memory_.install(page, bytes, pinned, holding);
 }
 
 SvmStats NodeSvm::stats() const {

@@ -90,7 +90,7 @@ class NodeSvm {
  private:
   friend class SvmSource;
   // Installs a fetched page where no worker's pin is.
-  int install(std::uint32_t page, std::span<const std::byte> bytes);
+  int install(std::uint32_t page, std::span<const std::byte> bytes, NodeMemory::Holding holding);
 
   NodeMemory memory_;
   std::vector<std::unique_ptr<SvmSource>> workers_;

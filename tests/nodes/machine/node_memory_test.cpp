@@ -103,6 +103,25 @@ TEST(NodeMemory, SlotInUseIsNeverEvicted) {
   EXPECT_EQ(memory.entry(1), -1);
 }
 
+// A page held by reference is the owner's bytes themselves, not a copy;
+// the slot it leaves, taken by a copy, gets a buffer of its own, and the
+// owner's page is never written.
+TEST(NodeMemory, APageHeldByReferenceIsTheOwnersAndItsSlotCopiesLater) {
+  const PagePlacement placement(Distribution::modulo, 2, 10);
+  NodeMemory memory(placement, 0, page_size, own_pages(placement, 0), 1);
+  const std::vector<std::byte> owners = page_bytes(1);
+  const int slot = memory.install(1, owners, {}, NodeMemory::Holding::reference);
+  EXPECT_EQ(memory.use(slot), owners.data());
+  EXPECT_EQ(memory.install(3, page_bytes(3)), slot);  // evicts page 1
+  EXPECT_EQ(memory.entry(1), -1);
+  EXPECT_NE(memory.slot_bytes(slot), owners.data());
+  EXPECT_EQ(memory.slot_bytes(slot)[0], std::byte{3});
+  EXPECT_EQ(owners, page_bytes(1));
+  EXPECT_EQ(memory.install(5, page_bytes(5)), slot);  // the buffer, reused, takes the copy
+  EXPECT_EQ(memory.slot_bytes(slot)[page_size - 1], std::byte{5});
+  EXPECT_EQ(memory.resident_bytes(), memory.own_bytes() + page_size);
+}
+
 // A long random run of installs and uses, with slots taken in and out of use,
 // against a plain list kept in recency order: the cache must hold exactly
 // the pages the list says.
