@@ -29,6 +29,7 @@ class FrameAssembler {
   std::uint32_t received() const { return received_; }
   bool complete() const { return received_ == colors_.size(); }
   const std::vector<tracer::Color>& colors() const { return colors_; }
+  std::vector<tracer::Color> take_colors() { return std::move(colors_); }  // leaves none
   std::uint32_t position(std::uint32_t item) const { return scanline_position(positions_, item); }
 
  private:

@@ -241,15 +241,14 @@ void spawn_host(const Wiring& w, Host& host) {
 
 // items: every pixel or corner sample, in scanline order.
 tracer::Image assemble_image(const tracer::DatabaseHeader& header, const ItemGrid& grid,
-                             const std::vector<tracer::Color>& items) {
+                             std::vector<tracer::Color>&& items) {
   const int width = header.camera.width, height = header.camera.height;
+  if (!grid.corners) return tracer::Image(width, height, std::move(items));  // items are the pixels, in rows
   tracer::Image image(width, height);
   for (int y = 0; y < height; ++y)
     for (int x = 0; x < width; ++x) {
       const auto at = [&](int sx, int sy) { return items[static_cast<std::size_t>(sy) * grid.width + sx]; };
-      image.at(x, y) = grid.corners
-                           ? tracer::Tracer::average_corners(at(x, y), at(x + 1, y), at(x, y + 1), at(x + 1, y + 1))
-                           : at(x, y);
+      image.at(x, y) = tracer::Tracer::average_corners(at(x, y), at(x + 1, y), at(x, y + 1), at(x + 1, y + 1));
     }
   return image;
 }
@@ -614,7 +613,7 @@ Executed execute(const tracer::DatabaseHeader& header, const topology::Topology&
     report.farmer.steals = host.plan->steals();
     report.collected = host.frame->received();
     report.owners = std::move(host.owners);
-    result.image = assemble_image(header, items.grid, host.frame->colors());
+    result.image = assemble_image(header, items.grid, host.frame->take_colors());
   }
   return executed;
 }

@@ -62,18 +62,20 @@ NodeMemory::NodeMemory(const PagePlacement& placement, int node, std::size_t pag
   // More slots than remote pages could never be filled.
   capacity_ = std::min(cache_pages, placement.page_count() - static_cast<std::uint32_t>(own_count_));
   slots_.reserve(capacity_);
+  uses_.reserve(capacity_);
 }
 
 int NodeMemory::take_slot(std::span<const int> in_use) {
   if (slots_.size() < capacity_) {
     slots_.emplace_back();
+    uses_.emplace_back();
     const int slot = static_cast<int>(slots_.size() - 1);
     push_front(slot);
     return slot;
   }
   int victim = back_;
   while (victim >= 0 && std::find(in_use.begin(), in_use.end(), victim) != in_use.end())
-    victim = slots_[static_cast<std::size_t>(victim)].newer;
+    victim = uses_[static_cast<std::size_t>(victim)].newer;
   if (victim < 0) throw std::logic_error("page cache: every slot is in use");
   entry_[slots_[static_cast<std::size_t>(victim)].page] = -1;
   ++evictions_;
@@ -88,11 +90,11 @@ int NodeMemory::install(std::uint32_t page, std::span<const std::byte> bytes, st
   const int slot = take_slot(in_use);
   Slot& s = slots_[static_cast<std::size_t>(slot)];
   if (holding == Holding::reference) {
-    s.data = bytes.data();
+    uses_[static_cast<std::size_t>(slot)].data = bytes.data();
   } else {
     if (!s.bytes) s.bytes = std::make_unique<std::byte[]>(page_size_);
     std::memcpy(s.bytes.get(), bytes.data(), page_size_);
-    s.data = s.bytes.get();
+    uses_[static_cast<std::size_t>(slot)].data = s.bytes.get();
   }
   s.page = page;
   entry_[page] = -2 - slot;

@@ -63,12 +63,12 @@ class NodeMemory {
   const std::byte* own_page(std::int32_t index) const {
     return own_.get() + static_cast<std::size_t>(index) * page_size_;
   }
-  const std::byte* slot_bytes(int slot) const { return slots_[static_cast<std::size_t>(slot)].data; }
+  const std::byte* slot_bytes(int slot) const { return uses_[static_cast<std::size_t>(slot)].data; }
 
   // The slot's bytes, making it the most recently used.
   const std::byte* use(int slot) {
     if (slot != front_) to_front(slot);
-    return slots_[static_cast<std::size_t>(slot)].data;
+    return uses_[static_cast<std::size_t>(slot)].data;
   }
 
   // How a slot holds a page: a copy of the bytes, or the bytes themselves,
@@ -101,26 +101,29 @@ class NodeMemory {
  private:
   struct Slot {
     std::unique_ptr<std::byte[]> bytes;  // page_size_ bytes, allocated on the first copy
-    const std::byte* data = nullptr;     // the page: bytes, or the owner's (Holding::reference)
     std::uint32_t page = 0;
-    // The use list links slots by index: a hit on the most recent slot
-    // changes nothing, any other hit moves its slot to the front, and an
-    // install into a full cache evicts from the back.
+  };
+  // What a hit touches, apart (16 bytes a slot): the use list links slots
+  // by index; a hit on the most recent slot changes nothing, any other hit
+  // moves its slot to the front, and an install into a full cache evicts
+  // from the back.
+  struct Use {
+    const std::byte* data = nullptr;  // the page: the slot's bytes, or the owner's (Holding::reference)
     int newer = -1;  // the slot used just after this one; -1: this is the front
     int older = -1;  // the slot used just before; -1: this is the back
   };
 
   int take_slot(std::span<const int> in_use);
   void unlink(int slot) {
-    Slot& s = slots_[static_cast<std::size_t>(slot)];
-    (s.newer >= 0 ? slots_[static_cast<std::size_t>(s.newer)].older : front_) = s.older;
-    (s.older >= 0 ? slots_[static_cast<std::size_t>(s.older)].newer : back_) = s.newer;
+    Use& s = uses_[static_cast<std::size_t>(slot)];
+    (s.newer >= 0 ? uses_[static_cast<std::size_t>(s.newer)].older : front_) = s.older;
+    (s.older >= 0 ? uses_[static_cast<std::size_t>(s.older)].newer : back_) = s.newer;
   }
   void push_front(int slot) {
-    Slot& s = slots_[static_cast<std::size_t>(slot)];
+    Use& s = uses_[static_cast<std::size_t>(slot)];
     s.newer = -1;
     s.older = front_;
-    (front_ >= 0 ? slots_[static_cast<std::size_t>(front_)].newer : back_) = slot;
+    (front_ >= 0 ? uses_[static_cast<std::size_t>(front_)].newer : back_) = slot;
     front_ = slot;
   }
   void to_front(int slot) {
@@ -134,6 +137,7 @@ class NodeMemory {
   std::unique_ptr<std::byte[]> own_;  // own_count_ pages end to end
   std::vector<std::int32_t> entry_;
   std::vector<Slot> slots_;
+  std::vector<Use> uses_;  // by slot, as slots_
   int front_ = -1;  // most recently used slot; -1: none
   int back_ = -1;   // least recently used
   std::uint64_t evictions_ = 0;
