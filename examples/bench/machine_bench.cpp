@@ -4,7 +4,9 @@
 // pulling rows (the single-process renderer, vmpray --single), measured side
 // by side on the same threads; and the speedup of T threads over 1.
 // Each machine line on T threads is also run with packets between threads
-// on plain channels rather than through the thread relays.
+// on plain channels rather than through the thread relays, and the 1- and
+// T-thread lines with every router step taken by the router's own process
+// (no steps in place: a fiber switch per hop).
 // Then where the machine's time goes, on 16 nodes and T threads: the same
 // run with the BVH's nodes in depth-first layout rather than in treelets,
 // with the paper's ask-when-idle protocol (prefetch 0), with every cache
@@ -139,9 +141,12 @@ int bench_machine(const std::vector<std::string>& args) {
   shared_memory_seconds(db, threads, image);  // the reference image, and a warm start for both sides
 
   for (int nodes : {16, 64}) {
-    MachineRun one, many, plain;
+    MachineRun one, many, plain, one_routers, many_routers;
     const Variant no_relays = [](nodes::MachineOptions& o, const tracer::DatabaseHeader&) {
       o.relay_between_threads = false;
+    };
+    const Variant no_steps_in_place = [](nodes::MachineOptions& o, const tracer::DatabaseHeader&) {
+      o.forward_in_place = false;
     };
     for (int r = 0; r < repeats; ++r) {
       std::vector<tracer::Color> frame;
@@ -150,6 +155,8 @@ int bench_machine(const std::vector<std::string>& args) {
       shared_t.seconds.push_back(shared_memory_seconds(db, threads, frame));
       run_machine_once(many, spec, size, nodes, threads, image);
       run_machine_once(plain, spec, size, nodes, threads, image, no_relays);
+      run_machine_once(one_routers, spec, size, nodes, 1, image, no_steps_in_place);
+      run_machine_once(many_routers, spec, size, nodes, threads, image, no_steps_in_place);
     }
     if (nodes == 16) {
       std::printf("single process, 1 thread                       %6.3f s (fastest %6.3f)\n", shared1.median(),
@@ -163,10 +170,16 @@ int bench_machine(const std::vector<std::string>& args) {
     print_run(lt.c_str(), many, shared_t.median());
     const std::string lp = lt + ", no relays";
     print_run(lp.c_str(), plain, shared_t.median());
+    const std::string l1r = l1 + ", no steps in place", ltr = lt + ", no steps in place";
+    print_run(l1r.c_str(), one_routers, shared1.median());
+    print_run(ltr.c_str(), many_routers, shared_t.median());
     if (one.ok() && many.ok())
-      std::printf("  speedup of %u threads over 1: %.2fx (fastest runs %.2fx); without relays %.2fx\n", threads,
-                  one.times.median() / many.times.median(), one.times.fastest() / many.times.fastest(),
-                  plain.ok() ? one.times.median() / plain.times.median() : 0.0);
+      std::printf("  speedup of %u threads over 1: %.2fx (fastest runs %.2fx); without relays %.2fx; "
+                  "with no steps in place %.2fx\n",
+                  threads, one.times.median() / many.times.median(), one.times.fastest() / many.times.fastest(),
+                  plain.ok() ? one.times.median() / plain.times.median() : 0.0,
+                  one_routers.ok() && many_routers.ok() ? one_routers.times.median() / many_routers.times.median()
+                                                        : 0.0);
   }
 
   std::printf("where the time goes: hypercube 16, %u threads, against the single process on %u threads\n", threads,

@@ -88,8 +88,9 @@ void Network::wire_node(csp::Runtime& runtime, NodeId node) {
     for (unsigned c = 0; c < classes_; ++c) {
       if (is_local(m) && relays_ && thread_of(m) != thread_of(node)) {
         cut_queues_.emplace_back("relayed " + link_name(node, m, c), options_.buffer_capacity);
-        relays_->add(thread_of(node), thread_of(m), cut_queues_.back().reader(),
-                     link_in_[m][back * classes_ + c].writer());
+        const std::size_t link = relays_->add(thread_of(node), thread_of(m), cut_queues_.back().reader(),
+                                              link_in_[m][back * classes_ + c].writer());
+        relayed_inputs_.push_back(RelayedInput{link, m, back * classes_ + c});
         ends.outputs.push_back(cut_queues_.back().writer());
         continue;
       }
@@ -113,8 +114,9 @@ void Network::wire_node(csp::Runtime& runtime, NodeId node) {
 }
 
 // Every link queue between two routers of this process and thread, by the
-// numbering of wire_node.
+// numbering of wire_node, and every relayed link's delivery.
 void Network::forward_in_place() {
+  for (const RelayedInput& r : relayed_inputs_) relays_->deliver_in_place(r.link, *routers_[r.node], r.input);
   for (NodeId node = 0; node < topology_.size(); ++node) {
     if (!is_local(node)) continue;
     const auto neighbours = topology_.neighbours(node);

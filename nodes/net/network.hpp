@@ -143,6 +143,12 @@ class Network {
   // exactly one process and read only after run().
   std::vector<std::unique_ptr<RouterCounters>> router_counters_;
   std::vector<std::shared_ptr<Router>> routers_;  // per node; null for a node of another process
+  struct RelayedInput {
+    std::size_t link;   // the relays' link
+    NodeId node;        // whose router it feeds
+    std::size_t input;  // by that router's input
+  };
+  std::vector<RelayedInput> relayed_inputs_;
   std::atomic<std::uint64_t> routes_to_trace_;  // RouterConfig::routes_to_trace
   std::array<bool, 256> kinds_to_trace_{};      // RouterConfig::kinds_to_trace, from trace_kinds
 };

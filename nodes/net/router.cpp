@@ -80,6 +80,16 @@ bool Router::inject_in_place(Packet& packet) {
   return true;
 }
 
+bool Router::take_in_place(std::size_t input, Packet& packet) {
+  std::size_t queue = 0;
+  if (input >= ends_.inputs.size() || !takes_at_once(input, packet, queue)) return false;
+  arrive(packet);
+  ++counters_.in_place;
+  if (!try_send(queue, packet))
+    throw std::logic_error("router " + std::to_string(self_) + ": an output with room refused a packet");
+  return true;
+}
+
 void Router::receive(std::size_t source, Packet& packet) {
   if (source >= ends_.inputs.size())
     accept_injection(packet);

@@ -95,6 +95,9 @@ class Router {
   // output has room; false, the packet untouched, otherwise (write it to
   // the injection channel then).
   bool inject_in_place(Packet& packet);
+  // The same for a packet arriving on link input `input`, from a process
+  // of this router's thread that is that input's only writer (a relay).
+  bool take_in_place(std::size_t input, Packet& packet);
 
  private:
   struct Pending {

@@ -1,6 +1,8 @@
 // ThreadRelays: the rings, and the relay process of each thread.
 #include "nodes/net/thread_relay.hpp"
 
+#include "nodes/net/router.hpp"
+
 #include <algorithm>
 #include <optional>
 #include <stdexcept>
@@ -14,6 +16,13 @@ struct ThreadRelays::Link {
   unsigned to_thread = 0;
   csp::In<Packet> queue;
   csp::Out<Packet> into;
+  Router* router = nullptr;  // the router `into` feeds, when its step may be taken in place
+  std::size_t input = 0;     // into's input number at that router
+
+  // Delivers the packet (true) or leaves it untouched (false: no room).
+  bool deliver(Packet& packet) {
+    return (router && router->take_in_place(input, packet)) || into.try_write(packet);
+  }
 };
 
 // One producer (the relay of the ring's first thread), one consumer (that
@@ -201,7 +210,7 @@ class ThreadRelays::Relay {
         }
         Incoming& i = incoming_[in_index_[e.link]];
         ++relays_.counters_[thread_].packets_received;
-        if (i.staged.empty() && relays_.links_[i.link].into.try_write(e.packet)) {
+        if (i.staged.empty() && relays_.links_[i.link].deliver(e.packet)) {
           ++i.owed;
           return;
         }
@@ -229,7 +238,7 @@ class ThreadRelays::Relay {
   // Staged packets of one incoming link, while its input has room.
   void deliver(Incoming& i) {
     Link& l = relays_.links_[i.link];
-    while (!i.staged.empty() && l.into.try_write(i.staged.front())) {
+    while (!i.staged.empty() && l.deliver(i.staged.front())) {
       i.staged.pop_front();
       ++i.owed;
     }
@@ -281,10 +290,18 @@ ThreadRelays::~ThreadRelays() = default;
 
 std::size_t ThreadRelays::links() const { return links_.size(); }
 
-void ThreadRelays::add(unsigned from_thread, unsigned to_thread, csp::In<Packet> queue, csp::Out<Packet> into) {
+std::size_t ThreadRelays::add(unsigned from_thread, unsigned to_thread, csp::In<Packet> queue,
+                              csp::Out<Packet> into) {
   if (from_thread == to_thread || from_thread >= threads_ || to_thread >= threads_)
     throw std::invalid_argument("thread relay: a relayed link joins two different threads of the runtime");
   links_.push_back(Link{from_thread, to_thread, std::move(queue), std::move(into)});
+  return links_.size() - 1;
+}
+
+void ThreadRelays::deliver_in_place(std::size_t link, Router& router, std::size_t input) {
+  Link& l = links_.at(link);
+  l.router = &router;
+  l.input = input;
 }
 
 // A ring from a to b carries the packets of links a→b (at most K each, by

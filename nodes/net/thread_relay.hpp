@@ -25,6 +25,8 @@
 
 namespace nodes {
 
+class Router;
+
 // What one thread's relay carried; read after the run.
 struct RelayCounters {
   std::uint64_t packets_sent = 0;      // packets this thread's relay put in rings
@@ -43,7 +45,12 @@ class ThreadRelays {
   // Before spawn(): a link's output queue at its sending router (read by
   // the relay of from_thread) and its input at its receiving router
   // (written by the relay of to_thread); the threads differ.
-  void add(unsigned from_thread, unsigned to_thread, csp::In<Packet> queue, csp::Out<Packet> into);
+  // Returns the link's index.
+  std::size_t add(unsigned from_thread, unsigned to_thread, csp::In<Packet> queue, csp::Out<Packet> into);
+  // Before spawn(): `into` of link `link` is input `input` of `router`, whose
+  // step the receiving relay then takes in place when the router could
+  // take the packet at once (router.hpp), rather than write it into `into`.
+  void deliver_in_place(std::size_t link, Router& router, std::size_t input);
   std::size_t links() const;
   // One relay process per thread that has links; under a FifoScheduler only.
   void spawn(csp::Runtime& runtime);
