@@ -1,19 +1,15 @@
-// A processor's share of the scene database: its own pages (the pages it
-// owns) and an LRU cache of copies of remote pages. No fibers here; the
-// blocking part of the shared virtual memory is in svm.hpp. Pages are
-// read-only while rendering, so a cached copy never goes stale: a page is
-// fetched at most once per residence in the cache, and never invalidated.
-// Invariants:
+// A processor's share of the scene database: its own pages and an LRU
+// cache of remote pages (the blocking part of the shared virtual memory is
+// in svm.hpp). Pages are read-only while rendering, so a cached page never
+// goes stale and is never invalidated. Invariants:
 //  - entry_[p] says where page p lives on this node, in one array load:
 //    >= 0 own page (its index among the own pages, which lie end to end in
 //    one block), -1 not here, <= -2 cache slot (-2 - entry).
 //  - the occupied slots form one list by use, most recent first: a hit and
 //    an install (evicting from the back) take O(1).
 //  - a slot named in install()'s `in_use` is never evicted; resident bytes
-//    = own pages + occupied slots, at most capacity. A slot holds a copy
-//    (its buffer allocated on first use) or, for a page that another node
-//    of this process owns, refers to the owner's page, which nothing
-//    writes while the machine runs (Holding).
+//    = own pages + occupied slots, at most capacity. A slot holds a copy,
+//    or refers to a page another node of this process owns (Holding).
 // A node's workers are fibers on one OS thread and run one at a time, and no
 // member function suspends, so no lock is needed.
 #pragma once

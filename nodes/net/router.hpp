@@ -1,7 +1,6 @@
 // The router of one processor: store-and-forward switching by the topology's
 // deadlock-free routing function (docs/architecture.md, "Why the network
-// cannot deadlock", gives the argument).
-//
+// cannot deadlock", gives the argument, and "Router steps in place").
 // Ends: inputs[p * classes + c] (link port p, buffer class c), injections
 // from the node's processes, outputs (bounded, capacity K): the link queues
 // numbered as the inputs, then one delivery queue per local port.
@@ -9,13 +8,11 @@
 // output a held-back packet waits for, a room guard. A packet goes out with
 // try_write at once, or waits in its input's pending slot (that input off,
 // the output's room guard on); held-back packets are admitted in rotation.
-// So each (link, class) owns at most K queued + 1 pending packets.
-// In place: a packet that a router on the same thread could read and send
-// on at once (nothing ahead of it on that input, room in its output) is
-// routed by the sender through that router's step, with the same counts.
-// Consumption assumption: a delivery queue drains while its reader reads,
-// so a process that both receives and sends reads its port in a fiber of
-// its own (or never blocks on injection while packets for it may wait).
+// So each (link, class) owns at most K queued + 1 pending packets. A writer
+// on the router's thread takes the router's step in place when the router
+// would send the packet straight on. Consumption assumption: a delivery
+// queue drains while its reader reads (a process that receives and sends
+// reads its port in a fiber of its own).
 #pragma once
 
 #include <array>
