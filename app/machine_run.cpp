@@ -86,7 +86,7 @@ std::string with_hint(const nodes::ResourceError& error, const std::string& fewe
 
 nodes::MachineOptions machine_options(const Options& o) {
   nodes::MachineOptions machine = o.machine;
-  if (machine.threads == 0) machine.threads = usable_cpus();  // affinity and CPU quota, not the machine's cores
+  if (machine.threads == 0 && machine.cpus == 0) machine.cpus = usable_cpus();  // affinity and CPU quota
   machine.trace = {.max_depth = o.max_depth,
                    .spd_procedure = o.spd_procedure,
                    .shadow_rays_to_all_lights = o.shadow_rays_all};

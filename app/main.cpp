@@ -169,8 +169,11 @@ int rank_main(int argc, char** argv, const vmpi::MpiSession& mpi) {
     return 2;
   }
   if (options.action != app::Options::Action::render) return host ? print_help_or_version(options) : 0;
-  options.machine.threads = app::threads_per_rank(options.machine.threads, mpi.ranks_on_this_host());
-  options.machine.shared_cores = app::cores_shared(options.machine.threads, mpi.ranks_on_this_host());
+  // --threads 0: the rank's share of the CPUs, then nodes::thread_count's choice.
+  if (options.machine.threads == 0)
+    options.machine.cpus = app::threads_per_rank(0, mpi.ranks_on_this_host());
+  const unsigned at_most = options.machine.threads ? options.machine.threads : options.machine.cpus;
+  options.machine.shared_cores = app::cores_shared(at_most, mpi.ranks_on_this_host());
   try {
     vmpi::MpiTransport transport;
     if (host) return run(options, std::vector<std::string>(argv, argv + argc), &transport);

@@ -244,11 +244,11 @@ std::uint64_t link_queues(const topology::Topology& t) {
   return ports * t.buffer_classes();
 }
 
-// The threads a run of `nodes` nodes gets: --threads, or the CPUs this
-// process may use, at most one a node (nodes::thread_count).
-unsigned run_threads(const nodes::MachineOptions& m, std::size_t nodes) {
-  const unsigned wanted = m.threads ? m.threads : usable_cpus();
-  return static_cast<unsigned>(std::min<std::size_t>(std::max(1u, wanted), std::max<std::size_t>(nodes, 1)));
+// The threads a run of `nodes` nodes gets (nodes::thread_count), with the
+// CPUs this process may use.
+unsigned run_threads(nodes::MachineOptions m, std::size_t nodes) {
+  if (m.threads == 0 && m.cpus == 0) m.cpus = usable_cpus();
+  return nodes::thread_count(m, nodes);
 }
 
 // Link queues whose ends run on different threads, nodes placed in blocks

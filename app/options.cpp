@@ -71,8 +71,9 @@ po::options_description describe_machine(Options& o, Raw& raw) {
        ("processors, at most " + std::to_string(topology::max_nodes) + " (default 16, or the full spec's)").c_str())
       ("threads", po::value(&raw.threads)->default_value(0),
        "OS threads carrying the processors, 0..4096 (0: the CPUs this process may use, by its affinity and CPU "
-       "quota; at most --nodes); with --single, threads tracing rows (at most the image's rows); the database "
-       "is built on as many")
+       "quota, but at most one thread for every two pixel computers, --nodes x --workers-per-node, so that a "
+       "processor waiting for a page leaves its thread another to run; never more than --nodes); with "
+       "--single, threads tracing rows (at most the image's rows); the database is built on as many")
       ("cache-pages", po::value(&raw.cache_pages),
        "remote pages cached per node (default: 1/8 of the database, at least 64 pages)")
       ("cache-kb", po::value(&raw.cache_kb), "the cache per node in KB instead of pages");

@@ -76,11 +76,6 @@ void check_fields(const MachineOptions& options) {
                                       std::to_string(options.buffer_capacity) + " packets)");
 }
 
-unsigned thread_count(const MachineOptions& options, std::size_t nodes) {
-  const unsigned wanted = options.threads ? options.threads : std::max(1u, std::thread::hardware_concurrency());
-  return static_cast<unsigned>(std::min<std::size_t>(wanted, nodes));
-}
-
 // Moves each page from the host's database into its owner's memory.
 std::vector<std::unique_ptr<NodeState>> distribute(tracer::Database& db, const PagePlacement& placement,
                                                    std::uint32_t cache_pages) {
@@ -288,6 +283,15 @@ double imbalance(const std::vector<double>& values) {
 }
 
 }  // namespace
+
+unsigned thread_count(const MachineOptions& options, std::size_t nodes) {
+  nodes = std::max<std::size_t>(nodes, 1);
+  if (options.threads) return static_cast<unsigned>(std::min<std::size_t>(options.threads, nodes));
+  const std::size_t cpus = options.cpus ? options.cpus : std::max(1u, std::thread::hardware_concurrency());
+  const std::size_t workers = static_cast<std::size_t>(std::max(options.workers_per_node, 1));
+  const std::size_t by_workers = std::max<std::size_t>(nodes * workers / min_pixel_computers_per_thread, 1);
+  return static_cast<unsigned>(std::min({cpus, by_workers, nodes}));
+}
 
 std::uint32_t default_cache_pages(const tracer::DatabaseHeader& header) {
   constexpr std::uint32_t share = 8, floor_pages = 64;

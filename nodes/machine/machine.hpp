@@ -45,7 +45,8 @@ namespace nodes {
 struct MachineOptions {
   std::string topology = "hypercube";  // a kind, or a full spec such as "hypercube:4"
   std::optional<std::size_t> nodes = 16;  // with a bare kind; must agree with a full spec
-  unsigned threads = 0;                // 0: hardware cores; never more than the nodes
+  unsigned threads = 0;                // 0: thread_count()'s choice; never more than the nodes
+  unsigned cpus = 0;                   // the CPUs threads = 0 may use; 0: the host's
   bool relay_between_threads = true;   // links between threads through relays (NetworkOptions)
   bool forward_in_place = true;        // routers of one thread route in place (NetworkOptions); real time only
   bool shared_cores = false;           // other processes share the cores (csp::RuntimeOptions::shared_cores)
@@ -75,6 +76,14 @@ struct MachineOptions {
   std::optional<std::uint64_t> schedule_seed;
   Progress progress;                   // called by the collector (on its thread): at 0 as it starts, then per result
 };
+
+// The OS threads that carry `nodes` nodes of a run: `threads` when given,
+// else the CPUs, but no more than one thread for every
+// min_pixel_computers_per_thread pixel computers (nodes x workers), so that
+// a pixel computer waiting for a page leaves its thread another to run;
+// never more than the nodes.
+constexpr std::size_t min_pixel_computers_per_thread = 2;
+unsigned thread_count(const MachineOptions& options, std::size_t nodes);
 
 // The bounds check_options() holds the fields to: a tile of at most a
 // million pixels, and at most 64 pixel computers on one node (each is a

@@ -101,6 +101,10 @@ TEST(MemoryEstimate, CountsTheLinksBetweenThreads) {
   EXPECT_EQ(app::machine_memory(parse_words("--topology complete:4 --threads 64"), 661).threads, 4u);
   EXPECT_EQ(app::machine_memory(parse_words("--topology complete:4 --threads 2 --timing virtual"), 661)
                 .relayed_link_queues, 0u);
+  // --threads 0 counts the threads the run will take (nodes::thread_count):
+  // here one, since two nodes leave no second pixel computer for a thread.
+  EXPECT_EQ(app::machine_memory(parse_words("--topology complete:2"), 661).threads, 1u);
+  EXPECT_EQ(app::machine_memory(parse_words("--topology complete:2"), 661).relayed_link_queues, 0u);
 }
 
 TEST(MemoryEstimate, CountsTheReplaysRecordingAtItsBound) {

@@ -426,6 +426,37 @@ TEST(Machine, DefaultCacheIsAnEighthOfTheDatabaseButNeverTooSmallForARay) {
   }
 }
 
+// --threads 0 takes the CPUs, but leaves each thread two pixel computers,
+// so that one waiting for a page does not idle its thread; a number given
+// is taken as it is, at most one thread a node.
+TEST(Machine, DefaultThreadsLeaveEachThreadTwoPixelComputers) {
+  MachineOptions o;
+  o.cpus = 16;
+  EXPECT_EQ(nodes::thread_count(o, 16), 8u);
+  EXPECT_EQ(nodes::thread_count(o, 64), 16u);
+  EXPECT_EQ(nodes::thread_count(o, 256), 16u);
+  EXPECT_EQ(nodes::thread_count(o, 5), 2u);
+  EXPECT_EQ(nodes::thread_count(o, 2), 1u);
+  EXPECT_EQ(nodes::thread_count(o, 1), 1u);
+  o.workers_per_node = 4;
+  EXPECT_EQ(nodes::thread_count(o, 16), 16u);
+  EXPECT_EQ(nodes::thread_count(o, 2), 2u);
+  o.cpus = 2;
+  o.workers_per_node = 1;
+  EXPECT_EQ(nodes::thread_count(o, 16), 2u);
+  EXPECT_EQ(nodes::thread_count(o, 3), 1u);
+  o.threads = 16;
+  o.cpus = 0;
+  EXPECT_EQ(nodes::thread_count(o, 16), 16u);
+  EXPECT_EQ(nodes::thread_count(o, 4), 4u);
+
+  // And a run takes what the rule says.
+  MachineOptions run;
+  run.nodes = 4;
+  run.cpus = 4;
+  EXPECT_EQ(nodes::run_machine(make_db("balls:1", 1024, 16), run).report.threads, 2u);
+}
+
 TEST(Machine, PageCommunicationsEqualMissesWithSharedCaches) {
   const auto result = run_case({"mesh", 9, 2, 256, 2, Schedule::dynamic, 3, 1});
   EXPECT_EQ(result.report.served().pages_served, result.report.svm().misses);
