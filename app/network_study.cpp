@@ -8,6 +8,7 @@
 #include <cmath>
 #include <iomanip>
 #include <iostream>
+#include <limits>
 #include <mutex>
 #include <sstream>
 #include <stdexcept>
@@ -22,6 +23,8 @@
 #include "app/output_files.hpp"
 #include "app/progress.hpp"
 #include "app/report.hpp"
+#include "app/scene_input.hpp"
+#include "nodes/machine/recorder.hpp"
 #include "app/timing_options.hpp"
 #include "app/viz/machine.hpp"
 #include "app/viz/plot.hpp"
@@ -45,7 +48,8 @@ std::vector<std::string> split(const std::string& text) {
 struct RawNetwork {
   std::string topologies = "hypercube:6,torus:8x8,mesh:8x8,ring:64,complete:64", patterns = "uniform",
               loads = "0.1,0.2,0.3,0.4,0.5,0.6,0.7,0.8,0.9,1,1.1,1.2", out = "network";
-  std::int64_t payload = 64, buffers = 4, jobs = 0, seed = 1;
+  std::string scene = "rings4";
+  std::int64_t payload = 64, buffers = 4, jobs = 0, seed = 1, scene_size = 64;
   double hotspot = 0.2, links_at = 0.5;
   TimingChoice model;
 };
@@ -59,7 +63,7 @@ po::options_description describe(NetworkStudyOptions& o, RawNetwork& raw) {
        "full specs, comma-separated (default hypercube:6,torus:8x8,mesh:8x8,ring:64,complete:64)")
       ("pattern", po::value(&raw.patterns),
        "traffic patterns, comma-separated (default uniform): uniform, transpose, bit-complement, bit-reversal, "
-       "shuffle, tornado, neighbour, hotspot (see below)")
+       "shuffle, tornado, neighbour, hotspot, render (see below)")
       ("loads", po::value(&raw.loads),
        "offered loads as fractions of each topology's channel-load bound, comma-separated, increasing (default "
        "0.1,0.2,...,1.2)")
@@ -67,6 +71,10 @@ po::options_description describe(NetworkStudyOptions& o, RawNetwork& raw) {
       ("buffers", po::value(&raw.buffers), "packets per link queue, 1..64 (default 4)")
       ("hotspot", po::value(&raw.hotspot), "hotspot: the share of packets sent to node 0, above 0 and below 1 (default 0.2)")
       ("seed", po::value(&raw.seed), "seed of the packets' times and destinations (default 1)")
+      ("scene", po::value(&raw.scene),
+       "render: the scene whose render's packets each topology is offered, a built-in or an NFF file "
+       "(default rings4)")
+      ("scene-size", po::value(&raw.scene_size), "render: its image's pixels a side, 1..1024 (default 64)")
       ("links-at", po::value(&raw.links_at),
        "draw each topology's links by their traffic at the load of --loads nearest this one, under the first "
        "pattern (default 0.5)");
@@ -139,6 +147,15 @@ void check_network(NetworkStudyOptions& o, const RawNetwork& raw) {
   o.study.payload_bytes = whole_in<std::size_t>(raw.payload, 1, 1 << 20, "--payload");
   o.study.buffer_capacity = whole_in<std::size_t>(raw.buffers, 1, 64, "--buffers");
   o.study.seed = whole_in<std::uint32_t>(raw.seed, 0, UINT32_MAX, "--seed");
+  o.scene = raw.scene;
+  o.scene_size = whole_in<int>(raw.scene_size, 1, 1024, "--scene-size");
+  if (std::count(o.patterns.begin(), o.patterns.end(), nodes::TrafficPattern::recorded) > 0) {
+    Options render;  // read now, so that a bad scene is refused before any run
+    render.scene = o.scene;
+    render.quiet = true;
+    render.width = render.height = o.scene_size;
+    o.render_scene = std::make_shared<const tracer::Scene>(load_scene(render));
+  }
   if (!(raw.hotspot > 0 && raw.hotspot < 1)) throw UsageError("--hotspot: expected a share above 0 and below 1");
   o.study.hotspot_fraction = raw.hotspot;
   if (!(raw.links_at > 0) || !std::isfinite(raw.links_at))
@@ -240,18 +257,30 @@ double pattern_distance(const topology::Topology& t, nodes::TrafficPattern p) {
   return senders ? sum / static_cast<double>(senders) : 0;
 }
 
-// Every point of every curve, with its bound and zero-load latency, not run.
-void plan_points(const NetworkStudyOptions& o, NetworkTable& table) {
+// Every point of every curve, with its bound and zero-load latency, not run;
+// the render pattern's traffic recorded once a topology.
+void plan_points(const NetworkStudyOptions& o, NetworkTable& table, std::ostream* progress) {
   const double message = nodes::zero_load_latency(o.study.link, o.study.payload_bytes, 0);
   for (const std::string& spec : o.topologies) {
     const topology::Topology t = topology::parse_topology(spec);
     table.costs.push_back(topology_cost(t));
     for (const nodes::TrafficPattern p : o.patterns) {
-      const double bound = 1.0 / (message * nodes::max_channel_load(t, p, o.study.hotspot_fraction));
+      std::shared_ptr<const nodes::RecordedTraffic> recorded;
+      double load_at_one = 0, zero_load = 0;
+      if (p == nodes::TrafficPattern::recorded) {
+        if (progress) *progress << "network: recording a render of " << o.scene << " on " << t.spec() << "\n";
+        recorded = std::make_shared<const nodes::RecordedTraffic>(record_render_traffic(o, t));
+        load_at_one = nodes::recorded_channel_load(t, *recorded, o.study.link, o.study.payload_bytes);
+        zero_load = nodes::recorded_zero_load_latency(t, *recorded, o.study.link);
+      } else {
+        load_at_one = nodes::max_channel_load(t, p, o.study.hotspot_fraction);
+        zero_load = (pattern_distance(t, p) + 1) * message;
+      }
+      const double bound = 1.0 / (message * load_at_one);
       for (const double load : o.loads)
         table.points.push_back({.topology = t.spec(), .pattern = p, .load = load, .bound = bound,
-                                .zero_load = (pattern_distance(t, p) + 1) * message, .saturated = false,
-                                .result = {}, .wall_seconds = 0});
+                                .zero_load = zero_load, .recorded = recorded, .saturated = false, .result = {},
+                                .wall_seconds = 0});
     }
   }
 }
@@ -267,7 +296,9 @@ void run_points(const NetworkStudyOptions& o, std::vector<NetworkPoint>& points,
       NetworkPoint& p = points[i];
       try {
         const auto start = std::chrono::steady_clock::now();
-        p.result = nodes::run_load(topology::parse_topology(p.topology), p.pattern, p.load * p.bound, o.study);
+        nodes::LoadStudyOptions study = o.study;
+        study.recorded = p.recorded;
+        p.result = nodes::run_load(topology::parse_topology(p.topology), p.pattern, p.load * p.bound, study);
         p.wall_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
         p.saturated = p.result.accepted < 0.95 * p.result.offered || p.result.mean_latency > 10 * p.zero_load;
       } catch (...) {
@@ -289,10 +320,29 @@ void run_points(const NetworkStudyOptions& o, std::vector<NetworkPoint>& points,
 
 }  // namespace
 
+nodes::RecordedTraffic record_render_traffic(const NetworkStudyOptions& o, const topology::Topology& t) {
+  if (!o.render_scene) throw std::logic_error("record_render_traffic: no scene read");
+  Options render;
+  render.width = render.height = o.scene_size;
+  nodes::MachineOptions m;
+  m.topology = t.spec();
+  m.nodes = t.size();
+  m.threads = 1;
+  m.timing = o.model;
+  m.record = true;
+  m.record_packets = std::numeric_limits<std::uint64_t>::max();
+  const nodes::MachineResult r = nodes::run_machine(tracer::build_database(*o.render_scene, build_options(render)), m);
+  nodes::RecordedTraffic traffic;
+  traffic.by_source.resize(t.size());
+  for (const nodes::PacketTrace& p : r.report.recording->packets)  // by injection time: each source's in its order
+    if (p.hops() > 0) traffic.by_source[p.route.front()].push_back({p.route.back(), p.bytes});
+  return traffic;
+}
+
 NetworkTable run_network_study(const NetworkStudyOptions& o, std::ostream* progress) {
   NetworkTable table;
   table.options = o;
-  plan_points(o, table);
+  plan_points(o, table, progress);
   run_points(o, table.points, progress);
   return table;
 }
@@ -341,8 +391,14 @@ std::string network_json(const NetworkTable& t) {
                       {"virtual_end_s", r.end_seconds},
                       {"wall_s", p.wall_seconds}});
   }
+  Json recorded = Json::object();  // the render pattern's packets a topology
+  for (const NetworkPoint& p : t.points)
+    if (p.recorded) recorded[p.topology] = p.recorded->packets();
   const Json j = {{"schema_version", network_schema_version},
                   {"command_line", t.command_line},
+                  {"render", {{"scene", t.options.scene},
+                              {"pixels_a_side", t.options.scene_size},
+                              {"recorded_packets", recorded}}},
                   {"payload_bytes", t.options.study.payload_bytes},
                   {"buffer_packets", t.options.study.buffer_capacity},
                   {"hotspot_share", t.options.study.hotspot_fraction},

@@ -12,6 +12,7 @@
 #pragma once
 
 #include <filesystem>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -19,6 +20,7 @@
 #include "nodes/machine/timing.hpp"
 #include "nodes/net/load_study.hpp"
 #include "topology/topology.hpp"
+#include "tracer/scene.hpp"
 
 namespace app {
 
@@ -28,6 +30,9 @@ struct NetworkStudyOptions {
   std::vector<double> loads{0.1, 0.2, 0.3, 0.4, 0.5, 0.6, 0.7, 0.8, 0.9, 1.0, 1.1, 1.2};
   nodes::CostModel model = nodes::ipsc2_profile();  // its hop and bandwidth make the link model
   nodes::LoadStudyOptions study;                    // payload, buffers, hotspot share, seed
+  std::string scene = "rings4";  // the render pattern's scene: a built-in or an NFF file
+  int scene_size = 64;           // its image, pixels a side
+  std::shared_ptr<const tracer::Scene> render_scene;  // scene, read when render is among the patterns
   double links_at = 0.5;  // the load whose link traffic each topology's picture shows (the nearest run)
   std::filesystem::path out_dir = "network";
   unsigned jobs = 1;
@@ -53,6 +58,7 @@ struct NetworkPoint {
   double load = 0;            // fraction of the bound
   double bound = 0;           // packets per node per second at load 1
   double zero_load = 0;       // seconds: the pattern's mean distance at zero load
+  std::shared_ptr<const nodes::RecordedTraffic> recorded;  // the render pattern's packets on this topology
   bool saturated = false;     // accepted under 95% of offered, or mean latency over 10x zero-load
   nodes::LoadResult result;
   double wall_seconds = 0;
@@ -73,6 +79,10 @@ OptionGroup network_option_group();
 std::string network_summary();
 
 NetworkTable run_network_study(const NetworkStudyOptions& options, std::ostream* progress);
+// The packets of a render of options.scene on `t`, in virtual time under
+// options.model, by source in the order each node sent them (a node's
+// messages to itself, which cross no link, left out).
+nodes::RecordedTraffic record_render_traffic(const NetworkStudyOptions& options, const topology::Topology& t);
 std::string network_csv(const NetworkTable& table);
 std::string network_json(const NetworkTable& table);
 

@@ -69,7 +69,8 @@ NodeId fixed_destination(TrafficPattern pattern, const Topology& t, NodeId n) {
       return each_digit(t, n, [](unsigned d, unsigned k) { return (d + (k + 1) / 2 - 1) % k; });
     case TrafficPattern::neighbour: return each_digit(t, n, [](unsigned d, unsigned k) { return (d + 1) % k; });
     case TrafficPattern::uniform:
-    case TrafficPattern::hotspot: break;
+    case TrafficPattern::hotspot:
+    case TrafficPattern::recorded: break;
   }
   return n;
 }
@@ -121,7 +122,8 @@ const std::vector<TrafficPattern>& traffic_patterns() {
   static const std::vector<TrafficPattern> all{TrafficPattern::uniform,      TrafficPattern::transpose,
                                                TrafficPattern::bit_complement, TrafficPattern::bit_reversal,
                                                TrafficPattern::shuffle,      TrafficPattern::tornado,
-                                               TrafficPattern::neighbour,    TrafficPattern::hotspot};
+                                               TrafficPattern::neighbour,    TrafficPattern::hotspot,
+                                               TrafficPattern::recorded};
   return all;
 }
 
@@ -135,6 +137,7 @@ const char* pattern_name(TrafficPattern pattern) {
     case TrafficPattern::tornado: return "tornado";
     case TrafficPattern::neighbour: return "neighbour";
     case TrafficPattern::hotspot: return "hotspot";
+    case TrafficPattern::recorded: return "render";
   }
   return "?";
 }
@@ -157,7 +160,9 @@ std::string pattern_descriptions() {
          "tornado: each digit d of radix k to d + ceil(k/2) - 1 mod k (digits: the grid's x and y, the "
          "ring's or complete graph's index; not on a hypercube, whose digits are bits)\n"
          "neighbour: each digit d of radix k to d + 1 mod k (on a hypercube, every bit)\n"
-         "hotspot: a share of the packets (--hotspot) to node 0, the rest uniform\n";
+         "hotspot: a share of the packets (--hotspot) to node 0, the rest uniform\n"
+         "render: the packets of a render of --scene on the topology (page requests and replies, work and "
+         "results), each node sending its own in their order, at its share of the load, each of its size\n";
 }
 
 std::string pattern_unfit(TrafficPattern pattern, const Topology& t) {
@@ -177,13 +182,15 @@ std::string pattern_unfit(TrafficPattern pattern, const Topology& t) {
       break;
     case TrafficPattern::uniform:
     case TrafficPattern::neighbour:
-    case TrafficPattern::hotspot: break;
+    case TrafficPattern::hotspot:
+    case TrafficPattern::recorded: break;
   }
   return "";
 }
 
 std::vector<NodeId> fixed_destinations(TrafficPattern pattern, const Topology& t) {
-  if (pattern == TrafficPattern::uniform || pattern == TrafficPattern::hotspot) return {};
+  if (pattern == TrafficPattern::uniform || pattern == TrafficPattern::hotspot || pattern == TrafficPattern::recorded)
+    return {};
   std::vector<NodeId> to(t.size());
   for (NodeId n = 0; n < t.size(); ++n) to[n] = fixed_destination(pattern, t, n);
   return to;
@@ -191,6 +198,8 @@ std::vector<NodeId> fixed_destinations(TrafficPattern pattern, const Topology& t
 
 double max_channel_load(const Topology& t, TrafficPattern pattern, double hotspot_fraction) {
   if (const std::string why = pattern_unfit(pattern, t); !why.empty()) throw std::invalid_argument(why);
+  if (pattern == TrafficPattern::recorded)
+    throw std::invalid_argument("render traffic's channel load depends on its recording (recorded_channel_load)");
   std::map<LinkKey, double> load;
   const auto n = static_cast<NodeId>(t.size());
   const std::vector<NodeId> fixed = fixed_destinations(pattern, t);
@@ -209,6 +218,57 @@ double max_channel_load(const Topology& t, TrafficPattern pattern, double hotspo
   return most;
 }
 
+std::uint64_t RecordedTraffic::packets() const {
+  std::uint64_t n = 0;
+  for (const auto& sent : by_source) n += sent.size();
+  return n;
+}
+
+namespace {
+
+void check_recorded(const Topology& t, const RecordedTraffic& traffic) {
+  if (traffic.by_source.size() != t.size())
+    throw std::invalid_argument("render traffic recorded on " + std::to_string(traffic.by_source.size()) +
+                                " nodes cannot be offered to " + t.spec() + " (" + std::to_string(t.size()) +
+                                " nodes)");
+  if (traffic.packets() == 0) throw std::invalid_argument("render traffic: the recording holds no packet");
+  for (NodeId s = 0; s < t.size(); ++s)
+    for (const RecordedPacket& p : traffic.by_source[s])
+      if (p.destination == s || p.destination >= t.size())
+        throw std::invalid_argument("render traffic: node " + std::to_string(s) + " sends to node " +
+                                    std::to_string(p.destination) + " on " + t.spec());
+}
+
+double message_seconds(const LinkModel& link, std::size_t bytes) {
+  return std::chrono::duration<double>(link.delay(bytes)).count();
+}
+
+}  // namespace
+
+double recorded_channel_load(const Topology& t, const RecordedTraffic& traffic, const LinkModel& link,
+                             std::size_t payload_bytes) {
+  check_recorded(t, traffic);
+  // A node offers rate n |sent| / total; each of its packets is 1 / |sent| of that.
+  const double per_packet = static_cast<double>(t.size()) / static_cast<double>(traffic.packets());
+  const double unit = message_seconds(link, payload_bytes);
+  std::map<LinkKey, double> load;
+  for (NodeId s = 0; s < t.size(); ++s)
+    for (const RecordedPacket& p : traffic.by_source[s])
+      add_route(t, s, p.destination, per_packet * message_seconds(link, p.bytes) / unit, load);
+  double most = 0;
+  for (const auto& [key, l] : load) most = std::max(most, l);
+  return most;
+}
+
+double recorded_zero_load_latency(const Topology& t, const RecordedTraffic& traffic, const LinkModel& link) {
+  check_recorded(t, traffic);
+  double sum = 0;
+  for (NodeId s = 0; s < t.size(); ++s)
+    for (const RecordedPacket& p : traffic.by_source[s])
+      sum += (t.distance(s, p.destination) + 1) * message_seconds(link, p.bytes);
+  return sum / static_cast<double>(traffic.packets());
+}
+
 double zero_load_latency(const LinkModel& link, std::size_t payload_bytes, unsigned distance) {
   const double message = std::chrono::duration<double>(link.delay(payload_bytes)).count();
   return (distance + 1) * message;
@@ -222,8 +282,9 @@ class LoadRun {
  public:
   LoadRun(const Topology& t, TrafficPattern pattern, double offered, const LoadStudyOptions& options)
       : t_(t), pattern_(pattern), offered_(offered), options_(options), fixed_(fixed_destinations(pattern, t)) {
-    const double base = zero_load_latency(options.link, options.payload_bytes,
-                                          static_cast<unsigned>(std::ceil(t.average_distance())));
+    const double base = recorded() ? recorded_zero_load_latency(t, *options.recorded, options.link)
+                                   : zero_load_latency(options.link, options.payload_bytes,
+                                                       static_cast<unsigned>(std::ceil(t.average_distance())));
     tally_.window_start = options.warmup_seconds > 0 ? options.warmup_seconds : 20 * base;
     window_ = options.window_seconds > 0 ? options.window_seconds : 200 * base;
     tally_.window_end = tally_.window_start + window_;
@@ -255,6 +316,16 @@ class LoadRun {
   }
 
  private:
+  bool recorded() const { return pattern_ == TrafficPattern::recorded; }
+
+  // A node's rate: the offered load, or under recorded traffic its share.
+  double rate_of(NodeId node) const {
+    if (!recorded()) return offered_;
+    const auto& sent = options_.recorded->by_source[node];
+    return offered_ * static_cast<double>(t_.size()) * static_cast<double>(sent.size()) /
+           static_cast<double>(options_.recorded->packets());
+  }
+
   NodeId destination(NodeId node, std::mt19937_64& rng) const {
     if (!fixed_.empty()) return fixed_[node];
     std::uniform_real_distribution<double> share(0.0, 1.0);
@@ -268,11 +339,19 @@ class LoadRun {
   // created at its instant even if a full injection queue holds the source.
   void source(Network& net, NodeId node, csp::Out<Packet>& out) {
     std::mt19937_64 rng(options_.seed * 0x9e3779b97f4a7c15ull + node);
-    std::exponential_distribution<double> gap(offered_);
     Tally& k = tally_;
+    const double rate = rate_of(node);
+    const std::vector<RecordedPacket>* sent = recorded() ? &options_.recorded->by_source[node] : nullptr;
+    if (!(rate > 0)) {  // a node the recording has send nothing
+      if (--k.sources_running == 0 && k.finished()) net.shutdown();
+      return;
+    }
+    std::exponential_distribution<double> gap(rate);
+    std::size_t index = 0;
     for (double next = gap(rng); next <= k.window_end; next += gap(rng)) {
       const double at = seconds_of(virtual_of(next));  // an instant of the virtual clock
-      const NodeId to = destination(node, rng);
+      const RecordedPacket* replayed = sent ? &(*sent)[index++ % sent->size()] : nullptr;
+      const NodeId to = replayed ? replayed->destination : destination(node, rng);
       if (to == node) break;  // a fixed pattern that maps this node to itself: it sends nothing
       if (at > seconds_of(csp::this_process::now()))
         csp::this_process::advance(virtual_of(next) - csp::this_process::now());
@@ -280,7 +359,7 @@ class LoadRun {
       p.destination = to;
       p.kind = kind_traffic;
       p.id = (std::uint64_t{node} << 32) | k.created_at[node].size();
-      p.payload.resize(options_.payload_bytes);
+      p.payload.resize(replayed ? replayed->bytes : options_.payload_bytes);
       // Its wait for a full injection queue counts as time in the network.
       const double held = seconds_of(csp::this_process::now());
       k.integrate_to(held);
@@ -372,6 +451,10 @@ LoadResult run_load(const Topology& t, TrafficPattern pattern, double offered, c
   if (const std::string why = pattern_unfit(pattern, t); !why.empty()) throw std::invalid_argument(why);
   if (!options.link.enabled()) throw std::invalid_argument("a load study needs a link model: a latency or a bandwidth");
   if (!(offered > 0)) throw std::invalid_argument("an offered load must be above 0");
+  if (pattern == TrafficPattern::recorded) {
+    if (!options.recorded) throw std::invalid_argument("render traffic needs its recording");
+    check_recorded(t, *options.recorded);
+  }
   return LoadRun(t, pattern, offered, options).run();
 }
 

@@ -5,13 +5,16 @@
 // would hold them) to delivery. One runtime thread, so a run is
 // deterministic: the same options give the same numbers.
 //
-// Invariants: every packet created is delivered exactly once to its
+// Besides the synthetic patterns, a recorded one: packets with their
+// sources, destinations and sizes, which each source offers in its order
+// (the layer above records them from a render). Invariants: every packet created is delivered exactly once to its
 // destination (counted, never assumed); the run ends when the last packet
 // created is delivered, however far past saturation the load is. Knows
 // nothing of the command line (app/network_study.hpp drives it).
 #pragma once
 
 #include <cstdint>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -23,7 +26,20 @@ namespace nodes {
 
 // Traffic patterns on node ids as digits (the hypercube's bits, the mesh's
 // and torus's coordinates, the ring's and complete graph's index).
-enum class TrafficPattern { uniform, transpose, bit_complement, bit_reversal, shuffle, tornado, neighbour, hotspot };
+// `recorded` ("render") offers LoadStudyOptions::recorded.
+enum class TrafficPattern {
+  uniform, transpose, bit_complement, bit_reversal, shuffle, tornado, neighbour, hotspot, recorded
+};
+
+// Recorded traffic: per source node, its packets in the order it sent them.
+struct RecordedPacket {
+  topology::NodeId destination = 0;
+  std::uint32_t bytes = 0;  // payload
+};
+struct RecordedTraffic {
+  std::vector<std::vector<RecordedPacket>> by_source;  // index = node
+  std::uint64_t packets() const;
+};
 
 // Every pattern, in the order --help lists them.
 const std::vector<TrafficPattern>& traffic_patterns();
@@ -48,6 +64,10 @@ struct LoadStudyOptions {
   double warmup_seconds = 0;            // virtual time before the window (0: 20 zero-load latencies)
   double window_seconds = 0;            // the measurement window (0: 200 zero-load latencies)
   std::uint32_t seed = 1;
+  // The recorded pattern's packets, for a topology of by_source.size()
+  // nodes: each source sends its own in order, cycling, at its share of the
+  // load (so the nodes' mean is the offered load), each packet its size.
+  std::shared_ptr<const RecordedTraffic> recorded;
 };
 
 // The channel load of the busiest link when every node offers one packet
@@ -56,6 +76,14 @@ struct LoadStudyOptions {
 // into each node counted as a link too. A network saturates where the
 // offered load per node reaches link capacity / this.
 double max_channel_load(const topology::Topology& t, TrafficPattern pattern, double hotspot_fraction);
+// The same for recorded traffic, its sizes counted: the busiest link's busy
+// time, in message times of `payload_bytes`, when the nodes offer one packet
+// per second on average, each at its share; and its zero-load latency, the
+// mean over its packets. std::invalid_argument when the recording's node
+// count is not t's or it holds a packet to its own source or beyond t.
+double recorded_channel_load(const topology::Topology& t, const RecordedTraffic& traffic, const LinkModel& link,
+                             std::size_t payload_bytes);
+double recorded_zero_load_latency(const topology::Topology& t, const RecordedTraffic& traffic, const LinkModel& link);
 
 // One point of a curve.
 struct LoadResult {

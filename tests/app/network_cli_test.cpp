@@ -23,7 +23,9 @@ class NetworkCli : public test::ScratchTest {
 TEST_F(NetworkCli, BadInputIsRefusedBeforeAnyRunNamingTheOption) {
   const std::pair<const char*, const char*> refused[] = {
       {"--pattern random", "vmpray network: --pattern: unknown traffic pattern 'random' (known: uniform, transpose, "
-                           "bit-complement, bit-reversal, shuffle, tornado, neighbour, hotspot)"},
+                           "bit-complement, bit-reversal, shuffle, tornado, neighbour, hotspot, render)"},
+      {"--pattern render --scene nosuch", "vmpray network: scene 'nosuch': unknown built-in scene"},
+      {"--pattern render --scene-size 0", "vmpray network: --scene-size: expected 1..1024, got 0"},
       {"--topology mesh:3x4 --pattern bit-reversal",
        "vmpray network: --pattern: bit-reversal traffic needs a power-of-two node count (mesh:3x4 has 12 nodes)"},
       {"--topology hypercube:4 --pattern tornado",
@@ -91,6 +93,38 @@ std::string without_wall_time(const std::string& csv) {
   std::string out;
   for (std::string line; std::getline(lines, line);) out += line.substr(0, line.rfind(',')) + "\n";
   return out;
+}
+
+// The render pattern offers each topology the packets of a render on it:
+// all of them, but node 0's messages to its own farmer and collector, which
+// cross no link (8 on 16 nodes: a work request, work, a result, two stops,
+// the worker's and the server's ends, the server's stop).
+TEST_F(NetworkCli, TheRenderPatternOffersEveryPacketOfTheRender) {
+  const std::string render = "--topology hypercube:4 --width 16 --height 16 --timing virtual -q";
+  ASSERT_EQ(run_vmpray("teapot " + render + " --stats s.json -o t.png").exit_code, 0);
+  const nlohmann::json stats = nlohmann::json::parse(test::read_file(dir_ / "s.json"));
+  const std::uint64_t packets = stats["machine"]["network"]["packets"].get<std::uint64_t>();
+  const std::string study =
+      "network --topology hypercube:4,torus:4x4 --pattern render,uniform --scene teapot --scene-size 16 "
+      "--loads 0.3,1.5 -q";
+  const test::Outcome r = run_vmpray(study + " --jobs 1 --out one");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const nlohmann::json j = nlohmann::json::parse(test::read_file(dir_ / "one" / "network.json"));
+  EXPECT_EQ(j["render"]["scene"], "teapot");
+  EXPECT_EQ(j["render"]["recorded_packets"]["hypercube:4"].get<std::uint64_t>(), packets - 8);
+  EXPECT_GT(j["render"]["recorded_packets"]["torus:4x4"].get<std::uint64_t>(), 1000u);
+  int render_points = 0;
+  for (const auto& p : j["points"]) {
+    if (p["pattern"] != "render") continue;
+    ++render_points;
+    EXPECT_EQ(p["packets"]["delivered"], p["packets"]["created"]) << p;
+    EXPECT_EQ(p["packets"]["misdelivered"], 0) << p;
+    EXPECT_EQ(p["saturated"], p["load"].get<double>() > 1) << p;
+  }
+  EXPECT_EQ(render_points, 4);
+  ASSERT_EQ(run_vmpray(study + " --jobs 2 --out two").exit_code, 0);
+  EXPECT_EQ(without_wall_time(test::read_file(dir_ / "one" / "network.csv")),
+            without_wall_time(test::read_file(dir_ / "two" / "network.csv")));
 }
 
 TEST_F(NetworkCli, TheTablesAreTheSameOnAnyNumberOfJobs) {

@@ -11,6 +11,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <memory>
 #include <string>
 
 #include "topology/spec.hpp"
@@ -136,6 +137,75 @@ TEST(LoadStudy, ChannelLoadsOfKnownCases) {
   // Hotspot: node 0's delivery channel takes the share of every other node, and its uniform part.
   EXPECT_NEAR(nodes::max_channel_load(topology::parse_topology("complete:8"), TrafficPattern::hotspot, 0.5),
               7 * 0.5 + 7 * 0.5 / 7, 1e-12);
+}
+
+// Recorded traffic: node 0 sends to 1 (64 bytes) and to 2 (1024 bytes) in
+// turn on a ring of 4; node 3 sends to 1 (64 bytes); nodes 1 and 2 send nothing.
+nodes::RecordedTraffic small_recording() {
+  nodes::RecordedTraffic r;
+  r.by_source = {{{1, 64}, {2, 1024}}, {}, {}, {{1, 64}}};
+  return r;
+}
+
+TEST(LoadStudy, RecordedTrafficTakesItsDestinationsAndSizesAtZeroLoad) {
+  const topology::Topology ring = topology::parse_topology("ring:4");
+  nodes::LoadStudyOptions o = small_options();
+  o.recorded = std::make_shared<const nodes::RecordedTraffic>(small_recording());
+  const auto seconds = [&o](std::size_t bytes) { return nodes::zero_load_latency(o.link, bytes, 0); };
+  // Its packets, each alike: 0->1 (1 hop) and 3->1 (2 hops) of 64 bytes, 0->2 (2 hops) of 1 KB.
+  const double zero = (2 * seconds(64) + 3 * seconds(1024) + 3 * seconds(64)) / 3;
+  EXPECT_NEAR(nodes::recorded_zero_load_latency(ring, *o.recorded, o.link), zero, 1e-15);
+  o.window_seconds = 2e7 * seconds(1024);
+  const LoadResult r = nodes::run_load(ring, TrafficPattern::recorded, 1e-6 / seconds(1024), o);
+  expect_nothing_lost(r, "recorded");
+  ASSERT_GT(r.measured, 30u);
+  // Node 0 sends two packets for node 3's one, in its order: the latencies
+  // come out in three values, in the recording's proportions.
+  EXPECT_NEAR(r.mean_latency, zero, 0.15 * zero);
+  EXPECT_NEAR(r.max_latency, 3 * seconds(1024), 1e-12);
+  EXPECT_NEAR(r.mean_hops, 5.0 / 3, 0.2);
+}
+
+TEST(LoadStudy, RecordedTrafficBelowSaturationIsAcceptedAndItsBoundCountsSizes) {
+  const topology::Topology ring = topology::parse_topology("ring:4");
+  nodes::LoadStudyOptions o = small_options();
+  const nodes::RecordedTraffic traffic = small_recording();
+  o.recorded = std::make_shared<const nodes::RecordedTraffic>(traffic);
+  // At a mean of one packet a second per node the 4 nodes offer 4: node 0
+  // two thirds of them, half to 2 (1 KB), node 3 a third. Link 0->1 is the
+  // busiest: both of node 0's, and node 3's to 1 (3->0->1, ties go up).
+  // In 64-byte message times: (4/3)(1 + 1024's/64's) + 4/3.
+  const double unit = nodes::zero_load_latency(o.link, 64, 0), big = nodes::zero_load_latency(o.link, 1024, 0);
+  const double load = nodes::recorded_channel_load(ring, traffic, o.link, 64);
+  EXPECT_NEAR(load, 4.0 / 3 * (1 + big / unit) + 4.0 / 3, 1e-12);
+  o.window_seconds = 2000 * big / 0.5;  // some thousands of packets
+  const double offered = 0.5 / (unit * load);
+  const LoadResult r = nodes::run_load(ring, TrafficPattern::recorded, offered, o);
+  expect_nothing_lost(r, "recorded at half its bound");
+  EXPECT_NEAR(r.accepted, offered, 0.02 * offered);
+  EXPECT_NEAR(r.mean_in_flight, r.arrival_rate * r.mean_latency, 0.02 * r.mean_in_flight);
+  // Past the bound nothing is lost either, and the run ends.
+  expect_nothing_lost(nodes::run_load(ring, TrafficPattern::recorded, 3 * offered / 0.5, o), "recorded past");
+}
+
+TEST(LoadStudy, RecordedTrafficMustFitItsTopology) {
+  nodes::LoadStudyOptions o = small_options();
+  o.recorded = std::make_shared<const nodes::RecordedTraffic>(small_recording());
+  EXPECT_THROW(nodes::run_load(topology::parse_topology("ring:8"), TrafficPattern::recorded, 1, o),
+               std::invalid_argument);
+  nodes::RecordedTraffic to_itself;
+  to_itself.by_source = {{{0, 8}}, {}};
+  EXPECT_THROW(nodes::recorded_channel_load(topology::parse_topology("ring:2"), to_itself, o.link, 64),
+               std::invalid_argument);
+  nodes::RecordedTraffic empty;
+  empty.by_source.resize(2);
+  EXPECT_THROW(nodes::recorded_zero_load_latency(topology::parse_topology("ring:2"), empty, o.link),
+               std::invalid_argument);
+  o.recorded.reset();
+  EXPECT_THROW(nodes::run_load(topology::parse_topology("ring:4"), TrafficPattern::recorded, 1, o),
+               std::invalid_argument);
+  EXPECT_THROW(nodes::max_channel_load(topology::parse_topology("ring:4"), TrafficPattern::recorded, 0),
+               std::invalid_argument);
 }
 
 TEST(LoadStudy, PatternsThatDoNotFitAreRefusedByName) {
