@@ -62,9 +62,12 @@ void add_polygon(Flattened& f, const std::vector<Vec3d>& v, const std::vector<Ve
   }
 }
 
-Flattened flatten(const Scene& scene) {
-  Flattened f;
-  for (std::uint32_t i = 0; i < scene.objects.size(); ++i) {
+// Objects flattened in chunks of this many, a chunk on one of the build's
+// threads; the chunks join in order, so the result is the one-thread one.
+constexpr std::size_t objects_per_chunk = 4096;
+
+void flatten_range(const Scene& scene, std::size_t begin, std::size_t end, Flattened& f) {
+  for (auto i = static_cast<std::uint32_t>(begin); i < end; ++i) {
     const Object& o = scene.objects[i];
     PrimRecord r{};
     r.material = o.material;
@@ -88,6 +91,35 @@ Flattened flatten(const Scene& scene) {
     } else if (const auto* pp = std::get_if<Patch>(&o.shape)) {
       add_polygon(f, pp->vertices, &pp->normals, o.material, i);
     }
+  }
+}
+
+Flattened flatten(const Scene& scene, unsigned threads) {
+  const std::size_t n = scene.objects.size();
+  const std::size_t chunks = (n + objects_per_chunk - 1) / objects_per_chunk;
+  Flattened f;
+  if (threads <= 1 || chunks <= 1) {
+    flatten_range(scene, 0, n, f);
+    return f;
+  }
+  std::vector<Flattened> parts(chunks);
+  parallel_pieces(threads, chunks, [&](std::size_t c) {
+    flatten_range(scene, c * objects_per_chunk, std::min(n, (c + 1) * objects_per_chunk), parts[c]);
+  });
+  std::size_t prims = 0, normals = 0;
+  for (const Flattened& p : parts) prims += p.prims.size(), normals += p.normals.size();
+  f.prims.reserve(prims);
+  f.bounds.reserve(prims);
+  f.normals.reserve(normals);
+  for (Flattened& p : parts) {
+    // A smooth triangle's aux indexes the normals, which now follow those of the chunks before.
+    const auto offset = static_cast<std::uint32_t>(f.normals.size());
+    for (PrimRecord& r : p.prims)
+      if (r.kind == PrimKind::smooth_triangle) r.aux += offset;
+    f.prims.insert(f.prims.end(), p.prims.begin(), p.prims.end());
+    f.bounds.insert(f.bounds.end(), p.bounds.begin(), p.bounds.end());
+    f.normals.insert(f.normals.end(), p.normals.begin(), p.normals.end());
+    p = Flattened{};
   }
   return f;
 }
@@ -198,7 +230,7 @@ Database build_database(const Scene& scene, const BuildOptions& opt) {
     throw std::invalid_argument("image size must be at least 1x1");
   Database db;
   auto t0 = Clock::now();
-  Flattened f = flatten(scene);
+  Flattened f = flatten(scene, opt.threads);
   if (f.prims.size() >= std::numeric_limits<std::uint32_t>::max())
     throw DatabaseError("scene too large: more than 2^32 primitives");
   fill_header(db.header, scene, f, opt);

@@ -119,6 +119,33 @@ TEST(Database, PagesAreTheSameOnAnyThreadCount) {
   }
 }
 
+// Objects are flattened in chunks of 4096 on the build's threads: smooth
+// patches (whose triangles index their normals), quads cut in two, spheres
+// and cones, in chunks that end in the middle of each kind, join in the
+// one-thread order, normals renumbered.
+TEST(Database, FlatteningInChunksOnThreadsGivesTheSamePages) {
+  Scene scene = testing::showcase_scene(8);
+  for (int i = 0; i < 10000; ++i) {
+    const double x = (i % 100) * 0.05 - 2.5, y = (i / 100) * 0.05 - 2.5;
+    switch (i % 4) {
+      case 0:
+        scene.objects.push_back({Patch{{{x, y, 0.1}, {x + 0.04, y, 0.1}, {x + 0.04, y + 0.04, 0.12}, {x, y + 0.04, 0.1}},
+                                       {{0, 0, 1}, {0.1, 0, 1}, {0, 0.1, 1}, {0.1, 0.1, 1}}},
+                                 1});
+        break;
+      case 1: scene.objects.push_back({Polygon{{{x, y, 0.2}, {x + 0.04, y, 0.2}, {x, y + 0.04, 0.21}}}, 0}); break;
+      case 2: scene.objects.push_back({Sphere{{x, y, 0.3}, 0.01}, 2}); break;
+      default: scene.objects.push_back({Cone{{x, y, 0.4}, 0.01, {x, y, 0.45}, 0.0}, 3}); break;
+    }
+  }
+  const Database one = build_database(scene);
+  for (unsigned threads : {2u, 3u}) {
+    const Database many = build_database(scene, {.threads = threads});
+    EXPECT_TRUE(one.pages == many.pages) << threads << " threads";
+    EXPECT_EQ(one.header.primitive_count, many.header.primitive_count);
+  }
+}
+
 TEST(Database, TriangulatesPolygonsAndCountsPolygons) {
   const Database db = build_database(testing::showcase_scene(8));
   // Quad (2) + hexagon (4) + patch (1) triangles, 3 spheres, 2 cones.
