@@ -172,18 +172,33 @@ class Packer {
 
 // Puts primitives (and their normal records) in BVH leaf order; a primitive
 // listed in several leaves is copied into each.
-void reorder(Flattened& f, const std::vector<std::uint32_t>& order) {
-  std::vector<PrimRecord> prims;
-  std::vector<NormalRecord> normals;
-  prims.reserve(order.size());
-  for (std::uint32_t idx : order) {
-    PrimRecord r = f.prims[idx];
-    if (r.kind == PrimKind::smooth_triangle) {
-      normals.push_back(f.normals[r.aux]);
-      r.aux = static_cast<std::uint32_t>(normals.size() - 1);
+// Primitives put in `order` (a permutation), each smooth triangle's normal
+// following it, in pieces on `threads`: a first pass counts each piece's
+// smooth triangles, so every piece knows where its normals start.
+void reorder(Flattened& f, const std::vector<std::uint32_t>& order, unsigned threads) {
+  constexpr std::size_t piece_size = 1 << 16;
+  const std::size_t pieces = (order.size() + piece_size - 1) / piece_size;
+  std::vector<std::size_t> first_normal(pieces + 1, 0);
+  parallel_pieces(threads, pieces, [&](std::size_t p) {
+    std::size_t smooth = 0;
+    for (std::size_t i = p * piece_size; i < std::min(order.size(), (p + 1) * piece_size); ++i)
+      smooth += f.prims[order[i]].kind == PrimKind::smooth_triangle;
+    first_normal[p + 1] = smooth;
+  });
+  for (std::size_t p = 0; p < pieces; ++p) first_normal[p + 1] += first_normal[p];
+  std::vector<PrimRecord> prims(order.size());
+  std::vector<NormalRecord> normals(first_normal[pieces]);
+  parallel_pieces(threads, pieces, [&](std::size_t p) {
+    std::size_t next_normal = first_normal[p];
+    for (std::size_t i = p * piece_size; i < std::min(order.size(), (p + 1) * piece_size); ++i) {
+      PrimRecord r = f.prims[order[i]];
+      if (r.kind == PrimKind::smooth_triangle) {
+        normals[next_normal] = f.normals[r.aux];
+        r.aux = static_cast<std::uint32_t>(next_normal++);
+      }
+      prims[i] = r;
     }
-    prims.push_back(r);
-  }
+  });
   f.prims = std::move(prims);
   f.normals = std::move(normals);
 }
@@ -246,7 +261,7 @@ Database build_database(const Scene& scene, const BuildOptions& opt) {
     BvhBuild bvh = build_bvh(refs, opt.bvh_max_leaf, {.threads = opt.threads});
     if (opt.bvh_layout == BvhLayout::treelet) lay_out_treelets(bvh, opt.page_size / sizeof(BvhNode));
     for (std::uint32_t& k : bvh.order) k = refs.prim[k];
-    reorder(f, bvh.order);
+    reorder(f, bvh.order, opt.threads);
     db.stats.accel_seconds = seconds_since(t0);
     t0 = Clock::now();
     h.bvh_root = bvh.nodes[0];
@@ -256,7 +271,7 @@ Database build_database(const Scene& scene, const BuildOptions& opt) {
     sec[int(Section::bvh_nodes)] = packer.add(bvh.nodes, "BVH node");
   } else {
     GridBuild g = build_grid(f.prims, f.bounds, h.bounds, opt.grid_density);
-    reorder(f, g.order);
+    reorder(f, g.order, opt.threads);
     db.stats.accel_seconds = seconds_since(t0);
     t0 = Clock::now();
     std::copy(g.dims, g.dims + 3, h.grid_dims);

@@ -119,30 +119,49 @@ TEST(Database, PagesAreTheSameOnAnyThreadCount) {
   }
 }
 
-// Objects are flattened in chunks of 4096 on the build's threads: smooth
-// patches (whose triangles index their normals), quads cut in two, spheres
-// and cones, in chunks that end in the middle of each kind, join in the
-// one-thread order, normals renumbered.
+// The build flattens objects in chunks of 4096 on its threads and puts the
+// primitives in leaf order in pieces of 65 536: smooth patches (whose
+// triangles index their normals), quads cut in two, spheres and cones, in
+// chunks and pieces that end in the middle of each kind, joined in the
+// one-thread order with the normals renumbered.
+Vec3d patch_normal(std::uint32_t object) { return {(object % 97) * 0.01, (object % 89) * 0.01, 1}; }
+
 TEST(Database, FlatteningInChunksOnThreadsGivesTheSamePages) {
   Scene scene = testing::showcase_scene(8);
-  for (int i = 0; i < 10000; ++i) {
-    const double x = (i % 100) * 0.05 - 2.5, y = (i / 100) * 0.05 - 2.5;
+  const auto first = static_cast<std::uint32_t>(scene.objects.size());  // the objects added here
+  for (int i = 0; i < 60000; ++i) {  // 75 000 primitives
+    const double x = (i % 250) * 0.02 - 2.5, y = (i / 250) * 0.02 - 2.5;
     switch (i % 4) {
-      case 0:
-        scene.objects.push_back({Patch{{{x, y, 0.1}, {x + 0.04, y, 0.1}, {x + 0.04, y + 0.04, 0.12}, {x, y + 0.04, 0.1}},
-                                       {{0, 0, 1}, {0.1, 0, 1}, {0, 0.1, 1}, {0.1, 0.1, 1}}},
-                                 1});
+      case 0: {  // its normals its own, so that each triangle's can be traced back to it
+        const Vec3d n = patch_normal(static_cast<std::uint32_t>(scene.objects.size()));
+        scene.objects.push_back(
+            {Patch{{{x, y, 0.1}, {x + 0.015, y, 0.1}, {x + 0.015, y + 0.015, 0.12}, {x, y + 0.015, 0.1}}, {n, n, n, n}},
+             1});
         break;
-      case 1: scene.objects.push_back({Polygon{{{x, y, 0.2}, {x + 0.04, y, 0.2}, {x, y + 0.04, 0.21}}}, 0}); break;
-      case 2: scene.objects.push_back({Sphere{{x, y, 0.3}, 0.01}, 2}); break;
-      default: scene.objects.push_back({Cone{{x, y, 0.4}, 0.01, {x, y, 0.45}, 0.0}, 3}); break;
+      }
+      case 1: scene.objects.push_back({Polygon{{{x, y, 0.2}, {x + 0.015, y, 0.2}, {x, y + 0.015, 0.21}}}, 0}); break;
+      case 2: scene.objects.push_back({Sphere{{x, y, 0.3}, 0.005}, 2}); break;
+      default: scene.objects.push_back({Cone{{x, y, 0.4}, 0.005, {x, y, 0.45}, 0.0}, 3}); break;
     }
   }
-  const Database one = build_database(scene);
-  for (unsigned threads : {2u, 3u}) {
-    const Database many = build_database(scene, {.threads = threads});
-    EXPECT_TRUE(one.pages == many.pages) << threads << " threads";
-    EXPECT_EQ(one.header.primitive_count, many.header.primitive_count);
+  for (const Accel accel : {Accel::bvh, Accel::grid}) {
+    const Database one = build_database(scene, {.accel = accel});
+    // Every smooth triangle's normals are its own patch's.
+    std::uint32_t smooth = 0;
+    for (std::uint32_t i = 0; i < one.header.section(Section::prims).record_count; ++i) {
+      const auto p = record<PrimRecord>(one, Section::prims, i);
+      if (p.kind != PrimKind::smooth_triangle || p.object < first) continue;
+      ++smooth;
+      const Vec3f want = static_cast<Vec3f>(normalize(patch_normal(p.object)));
+      const auto n = record<NormalRecord>(one, Section::normals, p.aux);
+      ASSERT_TRUE(n.n0 == want && n.n1 == want && n.n2 == want) << "primitive " << i << " of object " << p.object;
+    }
+    EXPECT_EQ(smooth, 2u * 15000);
+    for (unsigned threads : {2u, 3u}) {
+      const Database many = build_database(scene, {.accel = accel, .threads = threads});
+      EXPECT_TRUE(one.pages == many.pages) << threads << " threads, accel " << int(accel);
+      EXPECT_EQ(one.header.primitive_count, many.header.primitive_count);
+    }
   }
 }
 
