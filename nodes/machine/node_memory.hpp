@@ -110,11 +110,6 @@ class NodeMemory {
   };
 
   int take_slot(std::span<const int> in_use);
-  void unlink(int slot) {
-    Use& s = uses_[static_cast<std::size_t>(slot)];
-    (s.newer >= 0 ? uses_[static_cast<std::size_t>(s.newer)].older : front_) = s.older;
-    (s.older >= 0 ? uses_[static_cast<std::size_t>(s.older)].newer : back_) = s.newer;
-  }
   void push_front(int slot) {
     Use& s = uses_[static_cast<std::size_t>(slot)];
     s.newer = -1;
@@ -122,9 +117,16 @@ class NodeMemory {
     (front_ >= 0 ? uses_[static_cast<std::size_t>(front_)].newer : back_) = slot;
     front_ = slot;
   }
+  // A hit on a slot behind the front: it has a newer neighbour, and the
+  // front exists, so only its older end can be the list's end.
   void to_front(int slot) {
-    unlink(slot);
-    push_front(slot);
+    Use& s = uses_[static_cast<std::size_t>(slot)];
+    uses_[static_cast<std::size_t>(s.newer)].older = s.older;
+    (s.older >= 0 ? uses_[static_cast<std::size_t>(s.older)].newer : back_) = s.newer;
+    s.older = front_;
+    s.newer = -1;
+    uses_[static_cast<std::size_t>(front_)].newer = slot;
+    front_ = slot;
   }
 
   std::size_t page_size_;
