@@ -266,9 +266,19 @@ std::vector<std::array<std::uint32_t, 3>> triangulate_polygon(const std::vector<
   const Vec3d an{std::fabs(n.x), std::fabs(n.y), std::fabs(n.z)};
   const int drop = an.x > an.y ? (an.x > an.z ? 0 : 2) : (an.y > an.z ? 1 : 2);
   const int ax = (drop + 1) % 3, ay = (drop + 2) % 3;
+  const double sign = n[drop] >= 0 ? 1.0 : -1.0;  // winding as seen in the projection
+  if (v.size() == 3) {
+    // A triangle turning with `sign` at all three corners goes round once
+    // (its exterior angles add up to 2 pi), so it is strictly convex and
+    // the convex path would give it whole; the rest go the general way.
+    const P2 a{v[0][ax], v[0][ay]}, b{v[1][ax], v[1][ay]}, c{v[2][ax], v[2][ay]};
+    if (sign * cross2(c, a, b) > 0 && sign * cross2(a, b, c) > 0 && sign * cross2(b, c, a) > 0) {
+      tris.push_back({0, 1, 2});
+      return tris;
+    }
+  }
   std::vector<P2> pts;
   for (const Vec3d& p : v) pts.push_back({p[ax], p[ay]});
-  const double sign = n[drop] >= 0 ? 1.0 : -1.0;  // winding as seen in the projection
   tris.reserve(v.size() - 2);
   if (is_strictly_convex(pts, sign)) {
     std::vector<std::uint32_t> ring(v.size());
