@@ -14,6 +14,7 @@
 // renderer's; a difference is printed and makes the exit status 1.
 //
 // usage: scaling_bench [CASES [THREADS [SIZE [REPEATS]]]]
+//   CASES: SCENE:NODES[:wWORKERS][:cCACHE_PAGES], e.g. rings4:64:c64
 //   default: rings4:16,rings4:64,teapot:16,teapot:64 1,2,4,8,16 512 3
 //   THREADS: increasing counts, 1..1024 (more than the cores oversubscribes
 //   them); SIZE 16..4096; REPEATS 1..100; a bad argument: usage, exit 2
@@ -23,6 +24,7 @@
 #include <cstring>
 #include <exception>
 #include <map>
+#include <optional>
 #include <sstream>
 #include <string>
 #include <thread>
@@ -38,8 +40,11 @@ namespace {
 using Clock = std::chrono::steady_clock;
 
 struct Case {
+  std::string label;  // as given
   std::string scene;
   int nodes = 16;
+  int workers = 1;                          // :wW
+  std::optional<std::uint32_t> cache_pages;  // :cC; none: the default
 };
 
 std::vector<std::string> split(const std::string& text) {
@@ -49,16 +54,36 @@ std::vector<std::string> split(const std::string& text) {
   return parts;
 }
 
+// SCENE:NODES[:wWORKERS][:cCACHE_PAGES]; a scene spec may hold colons of
+// its own, so the fields are taken from the end.
+Case parse_case(const std::string& item) {
+  Case c;
+  c.label = item;
+  std::string rest = item;
+  for (;;) {
+    const auto colon = rest.rfind(':');
+    if (colon == std::string::npos || colon == 0)
+      throw bench::BadArgument{"CASES: expected SCENE:NODES[:wWORKERS][:cCACHE_PAGES], got '" + item + "'"};
+    const std::string field = rest.substr(colon + 1);
+    rest.resize(colon);
+    if (!field.empty() && field[0] == 'w') {
+      c.workers = static_cast<int>(bench::parse_int(field.substr(1), 1, 64, "CASES' WORKERS"));
+    } else if (!field.empty() && field[0] == 'c') {
+      c.cache_pages = static_cast<std::uint32_t>(bench::parse_int(field.substr(1), 1, 1 << 24, "CASES' CACHE_PAGES"));
+    } else {
+      c.nodes = static_cast<int>(bench::parse_int(field, 1, 4096, "CASES' NODES"));
+      break;
+    }
+  }
+  if (c.nodes & (c.nodes - 1))
+    throw bench::BadArgument{"CASES: a hypercube needs a power-of-two node count, got '" + item + "'"};
+  c.scene = rest;
+  return c;
+}
+
 std::vector<Case> parse_cases(const std::string& text) {
   std::vector<Case> cases;
-  for (const std::string& item : split(text)) {
-    const auto colon = item.rfind(':');
-    if (colon == std::string::npos || colon == 0)
-      throw bench::BadArgument{"CASES: expected SCENE:NODES, got '" + item + "'"};
-    const long nodes = bench::parse_int(item.substr(colon + 1), 1, 4096, "CASES' NODES");
-    if (nodes & (nodes - 1)) throw bench::BadArgument{"CASES: a hypercube needs a power-of-two node count, got '" + item + "'"};
-    cases.push_back({item.substr(0, colon), static_cast<int>(nodes)});
-  }
+  for (const std::string& item : split(text)) cases.push_back(parse_case(item));
   if (cases.empty()) throw bench::BadArgument{"CASES: empty list"};
   return cases;
 }
@@ -107,6 +132,8 @@ MachineSample run_machine(const Case& c, const tracer::Database& source, unsigne
   options.topology = "hypercube";
   options.nodes = static_cast<std::size_t>(c.nodes);
   options.threads = threads;  // 0: the default rule
+  options.workers_per_node = c.workers;
+  if (c.cache_pages) options.cache_pages = c.cache_pages;
   const auto start = Clock::now();
   const nodes::MachineResult result = nodes::run_machine(std::move(db), options);
   MachineSample s;
@@ -142,7 +169,7 @@ void print_row(const Case& c, const Row& row, const std::vector<unsigned>& threa
   const double one = median(row.machine.at(threads.front()));
   double best = one;
   unsigned best_t = threads.front();
-  std::printf("%-12s machine", (c.scene + ":" + std::to_string(c.nodes)).c_str());
+  std::printf("%-12s machine", c.label.c_str());
   for (const unsigned t : threads) {
     const double m = median(row.machine.at(t));
     std::printf(" %8.3f", m);
@@ -172,7 +199,8 @@ void print_row(const Case& c, const Row& row, const std::vector<unsigned>& threa
 const char* const usage =
     "usage: scaling_bench [CASES [THREADS [SIZE [REPEATS]]]]\n"
     "  default: rings4:16,rings4:64,teapot:16,teapot:64 1,2,4,8,16 512 3\n"
-    "  CASES: SCENE:NODES, comma-separated (a hypercube of NODES, a power of two)\n"
+    "  CASES: SCENE:NODES[:wWORKERS][:cCACHE_PAGES], comma-separated (a hypercube of NODES, a power of\n"
+    "  two; WORKERS pixel computers a node, 1..64; CACHE_PAGES a node, default 1/8 of the database)\n"
     "  THREADS: increasing, 1..1024; SIZE 16..4096; REPEATS 1..100\n";
 
 int bench_scaling(const std::vector<std::string>& args) {
