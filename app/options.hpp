@@ -15,6 +15,8 @@
 
 #include "app/timing_options.hpp"
 #include "nodes/machine/machine.hpp"
+#include "nodes/machine/pixel_order.hpp"
+#include "nodes/machine/work_plan.hpp"
 #include "tracer/database.hpp"
 
 namespace app {
@@ -38,7 +40,7 @@ struct Options {
   bool shadow_rays_all = false;  // --shadow-rays all: one per light at every hit
   tracer::Accel accel = tracer::Accel::bvh;
   tracer::BvhLayout bvh_layout = tracer::BvhLayout::treelet;
-  std::uint32_t page_size = 1024;
+  std::uint32_t page_size = tracer::BuildOptions{}.page_size;
   int max_depth = 5;
   int width = 0;       // 0: the scene's resolution
   int height = 0;
@@ -59,12 +61,14 @@ struct Options {
 // ---- Options a render and a sweep share ----
 // Both commands describe them with add_database_options and
 // add_farming_options and parse them with parse_database and parse_farming;
-// each starts from its own defaults (these are the render's).
+// each starts from its own defaults (these are the render's: the
+// database's and the machine's own).
 struct SharedChoice {
   std::string accel = "bvh", bvh_layout = "treelet", shadow_rays = "facing";
-  std::int64_t page_size = 1024;
-  std::int64_t grain = 16, prefetch = 1;
-  std::string schedule = "affinity", pixel_order = "hilbert";
+  std::int64_t page_size = tracer::BuildOptions{}.page_size;
+  std::int64_t grain = nodes::MachineOptions{}.grain, prefetch = nodes::MachineOptions{}.prefetch;
+  std::string schedule = nodes::schedule_name(nodes::MachineOptions{}.schedule),
+              pixel_order = nodes::pixel_order_name(nodes::MachineOptions{}.pixel_order);
 };
 
 // How the database is built and traced: --accel, --bvh-layout, --shadow-rays, --page-size.
@@ -72,17 +76,17 @@ struct DatabaseChoice {
   tracer::Accel accel = tracer::Accel::bvh;
   tracer::BvhLayout bvh_layout = tracer::BvhLayout::treelet;
   bool shadow_rays_all = false;
-  std::uint32_t page_size = 1024;
+  std::uint32_t page_size = tracer::BuildOptions{}.page_size;
 };
 void add_database_options(boost::program_options::options_description& d, SharedChoice& choice);
 DatabaseChoice parse_database(const SharedChoice& choice);
 
 // How the pixels are handed out: --grain, --schedule, --pixel-order, --prefetch.
 struct FarmingChoice {
-  std::uint32_t grain = 16;
-  std::uint16_t prefetch = 1;
-  nodes::Schedule schedule = nodes::Schedule::affinity;
-  nodes::PixelOrder pixel_order = nodes::PixelOrder::hilbert;
+  std::uint32_t grain = nodes::MachineOptions{}.grain;
+  std::uint16_t prefetch = nodes::MachineOptions{}.prefetch;
+  nodes::Schedule schedule = nodes::MachineOptions{}.schedule;
+  nodes::PixelOrder pixel_order = nodes::MachineOptions{}.pixel_order;
 };
 void add_farming_options(boost::program_options::options_description& d, SharedChoice& choice);
 // Also refuses a --grain given with the static schedule (check_grain).

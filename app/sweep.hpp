@@ -31,7 +31,7 @@ struct SweepOptions {
   Kind kind = Kind::nodes;
   std::string scene = "teapot";
   int size = 64;                          // image side in pixels
-  std::uint32_t page_size = 1024;
+  std::uint32_t page_size = tracer::BuildOptions{}.page_size;
   std::vector<std::string> topologies{"hypercube"};
   std::vector<std::size_t> nodes{1, 2, 4, 8, 16, 32, 64};  // sweep nodes: the axis; cache: the first
   std::vector<std::uint32_t> cache_pages;  // sweep cache: the axis; nodes: the first (empty: default)
