@@ -311,8 +311,10 @@ void Runtime::Impl::worker_main(unsigned index, detail::StartGate& gate, std::ba
     serve(index);
     // A fiber of another thread may still be inside this thread's scheduler,
     // waking it; the scheduler dies with the thread, so wait for every
-    // thread to finish its fibers first.
+    // thread to finish its fibers first, and for any wake from outside the
+    // runtime (a shutdown from another thread) to be through notify().
     finished.arrive_and_wait();
+    while (detail::remote_wakes_in_flight.load(std::memory_order_seq_cst) != 0) std::this_thread::yield();
   }
   detail::set_thread_scheduler(nullptr, nullptr);
   detail::release_properties_reserve();

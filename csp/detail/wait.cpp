@@ -166,6 +166,7 @@ void complete(Waiter& w, WaitState outcome, std::size_t fired) {
       local->schedule(ctx);
     } else {
       if (deferred_wake_count == deferred_wake_capacity) issue_deferred_wakes();
+      remote_wakes_in_flight.fetch_add(1, std::memory_order_seq_cst);  // before ctx can run
       deferred_wakes[deferred_wake_count++] = ctx;
     }
   }
@@ -173,11 +174,15 @@ void complete(Waiter& w, WaitState outcome, std::size_t fired) {
 
 constinit thread_local std::uint64_t remote_wakes_here = 0;
 
+std::atomic<std::uint64_t> remote_wakes_in_flight{0};
+
 void issue_deferred_wakes() {
-  remote_wakes_here += deferred_wake_count;
-  for (std::size_t i = 0; i < deferred_wake_count; ++i)
+  const std::size_t count = deferred_wake_count;
+  remote_wakes_here += count;
+  for (std::size_t i = 0; i < count; ++i)
     deferred_wakes[i]->get_scheduler()->schedule_from_remote(deferred_wakes[i]);
   deferred_wake_count = 0;
+  remote_wakes_in_flight.fetch_sub(count, std::memory_order_seq_cst);  // every notify() has returned
 }
 
 boost::fibers::scheduler* thread_scheduler() { return runtime_scheduler; }

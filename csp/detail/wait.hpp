@@ -280,6 +280,11 @@ void complete(Waiter& w, WaitState outcome, std::size_t fired);
 // that the inline test below reaches without a call.
 extern constinit thread_local std::size_t deferred_wake_count;
 void issue_deferred_wakes();
+// Cross-thread wakes deferred and not yet through their scheduler's
+// notify(), process-wide: a woken fiber can end, and its thread with it,
+// before the waker's notify() returns, so a runtime thread keeps its
+// scheduler until none is in flight (Runtime's worker_main).
+extern std::atomic<std::uint64_t> remote_wakes_in_flight;
 inline void flush_wakes() {
   if (deferred_wake_count != 0) issue_deferred_wakes();
 }
