@@ -88,6 +88,13 @@ void add_route(const Topology& t, NodeId from, NodeId to, double weight, std::ma
   load[{to, t.degree(to)}] += weight;
 }
 
+// The load of the busiest link in `load`.
+double busiest(const std::map<LinkKey, double>& load) {
+  double most = 0;
+  for (const auto& [link, l] : load) most = std::max(most, l);
+  return most;
+}
+
 double seconds_of(csp::VirtualDuration d) { return std::chrono::duration<double>(d).count(); }
 csp::VirtualDuration virtual_of(double seconds) {
   return std::chrono::duration_cast<csp::VirtualDuration>(std::chrono::duration<double>(seconds));
@@ -213,9 +220,7 @@ double max_channel_load(const Topology& t, TrafficPattern pattern, double hotspo
     for (NodeId d = 0; d < n; ++d)
       if (d != s) add_route(t, s, d, (1.0 - hot) / (n - 1), load);
   }
-  double most = 0;
-  for (const auto& [link, l] : load) most = std::max(most, l);
-  return most;
+  return busiest(load);
 }
 
 std::uint64_t RecordedTraffic::packets() const {
@@ -239,10 +244,6 @@ void check_recorded(const Topology& t, const RecordedTraffic& traffic) {
                                     std::to_string(p.destination) + " on " + t.spec());
 }
 
-double message_seconds(const LinkModel& link, std::size_t bytes) {
-  return std::chrono::duration<double>(link.delay(bytes)).count();
-}
-
 }  // namespace
 
 double recorded_channel_load(const Topology& t, const RecordedTraffic& traffic, const LinkModel& link,
@@ -250,14 +251,12 @@ double recorded_channel_load(const Topology& t, const RecordedTraffic& traffic, 
   check_recorded(t, traffic);
   // A node offers rate n |sent| / total; each of its packets is 1 / |sent| of that.
   const double per_packet = static_cast<double>(t.size()) / static_cast<double>(traffic.packets());
-  const double unit = message_seconds(link, payload_bytes);
+  const double unit = zero_load_latency(link, payload_bytes, 0);
   std::map<LinkKey, double> load;
   for (NodeId s = 0; s < t.size(); ++s)
     for (const RecordedPacket& p : traffic.by_source[s])
-      add_route(t, s, p.destination, per_packet * message_seconds(link, p.bytes) / unit, load);
-  double most = 0;
-  for (const auto& [key, l] : load) most = std::max(most, l);
-  return most;
+      add_route(t, s, p.destination, per_packet * zero_load_latency(link, p.bytes, 0) / unit, load);
+  return busiest(load);
 }
 
 double recorded_zero_load_latency(const Topology& t, const RecordedTraffic& traffic, const LinkModel& link) {
@@ -265,7 +264,7 @@ double recorded_zero_load_latency(const Topology& t, const RecordedTraffic& traf
   double sum = 0;
   for (NodeId s = 0; s < t.size(); ++s)
     for (const RecordedPacket& p : traffic.by_source[s])
-      sum += (t.distance(s, p.destination) + 1) * message_seconds(link, p.bytes);
+      sum += zero_load_latency(link, p.bytes, t.distance(s, p.destination));
   return sum / static_cast<double>(traffic.packets());
 }
 
