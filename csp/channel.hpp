@@ -18,6 +18,7 @@
 #include <algorithm>
 #include <cstddef>
 #include <memory>
+#include <new>
 #include <optional>
 #include <string>
 #include <utility>
@@ -256,9 +257,12 @@ class ChannelState final : public ChannelBase {
 // and throws std::logic_error instead of Poisoned; the ends' other members
 // check first. It is never freed, and an end refers to it without a share
 // in its ownership, so making an end unbound touches no reference count.
+// It lives in static storage and its constructor allocates nothing, so
+// making it cannot fail: a move of an end (noexcept) may be the first use.
 template <class T>
-std::shared_ptr<ChannelState<T>> unbound_channel() {
-  static ChannelState<T>* const channel = new ChannelState<T>(ChannelBase::Unbound{});
+std::shared_ptr<ChannelState<T>> unbound_channel() noexcept {
+  alignas(ChannelState<T>) static unsigned char storage[sizeof(ChannelState<T>)];
+  static ChannelState<T>* const channel = ::new (static_cast<void*>(storage)) ChannelState<T>(ChannelBase::Unbound{});
   return std::shared_ptr<ChannelState<T>>(std::shared_ptr<void>(), channel);
 }
 
