@@ -93,7 +93,7 @@ po::options_description describe_machine(Options& o, Raw& raw) {
        "with --timing virtual), page requests and rays")
       ("replay", po::value(&o.replay_html),
        "write one self-contained HTML page that replays the run: nodes at work, packets hop by hop, the image "
-       "filling in (not over mpirun)")
+       "filling in (over mpirun too: rank 0 gathers every rank's recording)")
       ("replay-packets", po::value(&raw.replay_packets)->default_value(100000),
        "with --replay: packets recorded hop by hop, 0..4194304, and the waits for pages and serves begun meanwhile; "
        "later ones are only counted (the page says so)")

@@ -18,8 +18,6 @@ void check_rank_options(const Options& o, int ranks) {
   if (o.single) throw UsageError("--single renders in one process: run it without mpirun");
   if (o.estimate_memory) throw UsageError("--estimate-memory" + over + ": run it without mpirun");
   if (o.compare_serial) throw UsageError("--compare-serial" + over + ": it runs the 1-node machine beside this one");
-  if (!o.replay_html.empty())
-    throw UsageError("--replay" + over + ": the recording stays in each rank; run it in one process");
   if (o.machine.timing)
     throw UsageError("--timing virtual" + over + ": one virtual clock orders the whole machine");
   const std::size_t nodes = topology::parse_topology(o.machine.topology, o.machine.nodes).size();

@@ -212,6 +212,7 @@ Json replay_data(const ReplaySource& source) {
           {"serves", serves_json(rec, ticks)},
           {"hits", hits_json(rec, ticks)},
           {"maxPackets", rec.max_packets},
+          {"ranks", rec.node_rank},
           {"unrecorded",
            {{"packets", rec.unrecorded_packets},
             {"hops", rec.unrecorded_hops},

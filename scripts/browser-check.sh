@@ -5,7 +5,8 @@
 # decoded and not blank, has its tables and SVG figures, raises no script
 # error, and screenshots to something that is not blank. The replay page
 # must also step, and its counters at its end must equal the same run's
-# --stats (packets, hops, page misses, pixels).
+# --stats (packets, hops, page misses, pixels); so must a replay recorded
+# over two MPI ranks, when mpirun is installed.
 #
 # The page is opened inside a checking page (scripts/browser-check.html)
 # whose script inspects it once it has loaded and writes one line, PASS or
@@ -72,12 +73,21 @@ print(",".join(str(v) for v in (n["packets"], round(n["packets"] * n["mean_hops"
                                 sum(x["pixels"] for x in m["per_node"]))))' "$1"
 }
 replay_stats=$(stats_of "$work/replay.json")
+# A replay recorded over two MPI ranks, when Open MPI is installed (CI has it).
+mpi_replay=""
+if command -v mpirun >/dev/null; then
+  OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1 OMPI_MCA_btl_vader_single_copy_mechanism=none \
+    timeout -k 10 120 mpirun -np 2 --oversubscribe --mca btl self,vader "$vmpray" teapot --width 64 --height 64 \
+    --topology hypercube:3 -q -o ranks.png --replay "$work/ranks.html" --stats "$work/ranks.json"
+  mpi_replay=$(stats_of "$work/ranks.json")
+fi
 
 status=0
 check "$work/run.html" 2 2 3 || status=1
 check "$work/sweep/nodes.html" 0 1 1 || status=1
 check "$work/replay.html" 0 0 0 "$replay_stats" || status=1
 check "$work/bounded.html" 0 0 0 "$(stats_of "$work/bounded.json")" || status=1
+[[ -z "$mpi_replay" ]] || check "$work/ranks.html" 0 0 0 "$mpi_replay" || status=1
 
 # The check itself must catch what it is for: each of these pages fails it.
 mkdir "$work/bad"

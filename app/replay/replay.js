@@ -6,7 +6,8 @@
 // canvas over the machine's SVG (node places come from the machine picture,
 // in its user units) and on a canvas of the frame, and exposes
 // window.vmprayReplay for scripted checks: stepToEnd() and counters()
-// (packets delivered, hops, misses, pixels).
+// (packets delivered, hops, misses, pixels), and over MPI ranks how many
+// ranks ran the machine and how many recorded packets crossed between them.
 // Cost: a frame walks the packets injected by t and the hops left by t, so a
 // recording of 36 000 packets draws in a few milliseconds.
 
@@ -34,6 +35,15 @@ const delivered = (i) => T[2 * routeStart[i + 1] - 1];
 const departs = (i, h) => T[2 * routeStart[i] + 1 + 2 * h];
 const arrives = (i, h) => T[2 * routeStart[i] + 2 + 2 * h];
 const node = (i, h) => P.route[routeStart[i] + h];
+// Over several MPI ranks, the rank of each node, and which packets crossed
+// between ranks (a hop whose ends ran on different ranks).
+const RANK = D.ranks && D.ranks.length === N ? D.ranks : null;
+const RANKS = RANK ? Math.max(...RANK) + 1 : 1;
+const betweenRanks = (a, b) => RANK !== null && RANK[a] !== RANK[b];
+const crossed = new Uint8Array(count);
+for (let i = 0; i < count; ++i)
+  for (let h = 0; h < P.hops[i]; ++h) if (betweenRanks(node(i, h), node(i, h + 1))) crossed[i] = 1;
+const crossedCount = crossed.reduce((a, b) => a + b, 0);
 
 function sorted(values) { const a = Float64Array.from(values); a.sort(); return a; }
 // How many of the sorted values are at most t.
@@ -165,11 +175,13 @@ function drawMachine() {
     const share = load[k] / maxLoad;
     g.strokeStyle = `rgba(230, 120, 0, ${0.25 + 0.75 * share})`;
     g.lineWidth = 1 + 5 * share;
+    g.setLineDash(betweenRanks(a, b) ? [6, 4] : []);
     g.beginPath();
     g.moveTo(ax + ux * from + ox, ay + uy * from + oy);
     g.lineTo(ax + ux * to + ox, ay + uy * to + oy);
     g.stroke();
   });
+  g.setLineDash([]);
   // Nodes: one arc per pixel computer (tracing, waiting for a page, idle), a
   // blue outer ring while its page server serves.
   for (let n = 0; n < N; ++n) {
@@ -212,8 +224,8 @@ function drawMachine() {
       y = py + Math.sin(a) * pr * 0.6;
     }
     g.fillStyle = KIND_COLOURS[P.kind[i]] || "#000";
-    g.strokeStyle = "#ffffff";
-    g.lineWidth = 1.2;
+    g.strokeStyle = crossed[i] ? "#000000" : "#ffffff";
+    g.lineWidth = crossed[i] ? 1.8 : 1.2;
     g.beginPath();
     g.arc(x, y, 4.5, 0, 2 * Math.PI);
     g.fill();
@@ -325,13 +337,15 @@ for (const r of document.querySelectorAll("input[name=view]")) r.onchange = () =
 // ---- Details of a node or a packet ----
 function esc(s) { return String(s).replace(/[&<>"]/g, (c) => ({"&": "&amp;", "<": "&lt;", ">": "&gt;", "\"": "&quot;"}[c])); }
 function packetDetails(i) {
-  let rows = `<tr><th>node</th><th>arrives</th><th>leaves</th></tr>`;
+  let rows = `<tr><th>node</th>${RANK ? "<th>rank</th>" : ""}<th>arrives</th><th>leaves</th></tr>`;
   for (let h = 0; h <= P.hops[i]; ++h)
-    rows += `<tr><td>${node(i, h)}</td><td>${format(h === 0 ? injected(i) : arrives(i, h - 1))}</td>` +
+    rows += `<tr><td>${node(i, h)}</td>${RANK ? `<td>${RANK[node(i, h)]}</td>` : ""}` +
+            `<td>${format(h === 0 ? injected(i) : arrives(i, h - 1))}</td>` +
             `<td>${format(h === P.hops[i] ? delivered(i) : departs(i, h))}</td></tr>`;
   $("details").innerHTML = `<h3>${esc(D.kinds[P.kind[i]])} packet ${P.id[i]}: ${P.bytes[i]} bytes, ` +
       `${P.hops[i]} hop${P.hops[i] === 1 ? "" : "s"}</h3><p>route ${Array.from({length: P.hops[i] + 1}, (_, h) => node(i, h)).join(" \u2192 ")}` +
-      ` (injected at the first node, delivered at the last)</p><table>${rows}</table>`;
+      ` (injected at the first node, delivered at the last)` +
+      (crossed[i] ? `; it crossed between MPI ranks` : ``) + `</p><table>${rows}</table>`;
 }
 function nodeDetails(n) {
   const buckets = 48, hits = new Float64Array(buckets), miss = new Float64Array(buckets);
@@ -347,7 +361,7 @@ function nodeDetails(n) {
   });
   const top = [...served.entries()].sort((a, b) => b[1] - a[1] || a[0] - b[0]).slice(0, 12);
   const totalHits = hits.reduce((a, b) => a + b, 0), totalMisses = miss.reduce((a, b) => a + b, 0);
-  $("details").innerHTML = `<h3>node ${n}</h3><p>page calls answered by its own pages or its cache: ${totalHits}; ` +
+  $("details").innerHTML = `<h3>node ${n}${RANK ? ` (MPI rank ${RANK[n]})` : ``}</h3><p>page calls answered by its own pages or its cache: ${totalHits}; ` +
       `misses (page requests sent): ${totalMisses}` +
       (D.window < END ? ` (recorded up to ${format(D.window)})` : ``) +
       `; over the run, in ${buckets} slices of ${format(END / buckets)}:</p>` +
@@ -390,7 +404,9 @@ const recorded = count, all = D.totals.packets;
 $("about").textContent = `${D.topology}, ${N} nodes, ${W} pixel computer${W === 1 ? "" : "s"} each; ` +
     (D.timing === "virtual" ? "virtual time: the modelled machine's timing, the same on every replay of this command"
                             : "real time: this computer's wall clock, as the run went") +
-    `; ${format(END)} recorded, ${recorded} packets hop by hop.`;
+    `; ${format(END)} recorded, ${recorded} packets hop by hop.` +
+    (RANK ? ` Run over ${RANKS} MPI ranks, each on its own clock put onto rank 0's; ` +
+            `${crossedCount} of the packets recorded crossed between ranks.` : ``);
 if (D.unrecorded.packets > 0) {
   $("bound").hidden = false;
   $("bound").textContent = `Only the first ${D.maxPackets} of ${all} packets were recorded hop by hop ` +
@@ -412,6 +428,7 @@ for (const s of ["tracing", "waiting", "idle"])
   legend += `<span class="sw" style="background:${STATE[s]}"></span>${s === "waiting" ? "waiting for a page" : s}`;
 legend += `<span class="sw" style="background:${STATE.serving}"></span>page server serving (outer ring)`;
 legend += "<br/><b>links</b>: orange, thicker as more packets have crossed them";
+if (RANK) legend += "; dashed between nodes of different MPI ranks. A packet ringed in black crossed between ranks";
 $("legend").innerHTML = legend;
 
 fit();
@@ -432,5 +449,7 @@ window.vmprayReplay = {
   stepToEnd: () => { seek(END); return counters(); },
   counters: () => counters(),
   packets: recorded,
+  ranks: RANKS,
+  crossedRanks: crossedCount,
 };
 })();

@@ -18,6 +18,7 @@
 
 #include "csp/errors.hpp"
 #include "csp/seeded_scheduler.hpp"
+#include "nodes/machine/rank_clock.hpp"
 #include "nodes/machine/report_wire.hpp"
 #include "nodes/net/mailbox.hpp"
 #include "topology/spec.hpp"
@@ -485,6 +486,7 @@ void run_and_translate(csp::Runtime& runtime, std::size_t nodes, SplitState* spl
 struct Executed {
   MachineResult result;
   std::vector<RouterCounters> routers;  // split runs only: index = node, zero for other ranks' nodes
+  std::unique_ptr<Recorder> recorder;   // recorded split runs only: this rank's logs, merged on rank 0
 };
 
 // The figures of the machine as this process ran it; per_node entries of
@@ -578,10 +580,11 @@ Executed execute(const tracer::DatabaseHeader& header, const topology::Topology&
 
   Network* network = nullptr;  // for the runtime's failure handler, once it exists
   csp::Runtime runtime(runtime_options(options, local_nodes, timing, split, share.rank, network));
-  if (options.record && share.plan) throw std::invalid_argument("record: a run over several processes cannot be recorded");
-  const std::unique_ptr<Recorder> recorder =
-      options.record ? std::make_unique<Recorder>(topology.size(), options.record_packets, timing != nullptr, started)
-                     : nullptr;
+  // Over several ranks each records its share of the packets, on its own clock.
+  const std::uint64_t budget =
+      share.plan ? rank_budget(options.record_packets, share.plan->ranks(), share.rank) : options.record_packets;
+  std::unique_ptr<Recorder> recorder =
+      options.record ? std::make_unique<Recorder>(topology.size(), budget, timing != nullptr, started) : nullptr;
   Network net(runtime, topology,
               network_options(options, timing, share, topology.size(), local_nodes, runtime.threads(), recorder.get()));
   network = &net;
@@ -609,9 +612,10 @@ Executed execute(const tracer::DatabaseHeader& header, const topology::Topology&
   MachineReport& report = result.report;
   report = machine_report(runtime, net, timing, header, options, cache_pages, items.count, nodes);
   report.wall_seconds = wall_seconds;
-  if (recorder) report.recording = recording_of(*recorder, topology, report);
+  if (recorder && !split) report.recording = recording_of(*recorder, topology, report);
   if (split)
     add_rank_figures(executed, share, local_nodes, runtime.threads(), *split, net, nodes, cpu_seconds() - cpu_started);
+  executed.recorder = split ? std::move(recorder) : nullptr;
   if (share.runs(0)) {
     report.farmer = host.farmer;
     report.farmer.steals = host.plan->steals();
@@ -698,9 +702,26 @@ tracer::DatabaseHeader receive_setup(const MachineOptions& options, const RankPl
   return header;
 }
 
-// Rank 0 folds another rank's reports into its own.
+// Another rank's part of the reports: its own, its nodes' and routers', and
+// in a recorded run its nodes' logs, then its clock for rank 0 to read.
+void report_to_rank_zero(Transport& transport, const RankPlan& plan, int rank, const Executed& executed) {
+  const MachineReport& report = executed.result.report;
+  WireWriter w;
+  put_rank_report(w, report.ranks.front(), report.host_threads);
+  for (NodeId n = plan.first(rank); n < plan.first(rank) + plan.count(rank); ++n) {
+    put_node_report(w, report.per_node[n]);
+    put_router_counters(w, executed.routers[n]);
+    if (executed.recorder) put_node_log(w, executed.recorder->log(n));
+  }
+  transport.post(0, Tag::report, w.take());
+  transport.flush();
+  if (executed.recorder) answer_clock(transport, *executed.recorder);
+}
+
+// Rank 0 folds another rank's reports into its own (and, in a recorded
+// run, its nodes' logs into `recorder`, still on that rank's clock).
 void merge_rank(const Incoming& message, const RankPlan& plan, MachineReport& report,
-                std::vector<RouterCounters>& routers) {
+                std::vector<RouterCounters>& routers, Recorder* recorder) {
   WireReader r(message.bytes);
   std::vector<csp::ThreadUse> threads;
   report.ranks.push_back(get_rank_report(r, threads));
@@ -708,8 +729,30 @@ void merge_rank(const Incoming& message, const RankPlan& plan, MachineReport& re
   for (NodeId n = plan.first(message.from); n < plan.first(message.from) + plan.count(message.from); ++n) {
     report.per_node[n] = get_node_report(r);
     routers[n] = get_router_counters(r);
+    if (recorder) recorder->adopt(n, get_node_log(r));
   }
   if (!r.done()) throw std::runtime_error("rank " + std::to_string(message.from) + " sent a report too long");
+}
+
+// Rank 0, in a recorded split run, once every rank has reported: each
+// rank's logs and tiles moved onto rank 0's clock, and merged.
+std::shared_ptr<const Recording> split_recording(Transport& transport, const RankPlan& plan,
+                                                 const topology::Topology& topology, MachineReport& report,
+                                                 Recorder& recorder, std::uint64_t packets) {
+  std::vector<int> node_rank(topology.size(), 0);
+  for (int q = 1; q < plan.ranks(); ++q) {
+    const double offset = clock_offset(transport, q, recorder);
+    for (NodeId n = plan.first(q); n < plan.first(q) + plan.count(q); ++n) {
+      node_rank[n] = q;
+      shift_times(recorder.log(n), offset);
+      for (TileSpan& span : report.per_node[n].work.spans) span.start += offset, span.end += offset;
+    }
+  }
+  std::vector<std::vector<TileSpan>> tiles;
+  for (const NodeReport& n : report.per_node) tiles.push_back(n.work.spans);
+  Recording recording = merge_recording(recorder, topology, std::move(tiles), std::move(node_rank));
+  recording.max_packets = packets;
+  return std::make_shared<const Recording>(std::move(recording));
 }
 
 }  // namespace
@@ -757,18 +800,14 @@ std::optional<MachineResult> run_machine_rank(std::optional<tracer::Database> db
       execute(header, topology, placement, cache_pages, nodes, options, Share{&plan, &transport, rank});
   MachineReport& report = executed.result.report;
   if (rank != 0) {
-    WireWriter w;
-    put_rank_report(w, report.ranks.front(), report.host_threads);
-    for (NodeId n = plan.first(rank); n < plan.first(rank) + plan.count(rank); ++n) {
-      put_node_report(w, report.per_node[n]);
-      put_router_counters(w, executed.routers[n]);
-    }
-    transport.post(0, Tag::report, w.take());
-    transport.flush();
+    report_to_rank_zero(transport, plan, rank, executed);
     return std::nullopt;
   }
   for (int q = 1; q < plan.ranks(); ++q)
-    merge_rank(transport.receive(Tag::report, q), plan, report, executed.routers);
+    merge_rank(transport.receive(Tag::report, q), plan, report, executed.routers, executed.recorder.get());
+  if (executed.recorder)
+    report.recording =
+        split_recording(transport, plan, topology, report, *executed.recorder, options.record_packets);
   std::vector<const RouterCounters*> routers;
   for (const auto& r : executed.routers) routers.push_back(&r);
   report.network = network_stats(topology, routers);

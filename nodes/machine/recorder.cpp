@@ -156,28 +156,59 @@ void add_node_traces(const Recorder& recorder, Recording& r, std::vector<std::ve
 }
 
 // What was recorded in full: the whole run, or up to the last packet,
-// wait or serve begun before the budget ran out.
+// wait or serve begun before the budget ran out. Over several ranks each
+// spent a budget of its own: up to the earliest of their last starts.
 double recorded_window(const Recording& r) {
   if (r.unrecorded_packets + r.unrecorded_fetches + r.unrecorded_serves == 0) return r.end;
-  double window = 0;
-  for (const PacketTrace& p : r.packets) window = std::max(window, p.injected());
-  for (const NodeTrace& t : r.nodes) {
-    for (const FetchEvent& e : t.fetches) window = std::max(window, e.start);
-    for (const ServeEvent& e : t.serves) window = std::max(window, e.start);
+  const auto rank_of = [&r](NodeId n) { return r.node_rank.empty() ? 0 : r.node_rank[n]; };
+  std::vector<double> last(r.node_rank.empty() ? 1 : *std::max_element(r.node_rank.begin(), r.node_rank.end()) + 1,
+                           0.0);
+  for (const PacketTrace& p : r.packets) {
+    double& at = last[static_cast<std::size_t>(rank_of(p.route.front()))];
+    at = std::max(at, p.injected());
   }
-  return window;
+  for (NodeId n = 0; n < r.nodes.size(); ++n) {
+    double& at = last[static_cast<std::size_t>(rank_of(n))];
+    for (const FetchEvent& e : r.nodes[n].fetches) at = std::max(at, e.start);
+    for (const ServeEvent& e : r.nodes[n].serves) at = std::max(at, e.start);
+  }
+  return *std::min_element(last.begin(), last.end());
+}
+
+// After the first hop between ranks, each time at least the one before.
+void raise_times_across_ranks(PacketTrace& p, const std::vector<int>& node_rank) {
+  for (std::size_t h = 0; h < p.hops(); ++h) {
+    if (p.route[h] >= node_rank.size() || p.route[h + 1] >= node_rank.size()) return;  // check() says why
+    if (node_rank[p.route[h]] == node_rank[p.route[h + 1]]) continue;
+    for (std::size_t i = 2 + 2 * h; i < p.times.size(); ++i) p.times[i] = std::max(p.times[i], p.times[i - 1]);
+    return;
+  }
 }
 
 }  // namespace
 
+void shift_times(NodeLog& log, double seconds) {
+  for (InjectEvent& e : log.injected) e.time += seconds;
+  for (HopEvent& e : log.departed) e.time += seconds;
+  for (HopEvent& e : log.arrived) e.time += seconds;
+  for (DeliverEvent& e : log.delivered) e.time += seconds;
+  for (FetchEvent& e : log.fetches) e.start += seconds, e.end += seconds;
+  for (ServeEvent& e : log.serves) e.start += seconds, e.end += seconds;
+  for (HitSample& e : log.hits) e.time += seconds;
+}
+
 Recording merge_recording(const Recorder& recorder, const topology::Topology& topology,
-                          std::vector<std::vector<TileSpan>> tiles) {
+                          std::vector<std::vector<TileSpan>> tiles, std::vector<int> node_rank) {
   const std::size_t nodes = recorder.nodes();
   if (topology.size() != nodes)
     throw std::invalid_argument("recording: " + std::to_string(nodes) + " node logs for a machine of " +
                                 std::to_string(topology.size()));
+  if (!node_rank.empty() && node_rank.size() != nodes)
+    throw std::invalid_argument("recording: the ranks of " + std::to_string(node_rank.size()) +
+                                " nodes for a machine of " + std::to_string(nodes));
   tiles.resize(nodes);
   Recording r;
+  r.node_rank = std::move(node_rank);
   r.virtual_time = recorder.virtual_time();
   r.max_packets = recorder.max_packets();
   std::unordered_map<std::uint64_t, std::size_t> index;
@@ -187,6 +218,7 @@ Recording merge_recording(const Recorder& recorder, const topology::Topology& to
   add_hops(recorder, topology, r, index);
   for (std::size_t i = 0; i < r.packets.size(); ++i) {
     if (r.packets[i].times.size() != 2 * r.packets[i].route.size()) broken(r.packets[i].id, "was never delivered");
+    if (!r.node_rank.empty()) raise_times_across_ranks(r.packets[i], r.node_rank);
     check(r.packets[i], topology, destination[i]);
     r.end = std::max(r.end, r.packets[i].delivered());
   }

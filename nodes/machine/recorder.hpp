@@ -19,6 +19,7 @@
 #include <chrono>
 #include <cstdint>
 #include <memory>
+#include <utility>
 #include <vector>
 
 #include "nodes/machine/pixel_computer.hpp"
@@ -70,6 +71,9 @@ class Recorder final : public RouteRecorder {
   const NodeLog& log(NodeId node) const { return *logs_.at(node); }
   RouteLog& route_log(NodeId node) override { return log(node); }
   std::size_t nodes() const { return logs_.size(); }
+  // Replaces a node's log with one another rank recorded, its times already
+  // moved onto this recorder's clock (shift_times).
+  void adopt(NodeId node, NodeLog log) { *logs_.at(node) = std::move(log); }
 
  private:
   std::vector<std::unique_ptr<NodeLog>> logs_;
@@ -101,6 +105,7 @@ struct NodeTrace {
 };
 
 struct Recording {
+  std::vector<int> node_rank;  // the rank that ran each node; empty when one process ran them all
   bool virtual_time = false;
   std::uint64_t max_packets = 0;
   std::vector<PacketTrace> packets;             // by injection time, then id
@@ -116,8 +121,16 @@ struct Recording {
   std::uint64_t recorded_hops() const;
 };
 
+// Moves every time in the log by `seconds`: another rank's clock onto rank 0's.
+void shift_times(NodeLog& log, double seconds);
+
 // The logs joined packet by packet, with each node's tiles (index = node).
+// With `node_rank` (a run over several ranks, each node's log on its rank's
+// clock moved onto rank 0's), a packet's times after a hop between ranks
+// are raised to at least the time before it, so that what is left of the
+// clocks' difference never shows a packet arriving before it left; the
+// window is then the earliest of the ranks' own windows.
 Recording merge_recording(const Recorder& recorder, const topology::Topology& topology,
-                          std::vector<std::vector<TileSpan>> tiles);
+                          std::vector<std::vector<TileSpan>> tiles, std::vector<int> node_rank = {});
 
 }  // namespace nodes

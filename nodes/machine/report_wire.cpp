@@ -2,6 +2,7 @@
 #include "nodes/machine/report_wire.hpp"
 
 #include "nodes/machine/node_report.hpp"
+#include "nodes/machine/recorder.hpp"
 
 namespace nodes {
 
@@ -12,6 +13,10 @@ tracer::DatabaseHeader get_header(WireReader& r) { return get_fields<tracer::Dat
 void put_node_report(WireWriter& w, const NodeReport& n) { put_fields(w, n); }
 
 NodeReport get_node_report(WireReader& r) { return get_fields<NodeReport>(r); }
+
+void put_node_log(WireWriter& w, const NodeLog& log) { put_fields(w, log); }
+
+NodeLog get_node_log(WireReader& r) { return get_fields<NodeLog>(r); }
 
 void put_router_counters(WireWriter& w, const RouterCounters& c) { put_fields(w, c); }
 

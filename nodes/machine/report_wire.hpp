@@ -1,6 +1,7 @@
 // The byte form of what ranks of a split machine send one another outside
 // the network: the database header (rank 0 to every rank, before the run)
-// and the reports of a rank's nodes and routers (to rank 0, after it).
+// and the reports of a rank's nodes and routers, with their recorded events
+// in a recorded run (to rank 0, after it).
 // Each format is the one field list below, in wire order, that both encode
 // and decode go by (wire_fields.hpp says how a field travels), so they are
 // inverses field by field; a decoder throws std::runtime_error
@@ -16,6 +17,7 @@
 
 namespace nodes {
 
+struct NodeLog;
 struct NodeReport;
 struct RankReport;
 struct RouteRecord;
@@ -82,6 +84,24 @@ void wire_fields(V& v, WireView<RouterCounters> auto& c) {
   v(c.routes);
 }
 
+// A node's recorded events (recorder.hpp), after its report when the run
+// is recorded; the events travel as their bytes, times on the sending
+// rank's clock.
+template <class V>
+void wire_fields(V& v, WireView<NodeLog> auto& log) {
+  v(log.injected);
+  v(log.departed);
+  v(log.arrived);
+  v(log.delivered);
+  v(log.unrecorded);
+  v(log.unrecorded_hops);
+  v(log.fetches);
+  v(log.serves);
+  v(log.hits);
+  v(log.unrecorded_fetches);
+  v(log.unrecorded_serves);
+}
+
 // Followed on the wire by the rank's host threads (put_rank_report).
 template <class V>
 void wire_fields(V& v, WireView<RankReport> auto& k) {
@@ -100,6 +120,9 @@ tracer::DatabaseHeader get_header(WireReader& r);
 
 void put_node_report(WireWriter& w, const NodeReport& report);
 NodeReport get_node_report(WireReader& r);
+
+void put_node_log(WireWriter& w, const NodeLog& log);
+NodeLog get_node_log(WireReader& r);
 
 void put_router_counters(WireWriter& w, const RouterCounters& counters);
 RouterCounters get_router_counters(WireReader& r);

@@ -3,10 +3,10 @@
 //   packet: the cut link it travels on, then the packet;
 //   credit: a CreditRecord;   end: nothing;   abort: an AbortRecord.
 // Each field list below is the whole format, read and written alike
-// (wire_fields.hpp); the other rank decodes what was encoded, but for two
-// things of a packet: its shared bytes arrive as payload (joined after it,
-// since the other process has no pointer to them), and `recorded` does not
-// travel (it reads false there).
+// (wire_fields.hpp); the other rank decodes what was encoded, but a
+// packet's shared bytes arrive as payload (joined after it, since the other
+// process has no pointer to them). `recorded` travels, so that the routers
+// of a recorded run log a packet's hops on every rank.
 #pragma once
 
 #include <cstdint>
@@ -49,6 +49,7 @@ void wire_fields(V& v, WireView<Packet> auto& p) {
   v(p.port);
   v(p.hops);
   v(p.traced);
+  v(p.recorded);
   v(p.id);
   v(wire_joined(p.payload, p.shared));
   v(p.route);

@@ -35,7 +35,7 @@ namespace nodes {
 using Bytes = std::vector<std::byte>;
 
 // The uses of the wire; each keeps its own order.
-enum class Tag : int { setup = 1, bridge = 2, report = 3 };
+enum class Tag : int { setup = 1, bridge = 2, report = 3, clock = 4 };
 
 struct Incoming {
   int from = 0;

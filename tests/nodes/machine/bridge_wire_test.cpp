@@ -75,8 +75,8 @@ TEST(BridgeWire, TracedSharedPageReplyRoundTrips) {
   const Packet p = traced_reply(page);
   const Bytes bytes = put_packet(p);
   const Bytes payload = nodes::encode_page_reply(0x00abcdef, page);  // the id, then the page
-  const Bytes head = raw(p.source, p.destination, p.kind, p.port, p.hops, std::uint8_t{1}, p.id);
-  EXPECT_EQ(head.size(), 4 + 4 + 1 + 2 + 2 + 1 + 8u);
+  const Bytes head = raw(p.source, p.destination, p.kind, p.port, p.hops, std::uint8_t{1}, std::uint8_t{1}, p.id);
+  EXPECT_EQ(head.size(), 4 + 4 + 1 + 2 + 2 + 1 + 1 + 8u);
   EXPECT_EQ(bytes.size(), head.size() + 8 + payload.size() + 8 + 3 * 4);
   const Bytes route = raw(std::uint64_t{3}, p.route[0], p.route[1], p.route[2]);
   EXPECT_EQ(bytes, joined(joined(joined(head, raw(std::uint64_t{payload.size()})), payload), route));
@@ -90,7 +90,7 @@ TEST(BridgeWire, TracedSharedPageReplyRoundTrips) {
   EXPECT_EQ(back.port, p.port);
   EXPECT_EQ(back.hops, p.hops);
   EXPECT_TRUE(back.traced);
-  EXPECT_FALSE(back.recorded);  // does not travel
+  EXPECT_TRUE(back.recorded);  // travels: the other rank's routers log its hops
   EXPECT_EQ(back.id, p.id);
   EXPECT_EQ(back.payload, payload);
   EXPECT_TRUE(back.shared.empty());
@@ -105,11 +105,13 @@ TEST(BridgeWire, UntracedPacketRoundTrips) {
   p.source = 1;
   p.id = 77;
   const Bytes bytes = put_packet(p);
-  EXPECT_EQ(bytes.size(), 22 + 8 + 2 + 8u);
+  EXPECT_EQ(bytes.size(), 23 + 8 + 2 + 8u);
   EXPECT_EQ(bytes[13], std::byte{0});  // traced, as one byte
+  EXPECT_EQ(bytes[14], std::byte{0});  // recorded, as one byte
   WireReader r(bytes);
   const Packet back = nodes::get_packet(r);
   EXPECT_FALSE(back.traced);
+  EXPECT_FALSE(back.recorded);
   EXPECT_EQ(back.payload, p.payload);
   EXPECT_TRUE(back.route.empty());
   // Any byte but 0 reads as traced.

@@ -18,6 +18,7 @@
 #include <vector>
 
 #include "nodes/machine/node_report.hpp"
+#include "nodes/machine/recorder.hpp"
 #include "wire_support.hpp"
 
 namespace {
@@ -280,6 +281,61 @@ TEST(ReportWire, RankReportRoundTripsWithItsThreads) {
 
 // As a rank sends them to rank 0 after the run: its report, then each
 // node's report and router counters; a cut anywhere is refused.
+// A node's recorded events, as a rank sends them to rank 0 after its
+// report in a recorded run: every list and count comes back, times and all.
+TEST(ReportWire, NodeLogRoundTripsAndMovesOntoAnotherClock) {
+  nodes::NodeLog log;
+  log.injected = {{0x1122334455667788, 0.25, 7, 1030, 4}};
+  log.departed = {{9, 0.5, 3, 1}, {10, 0.75, 1, 0}};
+  log.arrived = {{9, 0.625, 0, 2}};
+  log.delivered = {{11, 1.5, 3}};
+  log.unrecorded[4] = 12;
+  log.unrecorded_hops = 30;
+  log.fetches = {{0.125, 0.375, 77, 1}};
+  log.serves = {{0.25, 0.3125, 78, 5}};
+  log.hits = {{0.875, 400, 1}};
+  log.unrecorded_fetches = 3;
+  log.unrecorded_serves = 2;
+  const Bytes bytes = encoded([&](WireWriter& w) { nodes::put_node_log(w, log); });
+  WireReader r(bytes);
+  nodes::NodeLog back = nodes::get_node_log(r);
+  EXPECT_TRUE(r.done());
+  ASSERT_EQ(back.injected.size(), 1u);
+  EXPECT_EQ(back.injected[0].id, 0x1122334455667788u);
+  EXPECT_EQ(back.injected[0].destination, 7u);
+  EXPECT_EQ(back.injected[0].bytes, 1030u);
+  ASSERT_EQ(back.departed.size(), 2u);
+  EXPECT_EQ(back.departed[1].id, 10u);
+  EXPECT_EQ(back.departed[0].queue, 3u);
+  ASSERT_EQ(back.arrived.size(), 1u);
+  EXPECT_EQ(back.arrived[0].hop, 2u);
+  ASSERT_EQ(back.delivered.size(), 1u);
+  EXPECT_EQ(back.delivered[0].hops, 3u);
+  EXPECT_EQ(back.unrecorded, log.unrecorded);
+  EXPECT_EQ(back.unrecorded_hops, 30u);
+  ASSERT_EQ(back.fetches.size(), 1u);
+  EXPECT_EQ(back.fetches[0].page, 77u);
+  ASSERT_EQ(back.serves.size(), 1u);
+  EXPECT_EQ(back.serves[0].to, 5u);
+  ASSERT_EQ(back.hits.size(), 1u);
+  EXPECT_EQ(back.hits[0].hits, 400u);
+  EXPECT_EQ(back.unrecorded_fetches, 3u);
+  EXPECT_EQ(back.unrecorded_serves, 2u);
+  nodes::shift_times(back, 2.0);
+  EXPECT_EQ(back.injected[0].time, 2.25);
+  EXPECT_EQ(back.departed[1].time, 2.75);
+  EXPECT_EQ(back.arrived[0].time, 2.625);
+  EXPECT_EQ(back.delivered[0].time, 3.5);
+  EXPECT_EQ(back.fetches[0].start, 2.125);
+  EXPECT_EQ(back.fetches[0].end, 2.375);
+  EXPECT_EQ(back.serves[0].end, 2.3125);
+  EXPECT_EQ(back.hits[0].time, 2.875);
+  expect_prefixes_refused(bytes, [](std::span<const std::byte> b) {
+    WireReader cut(b);
+    nodes::get_node_log(cut);
+  });
+}
+
 TEST(ReportWire, AReportMessageCutShortIsRefused) {
   const nodes::RankReport k = rank_report();
   const nodes::NodeReport n = node_report();

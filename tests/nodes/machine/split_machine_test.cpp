@@ -239,6 +239,61 @@ TEST(SplitMachine, TracedRoutesThatCrossRanksHaveHopsEqualToDistance) {
   EXPECT_GT(crossing, 0u);
 }
 
+// A replay recorded over 2 and 3 ranks: rank 0 gathers every rank's logs
+// onto its clock, and under the static schedule (which fixes who computes
+// what) the recording ends with the one-process run's counters: packets
+// and hops by kind, waits and serves by node, tiles; each node's rank is
+// named, and packets that crossed between ranks are among those recorded.
+TEST(SplitMachine, AReplayRecordedOverRanksCountsWhatOneProcessCounts) {
+  for (const int ranks : {2, 3}) {
+    SCOPED_TRACE(std::to_string(ranks) + " ranks");
+    auto db = make_db("teapot:2", 1024, 16);
+    MachineOptions options = options_for({"hypercube:3", ranks, Schedule::static_split}, db);
+    options.record = true;
+    options.record_packets = 1u << 20;
+    const auto whole = nodes::run_machine(make_db("teapot:2", 1024, 16), options);
+    const auto run = run_split(std::move(db), options, ranks);
+    for (int r = 0; r < ranks; ++r)
+      ASSERT_FALSE(run.errors[static_cast<std::size_t>(r)]) << what(run.errors[static_cast<std::size_t>(r)]);
+    ASSERT_TRUE(run.result);
+    ASSERT_TRUE(run.result->report.recording);
+    const nodes::Recording& split = *run.result->report.recording;
+    const nodes::Recording& one = *whole.report.recording;
+    EXPECT_EQ(split.unrecorded_packets, 0u);
+    EXPECT_EQ(split.packets.size(), one.packets.size());
+    EXPECT_EQ(split.packets.size(), run.result->report.network.hops.packets);
+    EXPECT_EQ(split.recorded_hops(), one.recorded_hops());
+    EXPECT_EQ(split.max_packets, options.record_packets);
+    const auto by_kind = [](const nodes::Recording& r) {
+      std::vector<std::uint64_t> k(256, 0);
+      for (const auto& p : r.packets) ++k[p.kind];
+      return k;
+    };
+    EXPECT_EQ(by_kind(split), by_kind(one));
+    const auto topology = topology::parse_topology("hypercube:3", std::nullopt);
+    const nodes::RankPlan plan(topology, ranks);
+    ASSERT_EQ(split.node_rank.size(), topology.size());
+    ASSERT_EQ(split.nodes.size(), one.nodes.size());
+    for (std::size_t n = 0; n < split.nodes.size(); ++n) {
+      EXPECT_EQ(split.node_rank[n], plan.rank_of(static_cast<nodes::NodeId>(n))) << "node " << n;
+      EXPECT_EQ(split.nodes[n].fetches.size(), one.nodes[n].fetches.size()) << "node " << n;
+      EXPECT_EQ(split.nodes[n].serves.size(), one.nodes[n].serves.size()) << "node " << n;
+      EXPECT_EQ(split.nodes[n].tiles.size(), one.nodes[n].tiles.size()) << "node " << n;
+    }
+    std::size_t crossing = 0;
+    for (const auto& p : split.packets) {
+      for (std::size_t h = 0; h < p.hops(); ++h)
+        if (plan.rank_of(p.route[h]) != plan.rank_of(p.route[h + 1])) {
+          ++crossing;
+          break;
+        }
+      for (std::size_t i = 1; i < p.times.size(); ++i) EXPECT_LE(p.times[i - 1], p.times[i]) << "packet " << p.id;
+    }
+    EXPECT_GT(crossing, 0u);
+    EXPECT_EQ(split.window, split.end);
+  }
+}
+
 TEST(SplitMachine, RefusesMoreRanksThanNodesAndVirtualTimeOnEveryRank) {
   auto db = make_db("teapot:2", 1024, 8);
   MachineOptions options = options_for({"hypercube:1", 3}, db);
