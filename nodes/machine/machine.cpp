@@ -32,6 +32,7 @@ namespace {
 struct NodeState {
   std::unique_ptr<NodeSvm> svm;
   ServerCounters served;
+  std::unique_ptr<PageServer> server;
   std::vector<std::unique_ptr<Outbox>> worker_out;
   std::vector<std::unique_ptr<WorkerPort>> worker_in;
   std::vector<WorkerCounters> work;
@@ -166,11 +167,10 @@ void spawn_node(const Wiring& w, NodeId n, NodeState& node) {
       drained_port(w, n, Ports::page_server, page_requests_bound(w.net.topology().size(), k), name + " page",
                    node.mailbox);
   std::function<void()> serve_hook = w.timing ? w.timing->serve_hook(static_cast<int>(n)) : nullptr;
-  w.runtime.spawn(
-      name + " page server", thread,
-      [n, &node, requests, out = w.outbox(n, Ports::page_server), serve_hook, recorder = w.recorder] {
-        PageServer(n, node.svm->memory(), requests, out, node.served, serve_hook, recorder).run();
-      });
+  node.server = std::make_unique<PageServer>(n, node.svm->memory(), requests, w.outbox(n, Ports::page_server),
+                                             node.served, serve_hook, w.recorder);
+  w.net.receive_in_place(n, Ports::page_server, *node.server);
+  w.runtime.spawn(name + " page server", thread, [server = node.server.get()] { server->run(); });
   node.work.resize(static_cast<std::size_t>(k));
   for (int i = 0; i < k; ++i) {
     const auto port = static_cast<std::uint16_t>(Ports::first_worker + i);
@@ -827,6 +827,7 @@ ServerCounters MachineReport::served() const {
   for (const auto& n : per_node) {
     total.pages_served += n.served.pages_served;
     total.bytes_served += n.served.bytes_served;
+    total.served_in_place += n.served.served_in_place;
   }
   return total;
 }

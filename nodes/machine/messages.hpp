@@ -146,6 +146,7 @@ class Outbox {
     next_id_ += step_;
     out_.write(std::move(packet));
   }
+  bool room_hint() const { return out_.room_hint(); }  // Injector::room_hint
 
  private:
   Injector out_;

@@ -34,7 +34,18 @@ void PageServer::run() {
   }
 }
 
+bool PageServer::takes_at_once(const Packet& packet) const {
+  return !serving_ && packet.kind == static_cast<std::uint8_t>(MessageKind::page_request) &&
+         !requests_.ready_hint() && out_.room_hint();
+}
+
+void PageServer::take(Packet& packet) {
+  serve(packet);
+  ++counters_.served_in_place;
+}
+
 void PageServer::serve(const Packet& request) {
+  serving_ = true;
   const bool record = recorder_ && recorder_->open();
   if (recorder_ && !record) ++recorder_->log(node_).unrecorded_serves;
   const double start = record ? recorder_->now() : 0.0;
@@ -49,6 +60,7 @@ void PageServer::serve(const Packet& request) {
   ++counters_.pages_served;
   counters_.bytes_served += bytes.size();
   if (record) recorder_->log(node_).serves.push_back({start, recorder_->now(), r.page, request.source});
+  serving_ = false;
 }
 
 }  // namespace nodes

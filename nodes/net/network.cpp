@@ -156,6 +156,14 @@ csp::In<Packet> Network::port(NodeId node, unsigned port) const {
   return ports_.at(node).at(port).reader();
 }
 
+bool Network::receive_in_place(NodeId node, unsigned port, PortReceiver& receiver) {
+  if (!in_place()) return false;
+  if (port >= options_.ports_per_node || !routers_.at(node))
+    throw std::out_of_range("network: node " + std::to_string(node) + " has no local port " + std::to_string(port));
+  routers_[node]->receive_in_place(port, receiver);
+  return true;
+}
+
 void Network::shutdown() {
   shut_down_.store(true, std::memory_order_release);
   if (relays_) relays_->poison();

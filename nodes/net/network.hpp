@@ -96,6 +96,11 @@ class Network {
   csp::Out<Packet> injector(NodeId node, unsigned port = 0) const;
   Injector in_place_injector(NodeId node, unsigned port = 0) const;
   csp::In<Packet> port(NodeId node, unsigned port = 0) const;
+  // Before the run, when routers route in place (forward_in_place, no link
+  // model): `receiver`, a process on the node's thread that reads `port`,
+  // takes deliveries there in place when it can (Router::receive_in_place).
+  // False, nothing registered, otherwise.
+  bool receive_in_place(NodeId node, unsigned port, PortReceiver& receiver);
   unsigned thread_of(NodeId node) const;
 
   bool is_local(NodeId node) const { return !options_.local || options_.local(node); }

@@ -31,7 +31,8 @@ Router::Router(topology::Topology topology, NodeId self, RouterEnds ends, Router
       link_queues_(ends_.inputs.size()),
       pending_(ends_.inputs.size() + ends_.injections.size()),
       held_for_(ends_.outputs.size(), 0),
-      in_place_(ends_.outputs.size()) {
+      in_place_(ends_.outputs.size()),
+      receivers_(ends_.outputs.size() - link_queues_, nullptr) {
   counters_.sent.assign(ends_.outputs.size(), LinkCounters{});
 }
 
@@ -67,6 +68,12 @@ void Router::forward_in_place(std::size_t queue, Router& next, std::size_t input
     throw std::logic_error("router " + std::to_string(self_) + ": no link queue " + std::to_string(queue) +
                            " into input " + std::to_string(input) + " of router " + std::to_string(next.self_));
   in_place_[queue] = InPlace{&next, input};
+}
+
+void Router::receive_in_place(std::size_t port, PortReceiver& receiver) {
+  if (port >= receivers_.size())
+    throw std::logic_error("router " + std::to_string(self_) + ": no local port " + std::to_string(port));
+  receivers_[port] = &receiver;
 }
 
 bool Router::inject_in_place(Packet& packet) {
@@ -184,7 +191,8 @@ bool Router::try_send(std::size_t queue, Packet& packet) {
   }
 }
 
-// The channel write of try_send, and its counts.
+// The channel write of try_send, and its counts; or a delivery taken in
+// place by the port's receiver, counted first, as it happens after.
 bool Router::write_out(std::size_t queue, Packet& packet) {
   const std::size_t bytes = packet.bytes();
   const std::uint16_t hops = packet.hops;
@@ -195,6 +203,12 @@ bool Router::write_out(std::size_t queue, Packet& packet) {
   const double left_at = log_ && recorded ? config_.recorder->now() : 0.0;
   std::optional<RouteRecord> route;
   if (queue >= link_queues_ && packet.traced) route = RouteRecord{packet.id, packet.kind, packet.route};
+  PortReceiver* receiver = queue >= link_queues_ ? receivers_[queue - link_queues_] : nullptr;
+  if (receiver && receiver->takes_at_once(packet)) {
+    count_sent(queue, bytes, hops, kind, recorded, id, left_at, route);
+    receiver->take(packet);
+    return true;
+  }
   if (!ends_.outputs[queue].try_write(packet)) return false;
   count_sent(queue, bytes, hops, kind, recorded, id, left_at, route);
   return true;

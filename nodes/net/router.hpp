@@ -1,18 +1,17 @@
 // The router of one processor: store-and-forward switching by the topology's
 // deadlock-free routing function (docs/architecture.md, "Why the network
-// cannot deadlock", gives the argument, and "Router steps in place").
+// cannot deadlock", and "Steps taken in place").
 // Ends: inputs[p * classes + c] (link port p, buffer class c), injections
 // from the node's processes, outputs (bounded, capacity K): the link queues
 // numbered as the inputs, then one delivery queue per local port.
-// Protocol: one doorbell ALT (csp/alt.hpp) over the inputs and, for each
-// output a held-back packet waits for, a room guard. A packet goes out with
-// try_write at once, or waits in its input's pending slot (that input off,
-// the output's room guard on); held-back packets are admitted in rotation.
-// So each (link, class) owns at most K queued + 1 pending packets. A writer
-// on the router's thread takes the router's step in place when the router
-// would send the packet straight on. Consumption assumption: a delivery
-// queue drains while its reader reads (a process that receives and sends
-// reads its port in a fiber of its own).
+// Protocol: one doorbell ALT over the inputs and a room guard per output a
+// held-back packet waits for. A packet goes out with try_write at once, or
+// waits in its input's pending slot; held-back packets are admitted in
+// rotation, so each (link, class) owns at most K queued + 1 pending packets.
+// A writer on the router's thread takes the router's step in place when the
+// router would send the packet straight on; a port's registered receiver
+// takes a delivery in place when its queue is empty. Consumption assumption:
+// a delivery queue drains while its reader reads.
 #pragma once
 
 #include <array>
@@ -77,6 +76,22 @@ struct RouterConfig {
   RouteRecorder* recorder = nullptr;
 };
 
+// A local process that can take a packet delivered to its port in place of
+// reading it, called on the router's thread by whoever takes the router's
+// last step (Router::receive_in_place). take() must not suspend: whoever
+// calls it may be a router's step or another process's send.
+class PortReceiver {
+ public:
+  virtual ~PortReceiver() = default;
+  // Whether take() would handle this packet now, at once: the port's queue
+  // is empty and nothing it would do waits. A packet taken so overtakes
+  // none queued, but may overtake one already handed to the port's parked
+  // reader and not yet handled: a receiver takes only packets whose order
+  // against those does not matter.
+  virtual bool takes_at_once(const Packet& packet) const = 0;
+  virtual void take(Packet& packet) = 0;
+};
+
 class Router {
  public:
   Router(topology::Topology topology, NodeId self, RouterEnds ends, RouterConfig config,
@@ -95,6 +110,9 @@ class Router {
   // The same for a packet arriving on link input `input`, from a process
   // of this router's thread that is that input's only writer (a relay).
   bool take_in_place(std::size_t input, Packet& packet);
+  // Before run(): deliveries to local `port` go to `receiver` whenever it
+  // takes them at once, counted as deliveries; otherwise into the port.
+  void receive_in_place(std::size_t port, PortReceiver& receiver);
 
  private:
   struct Pending {
@@ -133,6 +151,7 @@ class Router {
   std::vector<std::optional<Pending>> pending_;  // per input, then per injection
   std::vector<std::uint32_t> held_for_;          // per output: pending packets waiting for it
   std::vector<InPlace> in_place_;                // per output
+  std::vector<PortReceiver*> receivers_;         // per local port; null: the port's reader reads
   std::uint32_t pending_count_ = 0;
   std::size_t next_admit_ = 0;  // rotates which pending packet is admitted first
   csp::Alt alt_{csp::Alt::Waiting::doorbell};
@@ -152,6 +171,10 @@ class Injector {
     if (router_ && router_->inject_in_place(packet)) return;
     out_.write(std::move(packet));
   }
+  // Whether a write would not wait, as the injection channel last
+  // published it: exact on the node's thread, where all its writers and
+  // its router run.
+  bool room_hint() const { return out_.room_hint(); }
 
  private:
   csp::Out<Packet> out_;

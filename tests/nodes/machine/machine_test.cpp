@@ -184,9 +184,10 @@ TEST(Machine, RelaysCarryEveryPacketBetweenThreadsOnce) {
   EXPECT_TRUE(same_bits(relayed.image.pixels(), cached_reference(c.scene, c.size)));
 }
 
-// Router steps taken in place by the senders on the router's thread (the
-// default) or only by the routers: the same image, and each packet's hops
-// within the topology's diameter; in place only where a sender shares the thread.
+// Router steps and page serves taken in place by the senders on the
+// router's thread (the default) or only by the routers and page servers:
+// the same image, and each packet's hops within the topology's diameter; in
+// place only where a sender shares the thread.
 TEST(Machine, RoutingInPlaceComputesWhatTheRoutersAloneCompute) {
   for (const unsigned threads : {1u, 2u})
     for (const char* topology : {"hypercube", "ring", "torus"}) {
@@ -203,6 +204,11 @@ TEST(Machine, RoutingInPlaceComputesWhatTheRoutersAloneCompute) {
       for (const auto& r : alone.report.network.routers) taken_alone += r.in_place;
       EXPECT_EQ(taken_alone, 0u);
       EXPECT_GT(taken, 0u);
+      // Page requests served by their deliverer, and every one answered once.
+      EXPECT_EQ(alone.report.served().served_in_place, 0u);
+      EXPECT_GT(in_place.report.served().served_in_place, 0u);
+      EXPECT_LE(in_place.report.served().served_in_place, in_place.report.served().pages_served);
+      EXPECT_EQ(in_place.report.served().pages_served, in_place.report.svm().misses);
       const auto t = topology::parse_topology(in_place.report.topology);
       EXPECT_LE(in_place.report.network.hops.max_hops, t.diameter());
       EXPECT_GT(in_place.report.network.hops.packets, 0u);

@@ -5,7 +5,10 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <atomic>
+#include <functional>
+#include <memory>
 #include <random>
 
 #include "csp/csp.hpp"
@@ -169,6 +172,96 @@ TEST(Network, RoutingInPlaceTakesTheSameLinksAsTheRoutersThemselves) {
           EXPECT_GT(taken, 0u);
         }
   }
+}
+
+// Takes the packets of even id delivered to its node's port 0 in place,
+// when the port holds nothing they would overtake.
+class EvenTaker final : public PortReceiver {
+ public:
+  EvenTaker(csp::In<Packet> port, Received& received, std::function<void()> on_packet)
+      : port_(std::move(port)), received_(received), on_packet_(std::move(on_packet)) {}
+  bool takes_at_once(const Packet& p) const override { return p.id % 2 == 0 && !port_.ready_hint(); }
+  void take(Packet& p) override {
+    received_.ids.push_back(p.id);
+    received_.sources.push_back(p.source);
+    ++taken;
+    on_packet_();
+  }
+  std::uint64_t taken = 0;
+
+ private:
+  csp::In<Packet> port_;
+  Received& received_;
+  std::function<void()> on_packet_;
+};
+
+// A port's receiver takes deliveries in place only where routers route in
+// place, and then every packet still arrives once, as the routers'
+// delivery count says. (A packet taken in place may overtake one already
+// handed to the parked reader, so the order per sender is not asserted.)
+TEST(Network, APortReceiverTakesDeliveriesInPlaceAndLosesNone) {
+  for (const char* spec : {"hypercube:3", "torus:3x3"})
+    for (const bool in_place : {false, true}) {
+      SCOPED_TRACE(std::string(spec) + (in_place ? " in place" : " by the routers"));
+      const auto t = topology::parse_topology(spec);
+      const Plan plan = random_plan(t.size(), 100, 7);
+      csp::Runtime runtime(1);
+      NetworkOptions options;
+      options.buffer_capacity = 2;
+      options.forward_in_place = in_place;
+      Network net(runtime, t, options);
+      std::vector<std::size_t> expected(t.size(), 0);
+      for (const auto& dsts : plan)
+        for (NodeId d : dsts) ++expected[d];
+      std::vector<Received> received(t.size());
+      std::size_t unfinished = t.size();
+      auto done_with = [&](NodeId n) {
+        if (received[n].ids.size() == expected[n] && --unfinished == 0) net.shutdown();
+      };
+      std::vector<std::unique_ptr<EvenTaker>> takers;
+      std::uint64_t next_id = 0;
+      for (NodeId n = 0; n < t.size(); ++n) {
+        takers.push_back(std::make_unique<EvenTaker>(net.port(n), received[n], [&done_with, n] { done_with(n); }));
+        EXPECT_EQ(net.receive_in_place(n, 0, *takers.back()), in_place);
+        std::vector<Packet> packets;
+        for (NodeId d : plan[n]) {
+          Packet p;
+          p.destination = d;
+          p.kind = kind_traffic;
+          p.id = next_id++;
+          packets.push_back(std::move(p));
+        }
+        runtime.spawn("send " + std::to_string(n), 0, [out = net.in_place_injector(n), packets]() mutable {
+          for (auto& p : packets) out.write(std::move(p));
+        });
+        runtime.spawn("receive " + std::to_string(n), 0, [&, n, in = net.port(n)]() mutable {
+          try {
+            while (received[n].ids.size() < expected[n]) {
+              Packet p = in.read();
+              received[n].ids.push_back(p.id);
+              received[n].sources.push_back(p.source);
+              done_with(n);
+            }
+          } catch (const csp::Poisoned&) {  // the last packets were taken in place
+          }
+        });
+      }
+      runtime.run();
+      std::vector<int> seen(next_id, 0);
+      for (NodeId n = 0; n < t.size(); ++n) {
+        EXPECT_EQ(received[n].ids.size(), expected[n]) << n;
+        for (std::uint64_t id : received[n].ids) ++seen.at(id);
+      }
+      EXPECT_EQ(std::count(seen.begin(), seen.end(), 1), static_cast<long>(next_id));
+      std::uint64_t taken = 0, delivered = 0;
+      for (const auto& taker : takers) taken += taker->taken;
+      for (const auto& r : net.stats().routers) delivered += r.delivered;
+      EXPECT_EQ(delivered, next_id);
+      if (in_place)
+        EXPECT_GT(taken, 0u);
+      else
+        EXPECT_EQ(taken, 0u);
+    }
 }
 
 TEST(Network, AllToAllMeanHopsEqualsAnalyticAverageDistance) {
