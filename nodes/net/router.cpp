@@ -22,17 +22,17 @@ void HopSummary::merge(const HopSummary& other) {
 }
 
 Router::Router(topology::Topology topology, NodeId self, RouterEnds ends, RouterConfig config, RouterCounters& counters)
-    : topology_(std::move(topology)),
-      self_(self),
+    : self_(self),
+      classes_(topology.buffer_classes()),
+      link_queues_(ends.inputs.size()),
+      topology_(std::move(topology)),
+      held_(ends.inputs.size() + ends.injections.size(), 0),
+      lanes_(ends.outputs.size()),
       ends_(std::move(ends)),
+      pending_(held_.size()),
       config_(config),
       counters_(counters),
-      log_(config.recorder ? &config.recorder->route_log(self) : nullptr),
-      link_queues_(ends_.inputs.size()),
-      pending_(ends_.inputs.size() + ends_.injections.size()),
-      held_for_(ends_.outputs.size(), 0),
-      in_place_(ends_.outputs.size()),
-      receivers_(ends_.outputs.size() - link_queues_, nullptr) {
+      log_(config.recorder ? &config.recorder->route_log(self) : nullptr) {
   counters_.sent.assign(ends_.outputs.size(), LinkCounters{});
 }
 
@@ -67,13 +67,14 @@ void Router::forward_in_place(std::size_t queue, Router& next, std::size_t input
   if (queue >= link_queues_ || input >= next.ends_.inputs.size())
     throw std::logic_error("router " + std::to_string(self_) + ": no link queue " + std::to_string(queue) +
                            " into input " + std::to_string(input) + " of router " + std::to_string(next.self_));
-  in_place_[queue] = InPlace{&next, input};
+  lanes_[queue].next = &next;
+  lanes_[queue].next_input = static_cast<std::uint32_t>(input);
 }
 
 void Router::receive_in_place(std::size_t port, PortReceiver& receiver) {
-  if (port >= receivers_.size())
+  if (port >= lanes_.size() - link_queues_)
     throw std::logic_error("router " + std::to_string(self_) + ": no local port " + std::to_string(port));
-  receivers_[port] = &receiver;
+  lanes_[link_queues_ + port].receiver = &receiver;
 }
 
 bool Router::inject_in_place(Packet& packet) {
@@ -104,7 +105,7 @@ void Router::receive(std::size_t source, Packet& packet) {
     arrive(packet);
   const std::size_t queue = output_queue(packet);
   // Packets already held back for this output go first.
-  if (held_for_[queue] > 0 || !try_send(queue, packet)) hold(source, packet, queue);
+  if (lanes_[queue].held_for > 0 || !try_send(queue, packet)) hold(source, packet, queue);
 }
 
 // A packet read from a link input: one more hop.
@@ -148,7 +149,7 @@ bool Router::take_route_to_trace(std::uint8_t kind) const {
 std::size_t Router::output_queue(const Packet& packet) const {
   if (packet.destination == self_) return link_queues_ + packet.port;
   const topology::Hop hop = topology_.next_hop(self_, packet.destination);
-  return hop.port * topology_.buffer_classes() + hop.buffer_class;
+  return hop.port * classes_ + hop.buffer_class;
 }
 
 // Whether this router's own step would send the packet, arriving now by
@@ -157,13 +158,13 @@ std::size_t Router::output_queue(const Packet& packet) const {
 // stays until this router writes (it is the output's only writer). Both
 // ends of `source` run on the caller's thread, so its hint is exact.
 bool Router::takes_at_once(std::size_t source, const Packet& packet, std::size_t& queue) const {
-  if (pending_[source]) return false;
+  if (held_[source]) return false;
   const csp::In<Packet>& in =
       source < ends_.inputs.size() ? ends_.inputs[source] : ends_.injections[source - ends_.inputs.size()];
   if (in.ready_hint()) return false;  // values ahead of it, or poison
   queue = output_queue(packet);
   const csp::Out<Packet>& out = ends_.outputs[queue];
-  return held_for_[queue] == 0 && out.room_hint() && !out.poisoned();
+  return lanes_[queue].held_for == 0 && out.room_hint() && !out.poisoned();
 }
 
 // Writes the packet into its output queue if that has room; false (packet
@@ -174,9 +175,10 @@ bool Router::takes_at_once(std::size_t source, const Packet& packet, std::size_t
 bool Router::try_send(std::size_t queue, Packet& packet) {
   Router* at = this;
   for (;;) {
-    const InPlace next = at->in_place_[queue];
+    const OutLane& lane = at->lanes_[queue];
+    Router* next = lane.next;
     std::size_t next_queue = 0;
-    if (!next.router || !next.router->takes_at_once(next.input, packet, next_queue)) {
+    if (!next || !next->takes_at_once(lane.next_input, packet, next_queue)) {
       if (at->write_out(queue, packet)) return true;
       if (at == this) return false;
       throw std::logic_error("router " + std::to_string(at->self_) + ": an output with room refused a packet");
@@ -184,9 +186,9 @@ bool Router::try_send(std::size_t queue, Packet& packet) {
     const double left_at = at->log_ && packet.recorded ? at->config_.recorder->now() : 0.0;
     std::optional<RouteRecord> no_route;
     at->count_sent(queue, packet.bytes(), packet.hops, packet.kind, packet.recorded, packet.id, left_at, no_route);
-    next.router->arrive(packet);
-    ++next.router->counters_.in_place;
-    at = next.router;
+    next->arrive(packet);
+    ++next->counters_.in_place;
+    at = next;
     queue = next_queue;
   }
 }
@@ -203,7 +205,7 @@ bool Router::write_out(std::size_t queue, Packet& packet) {
   const double left_at = log_ && recorded ? config_.recorder->now() : 0.0;
   std::optional<RouteRecord> route;
   if (queue >= link_queues_ && packet.traced) route = RouteRecord{packet.id, packet.kind, packet.route};
-  PortReceiver* receiver = queue >= link_queues_ ? receivers_[queue - link_queues_] : nullptr;
+  PortReceiver* receiver = lanes_[queue].receiver;  // null for link queues
   if (receiver && receiver->takes_at_once(packet)) {
     count_sent(queue, bytes, hops, kind, recorded, id, left_at, route);
     receiver->take(packet);
@@ -248,22 +250,24 @@ void Router::record_sent(bool recorded, std::uint64_t id, std::uint16_t hops, st
 
 void Router::hold(std::size_t source, Packet& packet, std::size_t queue) {
   pending_[source] = Pending{std::move(packet), queue};
+  held_[source] = 1;
   alt_.enable(source_guard_[source], false);
-  if (held_for_[queue]++ == 0) alt_.enable(room_guard_[queue], true);
+  if (lanes_[queue].held_for++ == 0) alt_.enable(room_guard_[queue], true);
   counters_.peak_pending = std::max(counters_.peak_pending, ++pending_count_);
 }
 
 // `queue` has room: write the packets held back for it while it has, taking
 // the pending slots in rotation so that no input starves.
 void Router::admit_pending(std::size_t queue) {
-  for (std::size_t k = 0; k < pending_.size() && held_for_[queue] > 0; ++k) {
+  for (std::size_t k = 0; k < pending_.size() && lanes_[queue].held_for > 0; ++k) {
     const std::size_t s = (next_admit_ + k) % pending_.size();
-    if (!pending_[s] || pending_[s]->queue != queue) continue;
-    if (!try_send(queue, pending_[s]->packet)) return;
-    pending_[s].reset();
+    if (!held_[s] || pending_[s].queue != queue) continue;
+    if (!try_send(queue, pending_[s].packet)) return;
+    held_[s] = 0;
+    pending_[s].packet = Packet{};  // what try_send left of it
     alt_.enable(source_guard_[s], true);
     --pending_count_;
-    if (--held_for_[queue] == 0) alt_.enable(room_guard_[queue], false);
+    if (--lanes_[queue].held_for == 0) alt_.enable(room_guard_[queue], false);
     next_admit_ = s + 1;
   }
 }

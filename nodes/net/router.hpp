@@ -117,11 +117,14 @@ class Router {
  private:
   struct Pending {
     Packet packet;
-    std::size_t queue;
+    std::size_t queue = 0;
   };
-  struct InPlace {
-    Router* router = nullptr;  // null: the queue is only a channel
-    std::size_t input = 0;
+  // What a step in place reads of one output, in one place.
+  struct OutLane {
+    std::uint32_t held_for = 0;        // pending packets waiting for this output
+    std::uint32_t next_input = 0;
+    Router* next = nullptr;            // set: the queue is next's input next_input, on this thread
+    PortReceiver* receiver = nullptr;  // a delivery queue's receiver in place; null: its reader reads
   };
 
   void build_alt();
@@ -141,17 +144,18 @@ class Router {
   void admit_pending(std::size_t queue);
   std::size_t output_queue(const Packet& packet) const;
 
-  topology::Topology topology_;
+  // The fields a step in place reads come first, together.
   NodeId self_;
+  unsigned classes_;         // the topology's buffer classes
+  std::size_t link_queues_;  // degree * classes; delivery queues follow
+  topology::Topology topology_;
+  std::vector<std::uint8_t> held_;  // per input, then per injection: a packet waits in pending_
+  std::vector<OutLane> lanes_;      // per output
   RouterEnds ends_;
+  std::vector<Pending> pending_;    // per input, then per injection; meaningful where held_
   RouterConfig config_;
   RouterCounters& counters_;
   RouteLog* log_ = nullptr;   // this node's log when the run is recorded
-  std::size_t link_queues_;  // degree * classes; delivery queues follow
-  std::vector<std::optional<Pending>> pending_;  // per input, then per injection
-  std::vector<std::uint32_t> held_for_;          // per output: pending packets waiting for it
-  std::vector<InPlace> in_place_;                // per output
-  std::vector<PortReceiver*> receivers_;         // per local port; null: the port's reader reads
   std::uint32_t pending_count_ = 0;
   std::size_t next_admit_ = 0;  // rotates which pending packet is admitted first
   csp::Alt alt_{csp::Alt::Waiting::doorbell};
