@@ -38,6 +38,21 @@ Plan all_to_all_plan(std::size_t nodes) {
   return plan;
 }
 
+// Node n's packets of the plan, numbered on from next_id, each carrying
+// `payload` bytes of n.
+std::vector<Packet> node_packets(const Plan& plan, NodeId n, std::uint64_t& next_id, std::size_t payload) {
+  std::vector<Packet> packets;
+  for (NodeId d : plan[n]) {
+    Packet p;
+    p.destination = d;
+    p.kind = kind_traffic;
+    p.id = next_id++;
+    p.payload.assign(payload, std::byte{static_cast<unsigned char>(n)});
+    packets.push_back(std::move(p));
+  }
+  return packets;
+}
+
 struct Received {
   std::vector<std::uint64_t> ids;
   std::vector<NodeId> sources;  // of each id
@@ -60,15 +75,7 @@ std::vector<Received> run_plan(const topology::Topology& t, const Plan& plan,
   std::atomic<std::size_t> unfinished{t.size()};
   std::uint64_t next_id = 0;
   for (NodeId n = 0; n < t.size(); ++n) {
-    std::vector<Packet> packets;
-    for (NodeId d : plan[n]) {
-      Packet p;
-      p.destination = d;
-      p.kind = kind_traffic;
-      p.id = next_id++;
-      p.payload.assign(payload, std::byte{static_cast<unsigned char>(n)});
-      packets.push_back(std::move(p));
-    }
+    std::vector<Packet> packets = node_packets(plan, n, next_id, payload);
     runtime.spawn("send " + std::to_string(n), net.thread_of(n),
                   [out = net.in_place_injector(n), packets = std::move(packets)]() mutable {
                     for (auto& p : packets) out.write(std::move(p));
@@ -223,14 +230,7 @@ TEST(Network, APortReceiverTakesDeliveriesInPlaceAndLosesNone) {
       for (NodeId n = 0; n < t.size(); ++n) {
         takers.push_back(std::make_unique<EvenTaker>(net.port(n), received[n], [&done_with, n] { done_with(n); }));
         EXPECT_EQ(net.receive_in_place(n, 0, *takers.back()), in_place);
-        std::vector<Packet> packets;
-        for (NodeId d : plan[n]) {
-          Packet p;
-          p.destination = d;
-          p.kind = kind_traffic;
-          p.id = next_id++;
-          packets.push_back(std::move(p));
-        }
+        std::vector<Packet> packets = node_packets(plan, n, next_id, 0);
         runtime.spawn("send " + std::to_string(n), 0, [out = net.in_place_injector(n), packets]() mutable {
           for (auto& p : packets) out.write(std::move(p));
         });
