@@ -741,7 +741,7 @@ std::shared_ptr<const Recording> split_recording(Transport& transport, const Ran
                                                  Recorder& recorder, std::uint64_t packets) {
   std::vector<int> node_rank(topology.size(), 0);
   for (int q = 1; q < plan.ranks(); ++q) {
-    const double offset = clock_offset(transport, q, recorder);
+    const double offset = clock_offset(transport, q, recorder).offset;
     for (NodeId n = plan.first(q); n < plan.first(q) + plan.count(q); ++n) {
       node_rank[n] = q;
       shift_times(recorder.log(n), offset);

@@ -33,8 +33,8 @@ Incoming next(Transport& transport, int round, int from) {
 
 }  // namespace
 
-double clock_offset(Transport& transport, int rank, const RouteRecorder& clock) {
-  double best = std::numeric_limits<double>::infinity(), offset = 0;
+ClockOffset clock_offset(Transport& transport, int rank, const RouteRecorder& clock) {
+  ClockOffset best{0, std::numeric_limits<double>::infinity()};
   for (int k = 0; k < rounds; ++k) {
     const double sent = clock.now();
     transport.post(rank, Tag::clock, Bytes{std::byte{0}});
@@ -43,12 +43,9 @@ double clock_offset(Transport& transport, int rank, const RouteRecorder& clock) 
     const double back = clock.now();
     WireReader r(answer.bytes);
     const auto theirs = r.get<double>();
-    if (back - sent < best) {
-      best = back - sent;
-      offset = (sent + back) / 2 - theirs;
-    }
+    if (back - sent < best.round_trip) best = {(sent + back) / 2 - theirs, back - sent};
   }
-  return offset;
+  return best;
 }
 
 void answer_clock(Transport& transport, const RouteRecorder& clock) {

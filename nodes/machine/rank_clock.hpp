@@ -15,9 +15,14 @@
 
 namespace nodes {
 
-// Rank 0: seconds to add to a time on rank `rank`'s clock to put it on
-// `clock`'s (rank 0's).
-double clock_offset(Transport& transport, int rank, const RouteRecorder& clock);
+// Rank 0's view of rank `rank`'s clock: the seconds to add to a time on it
+// to put it on `clock`'s (rank 0's), and the quickest round trip, half of
+// which bounds the offset's error.
+struct ClockOffset {
+  double offset = 0;
+  double round_trip = 0;
+};
+ClockOffset clock_offset(Transport& transport, int rank, const RouteRecorder& clock);
 
 // Any other rank: answers each of rank 0's pings with `clock`'s reading.
 void answer_clock(Transport& transport, const RouteRecorder& clock);

@@ -7,6 +7,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <string>
@@ -26,7 +27,10 @@ class Clock final : public nodes::RouteRecorder {
   nodes::RouteLog log_;
 };
 
-TEST(RankClock, TheOffsetFoundIsTheTrueOneWithinAMillisecond) {
+// Each answer is read between a ping's sending and the answer's arrival,
+// so the error is at most half the quickest round trip, however slow the
+// ranks (sanitizers, a loaded host) make it.
+TEST(RankClock, TheOffsetFoundIsTheTrueOneWithinHalfTheQuickestRoundTrip) {
   const auto now = std::chrono::steady_clock::now();
   for (const auto apart : {250ms, -40ms}) {
     SCOPED_TRACE(apart.count());
@@ -34,12 +38,16 @@ TEST(RankClock, TheOffsetFoundIsTheTrueOneWithinAMillisecond) {
     const Clock zero(now), one(now - apart);
     nodes::LocalTransportGroup group(2);
     std::thread answering([&] { nodes::answer_clock(group.rank(1), one); });
-    const double offset = nodes::clock_offset(group.rank(0), 1, zero);
+    const nodes::ClockOffset found = nodes::clock_offset(group.rank(0), 1, zero);
     answering.join();
     const double truth = -std::chrono::duration<double>(apart).count();
-    const double error = std::abs(offset - truth);
+    const double error = std::abs(found.offset - truth);
     RecordProperty("error_nanoseconds_" + std::to_string(apart.count()), static_cast<int>(error * 1e9));
-    EXPECT_LT(error, 1e-3) << "offset " << offset << " s, true " << truth << " s";
+    RecordProperty("round_trip_nanoseconds_" + std::to_string(apart.count()),
+                   static_cast<int>(std::min(found.round_trip, 1.0) * 1e9));
+    EXPECT_GT(found.round_trip, 0.0);
+    EXPECT_LE(error, found.round_trip / 2 + 1e-9)
+        << "offset " << found.offset << " s, true " << truth << " s, round trip " << found.round_trip << " s";
   }
 }
 
