@@ -35,7 +35,7 @@ class FrameAssembler {
  private:
   std::span<const std::uint32_t> positions_;
   std::vector<tracer::Color> colors_;
-  std::vector<bool> arrived_;
+  std::vector<std::uint8_t> arrived_;  // by scanline position: its colour has come
   std::uint32_t received_ = 0;
 };
 

@@ -150,6 +150,10 @@ TEST(FrameAssembler, StoresColoursBitExactAndRejectsDuplicates) {
   EXPECT_THROW(frame.add(nodes::decode_result(payload)), std::logic_error);
   const auto beyond = nodes::encode_result(5, {3, 2}, colors);
   EXPECT_THROW(frame.add(nodes::decode_result(beyond)), std::logic_error);
+  // A view whose colours do not fill its tile is refused, not read past.
+  const std::vector<std::byte> short_rgb(sizeof(tracer::Color));
+  EXPECT_THROW(frame.add(nodes::ResultView{5, {0, 2}, short_rgb}), std::logic_error);
+  EXPECT_EQ(frame.received(), 2u);
 }
 
 TEST(FrameAssembler, PutsItemsOfAPixelOrderInTheirScanlinePlaces) {
