@@ -53,6 +53,14 @@ std::vector<Packet> node_packets(const Plan& plan, NodeId n, std::uint64_t& next
   return packets;
 }
 
+// How many packets of the plan each node receives.
+std::vector<std::size_t> packets_to_each(const Plan& plan) {
+  std::vector<std::size_t> expected(plan.size(), 0);
+  for (const auto& dsts : plan)
+    for (NodeId d : dsts) ++expected[d];
+  return expected;
+}
+
 struct Received {
   std::vector<std::uint64_t> ids;
   std::vector<NodeId> sources;  // of each id
@@ -68,9 +76,7 @@ std::vector<Received> run_plan(const topology::Topology& t, const Plan& plan,
                                std::size_t payload = 16, unsigned threads = 2) {
   csp::Runtime runtime(threads);
   Network net(runtime, t, options);
-  std::vector<std::size_t> expected(t.size(), 0);
-  for (const auto& dsts : plan)
-    for (NodeId d : dsts) ++expected[d];
+  const std::vector<std::size_t> expected = packets_to_each(plan);
   std::vector<Received> received(t.size());
   std::atomic<std::size_t> unfinished{t.size()};
   std::uint64_t next_id = 0;
@@ -217,9 +223,7 @@ TEST(Network, APortReceiverTakesDeliveriesInPlaceAndLosesNone) {
       options.buffer_capacity = 2;
       options.forward_in_place = in_place;
       Network net(runtime, t, options);
-      std::vector<std::size_t> expected(t.size(), 0);
-      for (const auto& dsts : plan)
-        for (NodeId d : dsts) ++expected[d];
+      const std::vector<std::size_t> expected = packets_to_each(plan);
       std::vector<Received> received(t.size());
       std::size_t unfinished = t.size();
       auto done_with = [&](NodeId n) {
