@@ -8,8 +8,6 @@
 #include <tuple>
 #include <vector>
 
-#include "app/options.hpp"
-#include "app/report.hpp"
 #include "app/wording.hpp"
 #include "nodes/machine/messages.hpp"
 #include "topology/spec.hpp"
@@ -289,25 +287,6 @@ void print_routes(std::ostream& out, const nodes::MachineReport& report) {
   if (routes.empty()) return;
   out << "routes         " << count_of(routes.size(), "packet") << " traced, hop by hop:\n";
   for (const nodes::RouteRecord& r : routes) out << "  " << nodes::format_route(r, kind_name) << "\n";
-}
-
-std::vector<std::uint8_t> parse_trace_kinds(const std::string& names) {
-  std::vector<std::uint8_t> kinds;
-  std::string known;
-  for (int k = 1; k < nodes::message_kind_count; ++k)
-    known += (known.empty() ? "" : ", ") + std::string(nodes::message_kind_name(static_cast<std::uint8_t>(k)));
-  std::size_t at = 0;
-  do {
-    const std::size_t comma = std::min(names.find(',', at), names.size());
-    const std::string name = names.substr(at, comma - at);
-    int kind = 1;
-    while (kind < nodes::message_kind_count && nodes::message_kind_name(static_cast<std::uint8_t>(kind)) != name) ++kind;
-    if (kind == nodes::message_kind_count)
-      throw UsageError("--trace-kind: expected packet kinds among " + known + ", got '" + name + "'");
-    kinds.push_back(static_cast<std::uint8_t>(kind));
-    at = comma + 1;
-  } while (at <= names.size());
-  return kinds;
 }
 
 Json cost_model_json(const nodes::CostModel& model) {

@@ -44,10 +44,6 @@ void print_machine_report(std::ostream& out, const MachineSummary& m);
 // ("  page_request 17: 5 → 4 → 6 (2 hops)"); nothing when none were traced.
 void print_routes(std::ostream& out, const nodes::MachineReport& report);
 
-// --trace-kind: packet kinds by name, comma-separated ("page_request,page_reply");
-// UsageError naming the option and the kinds there are otherwise.
-std::vector<std::uint8_t> parse_trace_kinds(const std::string& names);
-
 // The run's tiles (recorded with MachineOptions::record_tiles) as CSV, one
 // row per tile in order of start time (ties by node, worker): node, worker,
 // first_item, items, start_s, end_s, page_requests, rays. Items are numbered

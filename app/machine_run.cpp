@@ -9,6 +9,7 @@
 #include "app/cpu_count.hpp"
 #include "app/memory_check.hpp"
 #include "app/progress.hpp"
+#include "app/usage_error.hpp"
 
 namespace app {
 namespace {
@@ -56,25 +57,6 @@ SerialComparison run_serial(const tracer::Database& db, const nodes::MachineOpti
 }
 
 }  // namespace
-
-std::string option_of_field(const std::string& field) {
-  // clang-format off
-  static const std::pair<const char*, const char*> options[] = {
-      {"topology", "--topology"}, {"nodes", "--nodes"}, {"threads", "--threads"},
-      {"cache_pages", "--cache-pages"}, {"cache_kb", "--cache-kb"}, {"grain", "--grain"},
-      {"schedule", "--schedule"}, {"pixel_order", "--pixel-order"}, {"workers_per_node", "--workers-per-node"},
-      {"prefetch", "--prefetch"}, {"distribution", "--distribution"}, {"trace_routes", "--trace-routes"},
-      {"trace_kinds", "--trace-kind"}, {"timing", "--timing"},
-  };
-  // clang-format on
-  for (const auto& [name, option] : options)
-    if (field == name) return option;
-  return field;
-}
-
-UsageError usage_error(const nodes::OptionError& error) {
-  return UsageError(option_of_field(error.field()) + ": " + error.reason());
-}
 
 std::string with_hint(const nodes::ResourceError& error, const std::string& fewer_threads) {
   const std::string line = error.what();

@@ -15,11 +15,6 @@ namespace app {
 // The machine's options from the command line's, with the tracing options.
 nodes::MachineOptions machine_options(const Options& options);
 
-// The machine's errors in the command line's terms. A MachineOptions field
-// is named by its option ("cache_kb" -> "--cache-kb"; a field no option sets
-// keeps its own name), and an OptionError becomes UsageError "OPTION: REASON".
-std::string option_of_field(const std::string& field);
-UsageError usage_error(const nodes::OptionError& error);
 // A machine the system could not give memory or threads: its line and what
 // to change. `fewer_threads` says how to ask for fewer ("--threads, 8 here").
 std::string with_hint(const nodes::ResourceError& error, const std::string& fewer_threads);

@@ -7,8 +7,7 @@
 #include <sstream>
 
 #include "app/cpu_count.hpp"
-#include "app/machine_report.hpp"
-#include "app/machine_run.hpp"
+#include "nodes/machine/messages.hpp"
 #include "topology/spec.hpp"
 #include "topology/topology.hpp"
 #include "tracer/generators.hpp"
@@ -301,6 +300,25 @@ nodes::PixelOrder parse_pixel_order(const std::string& name) {
   for (auto order : {nodes::PixelOrder::scanline, nodes::PixelOrder::hilbert})
     if (name == nodes::pixel_order_name(order)) return order;
   throw UsageError("--pixel-order: expected scanline or hilbert, got '" + name + "'");
+}
+
+std::vector<std::uint8_t> parse_trace_kinds(const std::string& names) {
+  std::vector<std::uint8_t> kinds;
+  std::string known;
+  for (int k = 1; k < nodes::message_kind_count; ++k)
+    known += (known.empty() ? "" : ", ") + std::string(nodes::message_kind_name(static_cast<std::uint8_t>(k)));
+  std::size_t at = 0;
+  do {
+    const std::size_t comma = std::min(names.find(',', at), names.size());
+    const std::string name = names.substr(at, comma - at);
+    int kind = 1;
+    while (kind < nodes::message_kind_count && nodes::message_kind_name(static_cast<std::uint8_t>(kind)) != name) ++kind;
+    if (kind == nodes::message_kind_count)
+      throw UsageError("--trace-kind: expected packet kinds among " + known + ", got '" + name + "'");
+    kinds.push_back(static_cast<std::uint8_t>(kind));
+    at = comma + 1;
+  } while (at <= names.size());
+  return kinds;
 }
 
 void check_grid_shape(const std::string& kind, std::size_t nodes) {

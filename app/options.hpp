@@ -14,18 +14,13 @@
 #include <vector>
 
 #include "app/timing_options.hpp"
+#include "app/usage_error.hpp"
 #include "nodes/machine/machine.hpp"
 #include "nodes/machine/pixel_order.hpp"
 #include "nodes/machine/work_plan.hpp"
 #include "tracer/database.hpp"
 
 namespace app {
-
-// A bad command line; the message is one line naming the option.
-class UsageError : public std::runtime_error {
- public:
-  using std::runtime_error::runtime_error;
-};
 
 struct Options {
   // help, version, manpage and completion print their text (--help, --version,
@@ -136,6 +131,9 @@ tracer::BuildOptions build_options(const Options& o);
 nodes::Schedule parse_schedule(const std::string& name);
 // --pixel-order: "scanline" or "hilbert"; UsageError otherwise.
 nodes::PixelOrder parse_pixel_order(const std::string& name);
+// --trace-kind: packet kinds by name, comma-separated ("page_request,page_reply");
+// UsageError naming the option and the kinds there are otherwise.
+std::vector<std::uint8_t> parse_trace_kinds(const std::string& names);
 // A bare mesh or torus whose node count has no factors would be a line
 // (mesh --nodes 17 is 17x1): UsageError asking for the shape or another
 // count, since a line is not what "mesh" promises. Other kinds, full specs

@@ -3,7 +3,7 @@
 
 #include <stdexcept>
 
-#include "app/options.hpp"
+#include "app/usage_error.hpp"
 
 namespace app {
 
