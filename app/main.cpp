@@ -2,7 +2,7 @@
 // (default: the teapot on a 16-node hypercube, each node caching 1/8 of the
 // database) or, with --single, in this process; write the image and report
 // rays, page accesses and traffic, the network and per-node work (JSON with
-// --stats). `vmpray sweep ...` runs the paper's experiments (app/sweep.hpp).
+// --stats). `vmpray sweep ...` runs the paper's experiments (app/experiments/sweep.hpp).
 // Exit 0 on success, 2 for a bad command line (or an image too large for
 // this machine's memory, found once the scene is read), 1 for a runtime
 // error; errors are one line on stderr, and a failed run leaves no output file.
@@ -11,7 +11,7 @@
 //
 // Started by an MPI launcher (mpirun; vmpi::launched_by_mpi() reads its
 // environment) with more than one rank, the machine is split over the
-// ranks (app/ranks.hpp): rank 0 does all a one-process run does, the others
+// ranks (app/render/ranks.hpp): rank 0 does all a one-process run does, the others
 // run their nodes. Every rank parses the same command line, so a bad one
 // fails on all alike and rank 0 alone says so; a failure on any rank after
 // that ends every rank, and rank 0 prints its one line. With one rank, or
@@ -24,21 +24,21 @@
 #include <utility>
 #include <vector>
 
-#include "app/machine_pictures.hpp"
-#include "app/machine_run.hpp"
+#include "app/experiments/machine_pictures.hpp"
+#include "app/experiments/network_study.hpp"
+#include "app/experiments/output_check.hpp"
+#include "app/experiments/replay.hpp"
+#include "app/experiments/sweep.hpp"
 #include "app/manual.hpp"
-#include "app/memory_check.hpp"
-#include "app/network_study.hpp"
-#include "app/options.hpp"
-#include "app/output_check.hpp"
-#include "app/output_files.hpp"
-#include "app/ranks.hpp"
-#include "app/replay.hpp"
-#include "app/report.hpp"
-#include "app/scene_input.hpp"
-#include "app/single.hpp"
-#include "app/sweep.hpp"
-#include "app/version.hpp"
+#include "app/render/machine_run.hpp"
+#include "app/render/memory_check.hpp"
+#include "app/render/options.hpp"
+#include "app/render/output_files.hpp"
+#include "app/render/ranks.hpp"
+#include "app/render/run_report.hpp"
+#include "app/render/scene_input.hpp"
+#include "app/render/single_run.hpp"
+#include "app/render/version.hpp"
 #include "mpi/mpi_transport.hpp"
 #include "tracer/database.hpp"
 

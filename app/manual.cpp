@@ -11,9 +11,9 @@
 #include <utility>
 #include <vector>
 
-#include "app/network_study.hpp"
-#include "app/options.hpp"
-#include "app/sweep.hpp"
+#include "app/experiments/network_study.hpp"
+#include "app/experiments/sweep.hpp"
+#include "app/render/options.hpp"
 #include "nodes/machine/pixel_order.hpp"
 #include "nodes/machine/work_plan.hpp"
 #include "topology/topology.hpp"

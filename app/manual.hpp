@@ -1,5 +1,5 @@
 // The manual page vmpray(1) and the bash completion script, made from the
-// option descriptions --help prints (options.hpp's OptionGroup; the sweep's
+// option descriptions --help prints (app/render/options.hpp's OptionGroup; the sweep's
 // and the network study's), so neither can drift from what the parser
 // takes; `vmpray --manpage` and `vmpray --completion bash` (hidden) print
 // them, and the build installs what they print (cmake/manual.cmake).

@@ -10,7 +10,7 @@
 #include <cstdint>
 #include <vector>
 
-#include "app/viz/report.hpp"
+#include "app/viz/html_report.hpp"
 #include "tracer/image.hpp"
 
 namespace viz {

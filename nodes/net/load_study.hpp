@@ -10,7 +10,7 @@
 // (the layer above records them from a render). Invariants: every packet created is delivered exactly once to its
 // destination (counted, never assumed); the run ends when the last packet
 // created is delivered, however far past saturation the load is. Knows
-// nothing of the command line (app/network_study.hpp drives it).
+// nothing of the command line (app/experiments/network_study.hpp drives it).
 #pragma once
 
 #include <cstdint>

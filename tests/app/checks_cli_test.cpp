@@ -14,9 +14,9 @@
 #include <string>
 #include <utility>
 
-#include "app/output_check.hpp"
-#include "app/report.hpp"
-#include "app/wording.hpp"
+#include "app/experiments/output_check.hpp"
+#include "app/render/run_report.hpp"
+#include "app/render/wording.hpp"
 #include "tests/support/command_line.hpp"
 #include "tests/support/scratch.hpp"
 

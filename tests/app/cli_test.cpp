@@ -18,7 +18,7 @@
 #include <thread>
 #include <utility>
 
-#include "app/output_files.hpp"
+#include "app/render/output_files.hpp"
 #include "tests/support/scratch.hpp"
 
 namespace {

@@ -17,7 +17,7 @@
 #include <string>
 #include <vector>
 
-#include "app/options.hpp"
+#include "app/render/options.hpp"
 #include "tests/support/command_line.hpp"
 #include "tests/support/scratch.hpp"
 

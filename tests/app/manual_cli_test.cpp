@@ -14,7 +14,7 @@
 #include <string>
 #include <vector>
 
-#include "app/sweep.hpp"
+#include "app/experiments/sweep.hpp"
 #include "tests/support/command_line.hpp"
 #include "tests/support/scratch.hpp"
 

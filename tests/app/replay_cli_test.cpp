@@ -12,8 +12,8 @@
 #include <regex>
 #include <string>
 
-#include "app/options.hpp"
-#include "app/ranks.hpp"
+#include "app/render/options.hpp"
+#include "app/render/ranks.hpp"
 #include "tests/support/command_line.hpp"
 #include "tests/support/scratch.hpp"
 
