@@ -3,10 +3,14 @@
 
 Each library folder has a layer; a file may include headers of its own
 folder and of folders in lower layers only (folders of one layer are
-independent of each other), and the headers of one folder include each
-other without a cycle (a source file may include any header of its folder:
-database.cpp builds the BVH whose header names the database). tests/ and
-examples/ may include anything and are not checked.
+independent of each other). Within a folder, the modules include each other
+without a cycle: a module is x.hpp with x.cpp (either may be missing), and
+module x depends on module y when either file of x includes y.hpp. So a
+source file including a header whose module includes the source's own
+header back is a cycle, as two headers including each other are. The few
+cycles listed in KNOWN_CYCLES are reported on every run but pass; a listed
+one that is no longer a cycle is a problem, so the list stays true.
+tests/ and examples/ may include anything and are not checked.
 
 usage: scripts/check-layers.py [--graph]   (exit 1 on any violation;
 --graph prints the edges between folders)
@@ -23,8 +27,19 @@ LAYERS = [
     ("nodes/ranks", 2),
     ("nodes/machine", 3),
     ("mpi", 4),
-    ("app/viz", 5),
-    ("app", 6),
+    ("app/render", 5), ("app/viz", 5),
+    ("app/experiments", 6),
+    ("app", 7),
+]
+# Module cycles that stand for now, each as its set of modules; in each a
+# .cpp uses helpers whose headers name its own types, and breaking it means
+# a header of those types alone: the database built from its BVH and grid,
+# the scheduler and the process records and waits it runs, the line plot and
+# its geometry and raster helpers.
+KNOWN_CYCLES = [
+    {"csp/detail/process", "csp/detail/wait", "csp/scheduler"},
+    {"tracer/bvh", "tracer/database", "tracer/grid"},
+    {"app/viz/plot", "app/viz/plot_geometry", "app/viz/plot_raster"},
 ]
 INCLUDE = re.compile(r'^\s*#\s*include\s+"([^"]+)"', re.M)
 
@@ -38,10 +53,15 @@ def folder_of(path):
     return best
 
 
+def module_of(path):
+    """x.hpp, x.cpp and x.h are one module, x."""
+    return path.rsplit(".", 1)[0]
+
+
 def main():
     root = pathlib.Path(__file__).resolve().parent.parent
     rank = dict(LAYERS)
-    problems = []
+    problems, notes = [], []
     between = collections.Counter()
     modules = collections.defaultdict(lambda: collections.defaultdict(set))  # folder -> module -> modules
     for source in sorted(root.rglob("*")):
@@ -51,37 +71,47 @@ def main():
         here = folder_of(rel)
         if here is None:
             continue
-        module = rel
-        if source.suffix != ".cpp":
-            modules[here].setdefault(module, set())
+        module = module_of(rel)
+        modules[here].setdefault(module, set())
         text = source.read_text(encoding="utf-8", errors="replace")
         for line_no, target in ((text.count("\n", 0, m.start()) + 1, m.group(1)) for m in INCLUDE.finditer(text)):
             there = folder_of(target)
             if there is None:
                 continue
             if there == here:
-                if source.suffix != ".cpp":
-                    modules[here][module].add(target)
+                if module_of(target) != module:
+                    modules[here][module].add(module_of(target))
                 continue
             between[(here, there)] += 1
             if rank[there] >= rank[here]:
                 problems.append(f"{rel}:{line_no}: {here} (layer {rank[here]}) includes {target} "
                                 f"of {there} (layer {rank[there]})")
-    for folder, graph in sorted(modules.items()):
-        for cycle in cycles(graph):
-            problems.append(f"{folder}: include cycle " + " -> ".join(cycle + [cycle[0]]))
+    found = [(folder, cycle) for folder, graph in sorted(modules.items()) for cycle in cycles(graph)]
+    for folder, (component, cycle) in found:
+        line = f"{folder}: include cycle " + " -> ".join(cycle + [cycle[0]])
+        if len(component) > len(cycle):
+            line += " (and " + ", ".join(sorted(component - set(cycle))) + " in cycles with them)"
+        if component in KNOWN_CYCLES:
+            notes.append(line + " (known, see KNOWN_CYCLES)")
+        else:
+            problems.append(line)
+    for known in KNOWN_CYCLES:
+        if not any(component == known for _, (component, _) in found):
+            problems.append("KNOWN_CYCLES: " + ", ".join(sorted(known)) + " is no longer a cycle; remove it")
     if "--graph" in sys.argv[1:]:
         for (a, b), n in sorted(between.items()):
             print(f"{a} -> {b}: {n}")
-    for p in problems:
-        print(p, file=sys.stderr)
-    print(f"check-layers: {len(problems)} problem(s); {sum(len(g) for g in modules.values())} headers "
+    for line in notes + problems:
+        print(line, file=sys.stderr)
+    print(f"check-layers: {len(problems)} problem(s); {sum(len(g) for g in modules.values())} modules "
           f"of {len(modules)} folders", file=sys.stderr)
     return 1 if problems else 0
 
 
 def cycles(graph):
-    """One cycle per strongly connected component of more than one module."""
+    """Each strongly connected component of more than one module, with one
+    cycle through it: the modules along it in order (the last one's include
+    closes it)."""
     index, low, on_stack, stack, found, counter = {}, {}, set(), [], [], [0]
 
     def visit(v):
@@ -106,13 +136,31 @@ def cycles(graph):
                 if w == v:
                     break
             if len(component) > 1:
-                found.append(sorted(component))
+                found.append((set(component), cycle_through(graph, set(component))))
 
     sys.setrecursionlimit(10000)
     for v in sorted(graph):
         if v not in index:
             visit(v)
     return found
+
+
+def cycle_through(graph, component):
+    """The shortest cycle from the component's first module back to it."""
+    start = min(component)
+    parent, queue = {start: None}, collections.deque([start])
+    while queue:
+        v = queue.popleft()
+        for w in sorted(graph[v] & component):
+            if w == start:
+                path = [v]
+                while parent[path[-1]] is not None:
+                    path.append(parent[path[-1]])
+                return path[::-1]
+            if w not in parent:
+                parent[w] = v
+                queue.append(w)
+    return sorted(component)
 
 
 if __name__ == "__main__":
