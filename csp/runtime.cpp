@@ -588,6 +588,15 @@ void yield() {
   boost::this_fiber::yield();
 }
 
+bool yield_to_all() {
+  const Scheduler* s = detail::thread_algorithm();
+  if (!s || !s->others_ready()) return false;
+  if (auto* props = boost::fibers::context::active()->get_properties())
+    static_cast<ProcessProps*>(props)->behind_all = true;
+  boost::this_fiber::yield();
+  return true;
+}
+
 const std::string& current_process_name() {
   static const std::string none;
   const Process* p = detail::current_process();

@@ -109,6 +109,15 @@ void sleep_for(std::chrono::steady_clock::duration d);
 // and the ones that yielded before it). Never counted as blocked.
 void yield();
 
+// Puts the caller, whatever its priority, behind every process of its
+// thread ready now (FifoScheduler: at the back of the yielded low-priority
+// ones) and returns true once it runs again; returns false at once if no
+// other process is ready, or under a scheduler without the rule (virtual
+// time). A process that gathers work for one costly transfer lets the
+// thread's pass add to it so, and sends when the thread would otherwise
+// wait. Never counted as blocked.
+bool yield_to_all();
+
 // True if the calling thread has work that should not wait for the caller
 // to finish a long computation: under FifoScheduler, a ready high-priority
 // process, or a process woken from another thread and not yet dispatched

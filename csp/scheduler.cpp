@@ -48,10 +48,14 @@ std::chrono::microseconds idle_spin(unsigned threads, unsigned hardware_threads)
 // Woken low-priority processes go before yielded ones: a process that waited
 // on a message has little left to do before it waits again, and the ones
 // that yielded are the long computations it would otherwise queue behind.
+// A process of either priority that yields to all goes behind every one.
 void FifoScheduler::awakened(boost::fibers::context* ctx, ProcessProps& props) noexcept {
   const bool yielded = std::exchange(props.yielded, false);
   if (ctx->is_context(boost::fibers::type::dispatcher_context)) {
     dispatcher_ = ctx;
+  } else if (std::exchange(props.behind_all, false)) {
+    ctx->ready_link(ready_low_);
+    dispatch_soon_ = true;
   } else if (props.process && props.process->priority == Priority::low) {
     ctx->ready_link(yielded ? ready_low_ : ready_low_woken_);
     // A long computation offers the thread: timers due meanwhile go first.
@@ -184,6 +188,10 @@ void FifoScheduler::notify() noexcept {
 bool FifoScheduler::yield_requested() const noexcept {
   return notified_.load(std::memory_order_relaxed) || !ready_.empty() ||
          (arrivals_ && arrivals_->marked_.load(std::memory_order_relaxed));
+}
+
+bool FifoScheduler::others_ready() const noexcept {
+  return !ready_.empty() || !ready_low_woken_.empty() || !ready_low_.empty();
 }
 
 // sleeping_ is set (seq_cst) before the sleeper looks at its arrivals for

@@ -64,6 +64,7 @@ class ProcessProps : public boost::fibers::fiber_properties {
   detail::Process* process = nullptr;  // null for fibers that are not csp processes
   const bool virtual_time;             // these are VirtualProps (virtual_time.hpp)
   bool yielded = false;                // set by csp::yield(), cleared when the fiber is ready again
+  bool behind_all = false;             // set by csp::yield_to_all(), cleared likewise
 };
 
 // The base of the runtime's schedulers.
@@ -78,6 +79,9 @@ class Scheduler : public boost::fibers::algo::algorithm_with_properties<ProcessP
   // csp::yield_requested()); called on the scheduler's thread. The default
   // keeps no such rule and says no.
   virtual bool yield_requested() const noexcept { return false; }
+  // Whether csp::yield_to_all() may put the caller behind the other ready
+  // processes: some is ready, and the scheduler has the rule. Default: no.
+  virtual bool others_ready() const noexcept { return false; }
 };
 
 // How one thread's time divides; written by that thread only. From the
@@ -200,6 +204,7 @@ class FifoScheduler final : public Scheduler {
   // A ready high-priority process, or a wake from another thread not yet
   // dispatched: a packet arrived here that the caller would delay.
   bool yield_requested() const noexcept override;
+  bool others_ready() const noexcept override;
 
  private:
   friend class Arrivals;

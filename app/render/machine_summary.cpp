@@ -143,6 +143,7 @@ Json json_ranks(const nodes::MachineReport& r) {
                      {"bytes_received", k.bridge.bytes_received},
                      {"messages_sent", k.bridge.messages_sent},
                      {"wire_bytes_sent", k.bridge.wire_bytes_sent},
+                     {"post_seconds", static_cast<double>(k.bridge.post_nanoseconds) * 1e-9},
                      {"polls", k.bridge.polls},
                      {"peak_scene_bytes", k.peak_scene_bytes},
                      {"cpu_seconds", k.cpu_seconds},

@@ -17,8 +17,10 @@ constexpr std::size_t poll_levels = 9;  // 4 us .. 1024 us
 // limit of MPI's shared-memory transport (4 KB in Open MPI) is delivered
 // whole by the send; a larger one waits, after the receiver matches it,
 // for the sender's next MPI call, which on a busy rank comes only after a
-// run of pixels.
+// run of pixels. A frame gathered because messages are dear (over TCP,
+// whose eager limit in Open MPI is 64 KB) may hold more.
 constexpr std::size_t frame_bytes = 3 * 1024;
+constexpr std::size_t gathered_frame_bytes = 32 * 1024;
 constexpr std::chrono::microseconds hot_window{1000};  // since the last activity
 
 }  // namespace
@@ -121,10 +123,8 @@ void Bridge::carry() {
     if (guard >= guard_owner_.size()) continue;  // a timeout: poll the wire
     try {
       if (take(guard)) {
-        // The rest of this pass first (the routers ready now may have more
-        // for the wire), then everything ready, in one message per rank.
-        csp::yield();
-        take_ready();
+        gather();
+        if (stopping_) continue;  // an `end` came over the wire meanwhile
         queue_credits(false);
         // Sent now rather than after the next select: the receiver may be idle.
         send_frames();
@@ -135,6 +135,37 @@ void Bridge::carry() {
       stop();
     }
   }
+}
+
+// After a packet for the wire: the rest of this pass (the routers ready
+// now may have more), then, while the frames are small and the window
+// lasts, every process ready on the thread, each in its turn, with what
+// came over the wire meanwhile: the packets of a pass leave in one message
+// per rank, and the message leaves at once when the thread has nothing
+// else to run, so gathering adds no wait where a rank would idle.
+void Bridge::gather() {
+  const auto start = std::chrono::steady_clock::now();
+  csp::yield();
+  take_ready();
+  if (!dear()) return;
+  while (gathered_bytes() < gathered_frame_bytes && std::chrono::steady_clock::now() - start < gathering_.window &&
+         csp::yield_to_all()) {
+    if (receive_all()) {
+      if (stopping_) return;
+      deliver_staged();
+    }
+    take_ready();
+  }
+}
+
+bool Bridge::dear() const {
+  return gathering_.window.count() > 0 && post_cost_ >= static_cast<double>(gathering_.dear_message.count());
+}
+
+std::size_t Bridge::gathered_bytes() const {
+  std::size_t bytes = 0;
+  for (const WireWriter& w : frames_) bytes = std::max(bytes, w.size());
+  return bytes;
 }
 
 // What a ready guard offers: the packets of an outgoing link (true), or room
@@ -165,7 +196,7 @@ void Bridge::take_outgoing(Outgoing& out) {
     w.put(BridgeRecord::packet);
     put_link(w, out.link);
     put_packet(w, *packet);
-    if (w.size() >= frame_bytes) post_frame(out.peer);
+    if (w.size() >= (dear() ? gathered_frame_bytes : frame_bytes)) post_frame(out.peer);
     ++counters_.packets_sent;
     ++unacknowledged_;
     counters_.bytes_sent += packet->bytes();
@@ -296,7 +327,11 @@ void Bridge::post_frame(int peer) {
   WireWriter& w = frame(peer);
   ++counters_.messages_sent;
   counters_.wire_bytes_sent += w.size();
+  const auto start = std::chrono::steady_clock::now();
   transport_.post(peer, Tag::bridge, w.take());
+  const auto cost = std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::steady_clock::now() - start);
+  counters_.post_nanoseconds += static_cast<std::uint64_t>(cost.count());
+  post_cost_ += (static_cast<double>(cost.count()) - post_cost_) / 32;
   w = WireWriter{};
 }
 

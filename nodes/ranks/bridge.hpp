@@ -8,8 +8,9 @@
 // nothing but its one ALT and never waits inside the transport, so the
 // channel dependency graph is the unsplit machine's and stays acyclic.
 // Credits owed go with the next frame to their rank, or alone once half of
-// K are owed or the bridge goes quiet. Polling backs off from 4 us to 1 ms
-// when all is quiet. At the end, a bridge that sees its network shut down,
+// K are owed or the bridge goes quiet; where messages are dear, a wake
+// gathers its thread's pass into one frame. Polling backs off from 4 us to
+// 1 ms when all is quiet. At the end, a bridge that sees its network shut down,
 // or `end` from a peer, sends `end` (after `abort` with the line of a local
 // failure) and drains until every peer's `end` has come.
 #pragma once
@@ -41,6 +42,7 @@ struct BridgeCounters {
   std::uint64_t messages_sent = 0;     // transport messages (packets and credits batched)
   std::uint64_t wire_bytes_sent = 0;   // their total size
   std::uint64_t polls = 0;             // times the bridge looked at the wire
+  std::uint64_t post_nanoseconds = 0;  // time spent handing messages to the transport
 };
 
 // A failure of this rank, or of another one, as the one line to report.
@@ -61,6 +63,16 @@ class Bridge {
  public:
   Bridge(Transport& transport, const RankPlan& plan, Network& network, FailureNote& local_failure,
          FailureNote& remote_failure, BridgeCounters& counters);
+  // When a wake gathers the packets its thread sends before they leave
+  // (docs/architecture.md, "Across processes"): while handing a message to
+  // the transport costs at least `dear_message` on average (a socket's
+  // system calls, not a copy into shared memory), for at most `window`.
+  struct Gathering {
+    std::chrono::microseconds window{20};    // zero: never
+    std::chrono::nanoseconds dear_message{2000};  // zero: always
+  };
+  // Before run().
+  void set_gathering(Gathering g) { gathering_ = g; }
   void run();
 
  private:
@@ -86,6 +98,9 @@ class Bridge {
   bool deliver_staged();
   bool take(std::size_t guard);
   void take_ready();
+  void gather();
+  std::size_t gathered_bytes() const;
+  bool dear() const;  // messages cost enough to gather
   void take_outgoing(Outgoing& out);
   void queue_credits(bool all);
   void post_frame(int peer);
@@ -116,6 +131,8 @@ class Bridge {
   std::uint64_t unacknowledged_ = 0;         // packets sent whose credits have not come back
   std::chrono::steady_clock::time_point last_active_{};
   std::vector<std::size_t> timeout_guards_;  // 4 us, 8 us, ... 1 ms
+  Gathering gathering_{};
+  double post_cost_ = 0;  // nanoseconds a message takes to post, a running average
 };
 
 }  // namespace nodes

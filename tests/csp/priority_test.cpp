@@ -1,6 +1,6 @@
 // Scheduling at two priorities: high before low, woken before yielded,
 // PAR children at their parent's priority, yield requests, and no starvation
-// of the low priority.
+// of the low priority, and yielding to all.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "csp/csp.hpp"
+#include "csp/virtual_time.hpp"
 
 namespace {
 
@@ -326,6 +327,48 @@ TEST(Runtime, AWakeFromAnotherThreadIsDispatchedAtTheNextSwitch) {
   std::sort(delays.begin(), delays.end());
   // The median is 1 here; left to a dispatch every 32 picks it is 12-13.
   EXPECT_LE(delays[trials / 2], 8) << "90th percentile " << delays[trials * 9 / 10] << ", most " << delays.back();
+}
+
+}  // namespace
+
+namespace {
+
+// One thread. A high-priority process that yields to all runs again only
+// after every process ready when it yielded, the low-priority ones too
+// (after a plain yield it would run first), and is told so; with nothing
+// else ready it goes on at once and is told that.
+TEST(Priority, AProcessThatYieldsToAllRunsAfterEveryReadyProcess) {
+  std::vector<std::string> log;
+  csp::Runtime rt(1);
+  for (const char* name : {"low 1", "low 2"})
+    rt.spawn(
+        name, 0,
+        [&log, name] {
+          csp::yield();
+          log.push_back(name);
+        },
+        csp::Priority::low);
+  rt.spawn("high", 0, [&log] {
+    log.push_back(csp::yield_to_all() ? "high behind all" : "high first");
+    log.push_back(csp::yield_to_all() ? "high behind none" : "high alone");
+  });
+  rt.run();
+  EXPECT_EQ(log, (std::vector<std::string>{"low 1", "low 2", "high behind all", "high alone"}));
+  EXPECT_FALSE(csp::yield_to_all()) << "outside a Runtime";
+}
+
+// Virtual time orders processes by their clocks: no process may jump the
+// queue, so yield_to_all() declines.
+TEST(Priority, YieldToAllDeclinesUnderVirtualTime) {
+  csp::RuntimeOptions options;
+  options.threads = 1;
+  options.scheduler = csp::virtual_time_scheduler();
+  bool yielded = true;
+  csp::Runtime rt(options);
+  rt.spawn("other", 0, [] { csp::yield(); });
+  rt.spawn("asker", 0, [&yielded] { yielded = csp::yield_to_all(); });
+  rt.run();
+  EXPECT_FALSE(yielded);
 }
 
 }  // namespace

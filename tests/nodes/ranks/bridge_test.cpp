@@ -14,10 +14,12 @@
 // flight, on one rank, on all at once or from outside the runtimes, ends
 // every rank with no exception, no failure noted and no send pending. A
 // watchdog bounds each run's wall time, so a hang fails instead of stalling.
+// And the packets a rank sends in one pass of its thread leave together.
 //
 // A seed fixes the topology, the ranks, K, the threads, the traffic, the
-// pauses and the delays each endpoint draws; the threads' timing is the
-// OS's, so a seed replays its case, not one exact schedule. Seeds as in
+// pauses, the delays each endpoint draws and whether the bridges gather;
+// the threads' timing is the OS's, so a seed replays its case, not one
+// exact schedule. Seeds as in
 // tests/support/seeded_runs.hpp (VMPRAY_SCHEDULE_SEEDS,
 // VMPRAY_SCHEDULE_FIRST_SEED); a failure prints its seed and the command
 // that replays it.
@@ -77,7 +79,9 @@ class WireLedger {
     std::lock_guard<std::mutex> lk(mutex_);
     try {
       nodes::WireReader r(frame);
+      const std::uint64_t before = packets_;
       while (!r.done()) record(from, to, r);
+      if (packets_ > before) ++frames_with_packets_[from];
     } catch (const std::exception& e) {
       fail("rank " + std::to_string(from) + " to " + std::to_string(to) + ": " + e.what());
     }
@@ -94,6 +98,11 @@ class WireLedger {
   std::uint64_t packets() const {  // packet records posted
     std::lock_guard<std::mutex> lk(mutex_);
     return packets_;
+  }
+  std::uint64_t frames_with_packets(int from) const {  // frames `from` posted that carried packets
+    std::lock_guard<std::mutex> lk(mutex_);
+    const auto it = frames_with_packets_.find(from);
+    return it == frames_with_packets_.end() ? 0 : it->second;
   }
   // Whether every rank posted `end` to every other.
   bool all_ended() const {
@@ -153,6 +162,7 @@ class WireLedger {
   std::vector<bool> ended_;          // [from * ranks + to]: `end` posted
   std::size_t peak_ = 0;
   std::uint64_t packets_ = 0;
+  std::map<int, std::uint64_t> frames_with_packets_;  // per sending rank
   std::string error_;
 };
 
@@ -254,6 +264,7 @@ struct Case {
   std::vector<Pauses> send, receive;                // per node
   std::vector<Delays> delays;                       // per rank
   NodeId slow = 0;                                  // its receiver sleeps before every packet
+  bool gathering = false;  // every bridge gathers its thread's pass, however cheap a message
 };
 
 std::string describe(const Case& c) {
@@ -262,7 +273,7 @@ std::string describe(const Case& c) {
     for (std::uint64_t n : row) packets += n;
   return c.topology.spec() + " on " + std::to_string(c.ranks) + " ranks, K=" + std::to_string(c.capacity) +
          " threads=" + std::to_string(c.threads) + (c.relays ? " relays" : "") + " packets=" + std::to_string(packets) +
-         " slow node " + std::to_string(c.slow);
+         " slow node " + std::to_string(c.slow) + (c.gathering ? " gathering" : "");
 }
 
 Case draw_case(std::uint64_t seed, std::uint64_t max_per_pair) {
@@ -295,6 +306,7 @@ Case draw_case(std::uint64_t seed, std::uint64_t max_per_pair) {
   }
   c.slow = static_cast<NodeId>(rng() % n);
   c.receive[c.slow] = Pauses{0, 1, microseconds(20 + rng() % 80)};
+  c.gathering = rng() % 2 == 0;
   return c;
 }
 
@@ -330,7 +342,9 @@ struct Rank {
       : endpoint(world.group.rank(r), world.ledger, c.delays[static_cast<std::size_t>(r)], mix(seed * 8 + r)),
         runtime(runtime_options(c)),
         net(runtime, c.topology, network_options(c, world.plan, r)),
-        bridge(endpoint, world.plan, net, local_failure, remote_failure, counters) {}
+        bridge(endpoint, world.plan, net, local_failure, remote_failure, counters) {
+    if (c.gathering) bridge.set_gathering({microseconds(200), std::chrono::nanoseconds(0)});
+  }
 
   static csp::RuntimeOptions runtime_options(const Case& c) {
     csp::RuntimeOptions o;
@@ -570,6 +584,41 @@ TEST(Bridge, ShutdownInFlightEndsEveryRank) {
     const std::string error = m.run(where);
     if (outside.joinable()) outside.join();
     ASSERT_EQ(error, "") << where;
+  }
+}
+
+// Four low-priority processes of rank 0, each on its first turn after the
+// one before has ended, send a packet each over four cut links: the first
+// wakes the bridge, which lets the others run before it sends, and the four
+// leave in one message once the thread has nothing else to run. With no
+// gathering window each leaves alone, in a message of its own.
+TEST(Bridge, ThePacketsOfOnePassLeaveInOneMessage) {
+  for (const microseconds window : {microseconds(60'000'000), microseconds(0)}) {
+    Case c;
+    c.topology = topology::Topology::hypercube(3);
+    c.capacity = 2;
+    c.packets.assign(8, std::vector<std::uint64_t>(8, 0));
+    for (NodeId n = 0; n < 4; ++n) c.packets[n][n + 4] = 1;
+    c.send.assign(8, Pauses{});
+    c.receive.assign(8, Pauses{});
+    c.delays.assign(2, Delays{});
+    Machine m(c, 1);
+    Rank& sending = m.rank(0);
+    sending.bridge.set_gathering({window, std::chrono::nanoseconds(0)});
+    for (NodeId n = 0; n < 4; ++n) {
+      spawn_checked(
+          sending, "send " + std::to_string(n), sending.net.thread_of(n),
+          [n, out = sending.net.injector(n)]() mutable {
+            csp::yield();
+            out.write(make_packet(n, n + 4, 0));
+          },
+          csp::Priority::low);
+      spawn_receiver(m, c, n + 4, 1, 1);
+    }
+    const std::string where = "a window of " + std::to_string(window.count()) + " us";
+    ASSERT_EQ(m.run(where), "") << where;
+    EXPECT_EQ(m.world().ledger.packets(), 4u) << where;
+    EXPECT_EQ(m.world().ledger.frames_with_packets(0), window.count() > 0 ? 1u : 4u) << where;
   }
 }
 
