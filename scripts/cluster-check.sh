@@ -7,6 +7,8 @@
 # over loopback or shared memory. It checks:
 #  - images identical to one process for 2, 3 and 4 hosts on hypercube,
 #    torus and ring, with the bytes the ranks sent seen on the veth links;
+#  - a replay recorded on 3 hosts counts what one process counts, under
+#    the static schedule, and shows the packets that crossed hosts;
 #  - a host whose processes are all killed mid-run, and a rank killed alone,
 #    end the job within 10 s, non-zero, with no output file, and the
 #    launcher's message names the lost host or rank.
@@ -178,6 +180,40 @@ for topology in hypercube:4 torus:4x4 ring:16; do
     echo "cluster-check: $topology on $n hosts: image identical to one process; $sent bytes over MPI, $carried on the veth links"
   done
 done
+
+# replay_counts PAGE: what a replay page recorded, as one line: packets,
+# hops, packets by kind, the totals, packets never recorded, the ranks its
+# nodes ran on, and how many recorded packets crossed from rank to rank.
+replay_counts() {
+  python3 - "$1" <<'PY'
+import collections, json, re, sys
+page = open(sys.argv[1], encoding="utf-8").read()
+d = json.loads(re.search(r'<script type="application/json" id="replay-data">(.*?)</script>', page, re.S).group(1))
+p, ranks = d["packets"], d["ranks"] or [0] * d["nodes"]
+routes, at = [], 0
+for h in p["hops"]:
+    routes.append(p["route"][at:at + h + 1])
+    at += h + 1
+crossed = sum(any(ranks[a] != ranks[b] for a, b in zip(r, r[1:])) for r in routes)
+print(len(p["hops"]), sum(p["hops"]), sorted(collections.Counter(p["kind"]).items()), d["totals"],
+      d["unrecorded"]["packets"], "|", sorted(set(ranks)), crossed)
+PY
+}
+
+# A replay recorded across 3 hosts counts what one process counts under
+# the static schedule (the same packets of each kind, hops and totals, none
+# left unrecorded), shows each node's rank, and has packets that crossed.
+replay_args=(teapot --topology hypercube:4 --width 48 --height 48 --schedule static -q)
+"$vmpray" "${replay_args[@]}" -o one.png --replay one.html
+on_hosts 3
+"${launch[@]}" "$vmpray" "${replay_args[@]}" -o many.png --replay many.html
+one=$(replay_counts one.html)
+many=$(replay_counts many.html)
+if [[ ${one%%|*} != "${many%%|*}" || ${many##*|} != " [0, 1, 2] "* || ${many##* } == 0 ]]; then
+  echo "cluster-check: a replay recorded on 3 hosts: $many; in one process: $one" >&2
+  exit 1
+fi
+echo "cluster-check: a replay recorded on 3 hosts counts what one process counts (${one%%|*}); ${many##* } packets crossed hosts"
 
 # lose WHAT: starts a long render on 3 hosts, waits until host 2 runs its
 # rank, kills the host's every process (WHAT=host) or its rank alone
