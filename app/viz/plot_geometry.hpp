@@ -9,7 +9,7 @@
 #include <string>
 #include <vector>
 
-#include "app/viz/plot.hpp"
+#include "app/viz/line_plot.hpp"
 
 namespace viz::detail {
 

@@ -2,7 +2,7 @@
 // drawing of plot.hpp on a cairo image surface, text anti-aliased.
 #pragma once
 
-#include "app/viz/plot.hpp"
+#include "app/viz/line_plot.hpp"
 #include "tracer/image.hpp"
 
 namespace viz {
