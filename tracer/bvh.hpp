@@ -16,8 +16,8 @@
 #include <cstdint>
 #include <vector>
 
-#include "tracer/database.hpp"
 #include "tracer/geometry.hpp"
+#include "tracer/records.hpp"
 
 namespace tracer {
 

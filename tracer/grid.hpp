@@ -7,7 +7,7 @@
 // Invariants:
 //  - Top cell (x, y, z) is cells[x + dims[0] * (y + dims[1] * z)]; the cells
 //    of a subgrid follow all top cells, in the same x-fastest order,
-//    starting at the top cell's `first` (see GridCell in database.hpp).
+//    starting at the top cell's `first` (see GridCell in records.hpp).
 //  - A list cell's primitives are lists[first .. first + count), ascending ids.
 //  - Primitives are renumbered in the order the cells first list them
 //    (`order`), so the primitives of a cell lie side by side in their pages.
@@ -18,8 +18,8 @@
 #include <cstdint>
 #include <vector>
 
-#include "tracer/database.hpp"
 #include "tracer/geometry.hpp"
+#include "tracer/records.hpp"
 
 namespace tracer {
 
