@@ -16,6 +16,7 @@
 
 #include "csp/detail/process.hpp"
 #include "csp/detail/stack.hpp"
+#include "csp/detail/wait.hpp"
 #include "csp/errors.hpp"
 
 namespace csp {

@@ -18,6 +18,24 @@ thread_local void* properties_reserve = nullptr;
 }  // namespace
 
 constinit thread_local std::uint64_t detail::sleepers_woken_here = 0;
+constinit thread_local boost::fibers::scheduler* detail::runtime_scheduler_here = nullptr;
+constinit thread_local Scheduler* detail::runtime_algorithm_here = nullptr;
+
+void detail::set_thread_scheduler(boost::fibers::scheduler* s, Scheduler* algorithm) {
+  runtime_scheduler_here = s;
+  runtime_algorithm_here = algorithm;
+}
+
+detail::Process* detail::process_of(boost::fibers::context* ctx) {
+  if (!runtime_scheduler_here) return nullptr;
+  auto* props = ctx->get_properties();
+  return props ? static_cast<ProcessProps*>(props)->process : nullptr;
+}
+
+detail::Process* detail::current_process() {
+  if (!runtime_scheduler_here) return nullptr;
+  return process_of(boost::fibers::context::active());
+}
 
 static_assert(sizeof(ProcessProps) <= ProcessProps::reserve_bytes);
 

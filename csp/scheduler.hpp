@@ -27,6 +27,8 @@
 #include <boost/fiber/properties.hpp>
 #include <boost/fiber/scheduler.hpp>
 
+#include "csp/priority.hpp"
+
 namespace csp {
 
 namespace detail {
@@ -39,14 +41,6 @@ void reserve_properties();
 // calls it before it exits.
 void release_properties_reserve() noexcept;
 }  // namespace detail
-
-// A transputer's two levels. A ready high-priority process always runs
-// before a ready low-priority one of the same thread; neither preempts the
-// running process, so a low-priority process that computes for long offers
-// the thread now and then with csp::yield() (runtime.hpp), as the
-// transputer time-slices its low-priority processes. The virtual-time
-// scheduler (virtual_time.hpp) orders by clock alone.
-enum class Priority { high, low };
 
 // Boost.Fiber makes a fiber's properties when the fiber is first made
 // ready, inside a noexcept call where std::bad_alloc would end the program.
@@ -235,5 +229,31 @@ class FifoScheduler final : public Scheduler {
   ThreadTimes* times_ = nullptr;
   Arrivals* arrivals_ = nullptr;  // attached on this thread
 };
+
+namespace detail {
+
+// The scheduler of the calling runtime thread, and the csp Scheduler
+// installed in it (null on other threads); a runtime thread sets them on
+// start and clears them on exit. Cached because context::active() is a
+// costly TLS lookup in Boost's shared library, and a thread's scheduler
+// never changes.
+extern constinit thread_local boost::fibers::scheduler* runtime_scheduler_here;
+extern constinit thread_local Scheduler* runtime_algorithm_here;
+inline boost::fibers::scheduler* thread_scheduler() { return runtime_scheduler_here; }
+inline Scheduler* thread_algorithm() { return runtime_algorithm_here; }
+void set_thread_scheduler(boost::fibers::scheduler* s, Scheduler* algorithm);
+
+// The process fiber ctx runs (ctx: the calling fiber's context), from its
+// ProcessProps; null outside a Runtime and for fibers of no process.
+Process* process_of(boost::fibers::context* ctx);
+// The process the calling fiber runs, or null outside a Runtime.
+Process* current_process();
+
+// Counted on the thread that wakes: of the processes of other threads it
+// woke (detail/wait.hpp), those that found the other thread asleep. Read
+// and reset by the runtime thread itself.
+extern constinit thread_local std::uint64_t sleepers_woken_here;
+
+}  // namespace detail
 
 }  // namespace csp

@@ -5,6 +5,8 @@
 #include <sstream>
 
 #include "csp/detail/process.hpp"
+#include "csp/detail/wait.hpp"
+#include "csp/scheduler.hpp"
 
 namespace csp::detail {
 

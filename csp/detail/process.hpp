@@ -22,15 +22,18 @@
 #include <mutex>
 #include <string>
 
-#include <boost/fiber/scheduler.hpp>
 #include <boost/intrusive/list.hpp>
 
-#include "csp/detail/wait.hpp"
-#include "csp/scheduler.hpp"
+#include "csp/priority.hpp"
+
+namespace csp {
+class Arrivals;
+}  // namespace csp
 
 namespace csp::detail {
 
 class Tracker;
+struct Waiter;
 
 struct Process {
   boost::intrusive::list_member_hook<> alive;  // in its Tracker's list while alive
@@ -101,24 +104,6 @@ class Tracker {
   std::size_t dump_processes_ = 0;
   std::function<void()> on_all_ended_;
 };
-
-// Counted on the thread that wakes: processes of other threads it woke
-// (wait.cpp), and of those wakes the ones that found the other thread
-// asleep (scheduler.cpp). Read and reset by the runtime thread itself.
-extern constinit thread_local std::uint64_t remote_wakes_here;
-extern constinit thread_local std::uint64_t sleepers_woken_here;
-
-// The process the calling fiber runs, or null outside a Runtime.
-Process* current_process();
-// The process fiber ctx runs (ctx: the calling fiber's context).
-Process* process_of(boost::fibers::context* ctx);
-
-// The scheduler of the calling runtime thread (null on other threads); a
-// runtime thread sets it on start and clears it on exit.
-boost::fibers::scheduler* thread_scheduler();
-// The csp Scheduler installed in it (null likewise).
-Scheduler* thread_algorithm();
-void set_thread_scheduler(boost::fibers::scheduler* s, Scheduler* algorithm);
 
 }  // namespace csp::detail
 

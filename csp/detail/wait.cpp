@@ -42,11 +42,6 @@ std::intptr_t timed_token(const Waiter& w) { return reinterpret_cast<std::intptr
 constexpr std::size_t deferred_wake_capacity = 64;
 constinit thread_local std::array<boost::fibers::context*, deferred_wake_capacity> deferred_wakes{};
 
-// Cached here because context::active() is a costly TLS lookup in Boost's
-// shared library, and a thread's scheduler never changes.
-thread_local boost::fibers::scheduler* runtime_scheduler = nullptr;
-thread_local Scheduler* runtime_algorithm = nullptr;
-
 }  // namespace
 
 constinit thread_local std::size_t deferred_wake_count = 0;
@@ -160,7 +155,7 @@ void complete(Waiter& w, WaitState outcome, std::size_t fired) {
   std::intptr_t expected = token;
   if (ctx->twstatus.compare_exchange_strong(expected, -1, std::memory_order_acq_rel) || expected == 0) {
     // Safe to defer: ctx stays parked until it is scheduled.
-    boost::fibers::scheduler* local = runtime_scheduler;
+    boost::fibers::scheduler* local = runtime_scheduler_here;
     if (!local) local = boost::fibers::context::active()->get_scheduler();
     if (ctx->get_scheduler() == local) {
       local->schedule(ctx);
@@ -185,24 +180,6 @@ void issue_deferred_wakes() {
   remote_wakes_in_flight.fetch_sub(count, std::memory_order_seq_cst);  // every notify() has returned
 }
 
-boost::fibers::scheduler* thread_scheduler() { return runtime_scheduler; }
-Scheduler* thread_algorithm() { return runtime_algorithm; }
-void set_thread_scheduler(boost::fibers::scheduler* s, Scheduler* algorithm) {
-  runtime_scheduler = s;
-  runtime_algorithm = algorithm;
-}
-
-Process* process_of(boost::fibers::context* ctx) {
-  if (!runtime_scheduler) return nullptr;
-  auto* props = ctx->get_properties();
-  return props ? static_cast<ProcessProps*>(props)->process : nullptr;
-}
-
-Process* current_process() {
-  if (!runtime_scheduler) return nullptr;
-  return process_of(boost::fibers::context::active());
-}
-
 namespace {
 
 // For a timed wait, or an untimed one of no process: false, with w refused,
@@ -215,7 +192,7 @@ namespace {
 // waits), so that a process's untimed wait pays nothing for it; the caller
 // then unlinks and throws std::logic_error (unwind_wait()).
 bool may_park(Waiter& w, boost::fibers::context* ctx) {
-  if (runtime_scheduler || !ctx->is_context(boost::fibers::type::main_context)) return true;
+  if (runtime_scheduler_here || !ctx->is_context(boost::fibers::type::main_context)) return true;
   w.state.store(WaitState::refused, std::memory_order_relaxed);
   return false;
 }

@@ -285,6 +285,9 @@ void issue_deferred_wakes();
 // before the waker's notify() returns, so a runtime thread keeps its
 // scheduler until none is in flight (Runtime's worker_main).
 extern std::atomic<std::uint64_t> remote_wakes_in_flight;
+// Counted on the thread that wakes: the processes of other threads it woke.
+// Read and reset by the runtime thread itself.
+extern constinit thread_local std::uint64_t remote_wakes_here;
 inline void flush_wakes() {
   if (deferred_wake_count != 0) issue_deferred_wakes();
 }
