@@ -7,9 +7,9 @@ independent of each other). Within a folder, the modules include each other
 without a cycle: a module is x.hpp with x.cpp (either may be missing), and
 module x depends on module y when either file of x includes y.hpp. So a
 source file including a header whose module includes the source's own
-header back is a cycle, as two headers including each other are. The few
-cycles listed in KNOWN_CYCLES are reported on every run but pass; a listed
-one that is no longer a cycle is a problem, so the list stays true.
+header back is a cycle, as two headers including each other are; a cycle
+is a problem, and the usual way out is a header of the plain types both
+sides name.
 tests/ and examples/ may include anything and are not checked.
 
 usage: scripts/check-layers.py [--graph]   (exit 1 on any violation;
@@ -31,16 +31,6 @@ LAYERS = [
     ("app/experiments", 6),
     ("app", 7),
 ]
-# Module cycles that stand for now, each as its set of modules; in each a
-# .cpp uses helpers whose headers name its own types, and breaking it means
-# a header of those types alone: the database built from its BVH and grid,
-# the scheduler and the process records and waits it runs, the line plot and
-# its geometry and raster helpers.
-KNOWN_CYCLES = [
-    {"csp/detail/process", "csp/detail/wait", "csp/scheduler"},
-    {"tracer/bvh", "tracer/database", "tracer/grid"},
-    {"app/viz/plot", "app/viz/plot_geometry", "app/viz/plot_raster"},
-]
 INCLUDE = re.compile(r'^\s*#\s*include\s+"([^"]+)"', re.M)
 
 
@@ -61,7 +51,7 @@ def module_of(path):
 def main():
     root = pathlib.Path(__file__).resolve().parent.parent
     rank = dict(LAYERS)
-    problems, notes = [], []
+    problems = []
     between = collections.Counter()
     modules = collections.defaultdict(lambda: collections.defaultdict(set))  # folder -> module -> modules
     for source in sorted(root.rglob("*")):
@@ -91,17 +81,11 @@ def main():
         line = f"{folder}: include cycle " + " -> ".join(cycle + [cycle[0]])
         if len(component) > len(cycle):
             line += " (and " + ", ".join(sorted(component - set(cycle))) + " in cycles with them)"
-        if component in KNOWN_CYCLES:
-            notes.append(line + " (known, see KNOWN_CYCLES)")
-        else:
-            problems.append(line)
-    for known in KNOWN_CYCLES:
-        if not any(component == known for _, (component, _) in found):
-            problems.append("KNOWN_CYCLES: " + ", ".join(sorted(known)) + " is no longer a cycle; remove it")
+        problems.append(line)
     if "--graph" in sys.argv[1:]:
         for (a, b), n in sorted(between.items()):
             print(f"{a} -> {b}: {n}")
-    for line in notes + problems:
+    for line in problems:
         print(line, file=sys.stderr)
     print(f"check-layers: {len(problems)} problem(s); {sum(len(g) for g in modules.values())} modules "
           f"of {len(modules)} folders", file=sys.stderr)
