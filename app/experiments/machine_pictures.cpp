@@ -11,7 +11,7 @@
 #include "app/render/output_files.hpp"
 #include "app/viz/ownership.hpp"
 #include "nodes/machine/messages.hpp"
-#include "topology/spec.hpp"
+#include "topology/topology.hpp"
 
 namespace app {
 
@@ -48,8 +48,8 @@ viz::MachineDrawing machine_shape(const topology::Topology& topo) {
 }
 
 viz::MachineDrawing machine_drawing(const nodes::MachineReport& report) {
-  viz::MachineDrawing m = machine_shape(topology::parse_topology(report.topology));
-  m.title = report.topology + ": pixels computed (fill), pages served (ring), link traffic";
+  viz::MachineDrawing m = machine_shape(report.topology);
+  m.title = report.topology.spec() + ": pixels computed (fill), pages served (ring), link traffic";
   for (const nodes::NodeReport& n : report.per_node)
     m.nodes.push_back(viz::NodeWork{.pixels = n.work.items, .page_requests_served = n.served.pages_served});
   for (const nodes::LinkStats& l : report.network.links)
@@ -73,7 +73,8 @@ std::vector<std::uint16_t> pixel_owners(const nodes::MachineReport& report, int 
 
 viz::Timeline timeline(const nodes::MachineReport& report) {
   viz::Timeline t;
-  t.title = report.topology + ", " + std::to_string(report.threads) + (report.threads == 1 ? " thread" : " threads") +
+  t.title = report.topology.spec() + ", " + std::to_string(report.threads) +
+            (report.threads == 1 ? " thread" : " threads") +
             (report.ranks.empty() ? "" : " per rank, " + std::to_string(report.ranks.size()) + " ranks") +
             ": tiles over time";
   t.time_axis = !report.model ? "wall time (s)" : "virtual time (s)";
@@ -89,7 +90,7 @@ viz::KeyValueTable machine_statistics(const nodes::MachineReport& r) {
   const tracer::RayStats rays = r.rays();
   const nodes::SvmStats svm = r.svm();
   viz::KeyValueTable t{.caption = "Run"};
-  t.rows = {{"topology", r.topology},
+  t.rows = {{"topology", r.topology.spec()},
             {"processors", std::to_string(r.nodes)},
             {"cache per node (pages)", std::to_string(r.cache_pages)},
             {"database pages", std::to_string(r.page_count) + " of " + std::to_string(r.page_size) + " bytes"},
@@ -181,7 +182,7 @@ std::vector<std::filesystem::path> write_machine_pictures(const PictureFiles& fi
   if (!files.report_html.empty()) {
     // The page takes the image and the ownership picture themselves: a copy
     // of either would be one more image-sized buffer at the outputs' peak.
-    viz::Section run{.heading = "The run on " + report.topology};
+    viz::Section run{.heading = "The run on " + report.topology.spec()};
     run.blocks.push_back(viz::ImageFigure{.caption = "rendered image", .image = std::move(image)});
     run.blocks.push_back(machine_statistics(report));
     for (viz::Table& t : machine_tables(report)) run.blocks.push_back(std::move(t));

@@ -325,8 +325,7 @@ nodes::RecordedTraffic record_render_traffic(const NetworkStudyOptions& o, const
   Options render;
   render.width = render.height = o.scene_size;
   nodes::MachineOptions m;
-  m.topology = t.spec();
-  m.nodes = t.size();
+  m.topology = t;
   m.threads = 1;
   m.timing = o.model;
   m.record = true;

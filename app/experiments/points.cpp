@@ -9,12 +9,13 @@
 #include <stdexcept>
 #include <thread>
 
+#include "topology/spec.hpp"
+
 namespace app {
 
 nodes::MachineOptions machine_options(const ExperimentSetup& setup) {
   nodes::MachineOptions options;
-  options.topology = setup.topology;
-  options.nodes = setup.nodes;
+  options.topology = topology::parse_topology(setup.topology, setup.nodes);
   options.cache_pages = setup.cache_pages;
   options.grain = setup.grain;
   options.prefetch = setup.prefetch;
@@ -29,7 +30,7 @@ ExperimentPoint run_point(const tracer::Database& db, const ExperimentSetup& set
   const nodes::MachineResult result = nodes::run_machine(db, machine_options(setup));
   const nodes::MachineReport& r = result.report;
   ExperimentPoint p;
-  p.topology = r.topology;
+  p.topology = r.topology.spec();
   p.nodes = r.nodes;
   p.cache_pages = r.cache_pages;
   p.predicted_seconds = r.predicted_seconds;

@@ -152,7 +152,7 @@ tracer::Image tile_map(const nodes::MachineReport& report, const std::vector<Til
 // the stage the page draws the run on.
 viz::MachineDrawing stage(const nodes::MachineReport& report) {
   viz::MachineDrawing m = machine_drawing(report);
-  m.title = report.topology + ": the run replayed";
+  m.title = report.topology.spec() + ": the run replayed";
   for (viz::NodeWork& n : m.nodes) n = viz::NodeWork{};
   for (viz::LinkTraffic& l : m.links) l.packets = l.bytes = 0;
   return m;
@@ -195,7 +195,7 @@ Json replay_data(const ReplaySource& source) {
       unrecorded_by_kind[std::string(nodes::message_kind_name(static_cast<std::uint8_t>(k)))] = rec.unrecorded[k];
   const int width = source.image->width(), height = source.image->height();
   return {{"title", source.title},
-          {"topology", report.topology},
+          {"topology", report.topology.spec()},
           {"nodes", report.nodes},
           {"workers", report.workers_per_node},
           {"timing", rec.virtual_time ? "virtual" : "real"},

@@ -48,8 +48,7 @@ nodes::MachineResult run_with_progress(tracer::Database db, nodes::MachineOption
 SerialComparison run_serial(const tracer::Database& db, const nodes::MachineOptions& machine,
                             const Options& o) {
   nodes::MachineOptions one = machine;
-  one.topology = "complete";
-  one.nodes = 1;
+  one.topology = topology::Topology::complete(1);
   one.trace_routes = 0;
   one.record = false;
   const nodes::MachineResult r = run_with_progress(db, one, o, " (1 node)");

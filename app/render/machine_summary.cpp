@@ -10,7 +10,7 @@
 
 #include "app/render/wording.hpp"
 #include "nodes/machine/messages.hpp"
-#include "topology/spec.hpp"
+#include "topology/topology.hpp"
 
 namespace app {
 namespace {
@@ -114,7 +114,7 @@ namespace {
 
 void print_ranks(std::ostream& out, const nodes::MachineReport& r) {
   if (r.ranks.empty()) return;
-  const topology::Topology t = topology::parse_topology(r.topology);
+  const topology::Topology& t = r.topology;
   std::size_t links = 0;
   for (topology::NodeId n = 0; n < t.size(); ++n) links += t.degree(n);
   out << "ranks          " << r.ranks.size() << " processes, " << r.cut_links << " of " << links / 2
@@ -244,7 +244,7 @@ void print_machine_report(std::ostream& out, const MachineSummary& m) {
   const nodes::SvmStats svm = r.svm();
   const nodes::ServerCounters served = r.served();
   out << std::fixed << std::setprecision(1);
-  out << "machine        " << r.topology << ": " << count_of(r.nodes, "node") << ", "
+  out << "machine        " << r.topology.spec() << ": " << count_of(r.nodes, "node") << ", "
       << count_of(r.workers_per_node, "pixel computer") << " each (prefetch " << r.prefetch << "), "
       << nodes::schedule_name(r.schedule) << " schedule";
   if (r.schedule != nodes::Schedule::static_split) out << " (grain " << r.grain;
@@ -262,7 +262,7 @@ void print_machine_report(std::ostream& out, const MachineSummary& m) {
       << served.bytes_served << " bytes; " << r.rays().pages_per_sample()
       << " distinct pages per " << (m.corner_samples ? "sample" : "pixel") << "\n";
   print_per_node(out, r, m.corner_samples ? "samples" : "pixels");
-  out << nodes::format_summary(r.network, topology::parse_topology(r.topology), kind_name);
+  out << nodes::format_summary(r.network, r.topology, kind_name);
   print_ranks(out, r);
   out << std::setprecision(3) << "wall time      " << r.wall_seconds << " s on ";
   if (r.ranks.empty())
@@ -307,7 +307,7 @@ Json cost_model_json(const nodes::CostModel& model) {
 Json machine_json(const MachineSummary& m) {
   const nodes::MachineReport& r = m.report;
   const nodes::ServerCounters served = r.served();
-  Json j = {{"topology", r.topology},
+  Json j = {{"topology", r.topology.spec()},
             {"nodes", r.nodes},
             {"threads", r.threads},
             {"workers_per_node", r.workers_per_node},

@@ -55,7 +55,7 @@
 #include "nodes/machine/work_plan.hpp"
 #include "nodes/net/network.hpp"
 #include "nodes/net/thread_relay.hpp"
-#include "topology/spec.hpp"
+#include "topology/topology.hpp"
 #include "tracer/tessellate.hpp"
 #include "tracer/vec.hpp"
 
@@ -127,7 +127,7 @@ std::uint64_t image_memory_bytes(const Options& o, int width, int height) {
   const std::uint64_t items =
       o.spd_procedure ? static_cast<std::uint64_t>(width + 1) * static_cast<std::uint64_t>(height + 1) : pixels;
   const std::uint64_t per_node = static_cast<std::uint64_t>(o.machine.workers_per_node);
-  const std::uint64_t nodes = topology::parse_topology(o.machine.topology, o.machine.nodes).size();
+  const std::uint64_t nodes = o.machine.topology.size();
   std::uint64_t bytes = std::max(machine_run_bytes(o, pixels, items, nodes * per_node),
                                  machine_output_bytes(o, pixels, items));
   if (o.compare_serial || o.machine.timing) bytes = std::max(bytes, machine_run_bytes(o, pixels, items, per_node));
@@ -269,7 +269,7 @@ std::uint64_t relayed_link_queues(const nodes::MachineOptions& m, const topology
 
 MachineMemory machine_memory(const Options& o, std::uint32_t page_count) {
   const nodes::MachineOptions& m = o.machine;
-  const topology::Topology t = topology::parse_topology(m.topology, m.nodes);
+  const topology::Topology& t = m.topology;
   const bool virtual_time = m.timing.has_value();
   const auto workers = static_cast<std::uint64_t>(m.workers_per_node);
   MachineMemory r;

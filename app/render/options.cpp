@@ -119,15 +119,15 @@ void check_render(Options& o, const Raw& raw, const po::variables_map& vm) {
 
 // A bare kind takes --nodes (default 16); a full spec stands alone or must agree.
 void check_topology(nodes::MachineOptions& m, const Raw& raw, const po::variables_map& vm) {
-  m.topology = raw.topology;
-  if (vm.count("nodes")) m.nodes = in_range<std::size_t>(raw.nodes, 1, topology::max_nodes, "--nodes");
-  else if (raw.topology.find(':') != std::string::npos) m.nodes.reset();
+  std::optional<std::size_t> nodes = 16;
+  if (vm.count("nodes")) nodes = in_range<std::size_t>(raw.nodes, 1, topology::max_nodes, "--nodes");
+  else if (raw.topology.find(':') != std::string::npos) nodes.reset();
   try {
-    topology::parse_topology(m.topology, m.nodes);
+    m.topology = topology::parse_topology(raw.topology, nodes);
   } catch (const std::invalid_argument& e) {
     throw UsageError(std::string("--topology: ") + e.what());
   }
-  if (m.nodes) check_grid_shape(m.topology, *m.nodes);
+  if (nodes) check_grid_shape(raw.topology, *nodes);
 }
 
 // The cache's rules (one of the two, at least a page) are the machine's,

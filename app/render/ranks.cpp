@@ -8,7 +8,7 @@
 
 #include "app/render/cpu_count.hpp"
 #include "app/render/machine_run.hpp"
-#include "topology/spec.hpp"
+#include "topology/topology.hpp"
 
 namespace app {
 
@@ -20,7 +20,7 @@ void check_rank_options(const Options& o, int ranks) {
   if (o.compare_serial) throw UsageError("--compare-serial" + over + ": it runs the 1-node machine beside this one");
   if (o.machine.timing)
     throw UsageError("--timing virtual" + over + ": one virtual clock orders the whole machine");
-  const std::size_t nodes = topology::parse_topology(o.machine.topology, o.machine.nodes).size();
+  const std::size_t nodes = o.machine.topology.size();
   if (static_cast<std::size_t>(ranks) > nodes)
     throw UsageError(std::to_string(ranks) + " MPI ranks for a machine of " + std::to_string(nodes) +
                      (nodes == 1 ? " node" : " nodes") + ": every rank needs one; use more --nodes or fewer ranks");

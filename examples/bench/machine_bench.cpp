@@ -36,6 +36,7 @@
 
 #include "examples/bench/bench_args.hpp"
 #include "nodes/machine/machine.hpp"
+#include "topology/spec.hpp"
 #include "tracer/generators.hpp"
 #include "tracer/render.hpp"
 
@@ -92,8 +93,7 @@ void run_machine_once(MachineRun& run, const std::string& spec, int size, int no
   try {
     auto db = make_db(spec, size, build);  // not timed, as for the single process
     nodes::MachineOptions options;
-    options.topology = "hypercube";
-    options.nodes = static_cast<std::size_t>(nodes);
+    options.topology = topology::parse_topology("hypercube", static_cast<std::size_t>(nodes));
     options.threads = threads;
     options.cache_pages = std::max<std::uint32_t>(1, db.header.page_count / 8);
     if (variant) variant(options, db.header);

@@ -25,6 +25,7 @@
 
 #include "examples/bench/bench_args.hpp"
 #include "nodes/machine/machine.hpp"
+#include "topology/spec.hpp"
 #include "tracer/generators.hpp"
 #include "tracer/render.hpp"
 
@@ -94,8 +95,7 @@ bool run_case(const Case& c, int size, int repeats) {
     {
       tracer::Database copy = db;  // run_machine takes the database; the copy is not timed
       nodes::MachineOptions options;
-      options.topology = "hypercube";
-      options.nodes = static_cast<std::size_t>(c.nodes);
+      options.topology = topology::parse_topology("hypercube", static_cast<std::size_t>(c.nodes));
       options.threads = 1;
       const double start = cpu_seconds();
       const nodes::MachineResult result = nodes::run_machine(std::move(copy), options);

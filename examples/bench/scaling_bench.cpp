@@ -32,6 +32,7 @@
 
 #include "examples/bench/bench_args.hpp"
 #include "nodes/machine/machine.hpp"
+#include "topology/spec.hpp"
 #include "tracer/generators.hpp"
 #include "tracer/render.hpp"
 
@@ -129,8 +130,7 @@ MachineSample run_machine(const Case& c, const tracer::Database& source, unsigne
                           const std::vector<tracer::Color>& reference, bool& differs) {
   tracer::Database db = source;  // copied outside the timed part, as the plain side's is built
   nodes::MachineOptions options;
-  options.topology = "hypercube";
-  options.nodes = static_cast<std::size_t>(c.nodes);
+  options.topology = topology::parse_topology("hypercube", static_cast<std::size_t>(c.nodes));
   options.threads = threads;  // 0: the default rule
   options.workers_per_node = c.workers;
   if (c.cache_pages) options.cache_pages = c.cache_pages;

@@ -496,7 +496,7 @@ MachineReport machine_report(const csp::Runtime& runtime, const Network& net, co
                              std::uint32_t cache_pages, std::uint32_t items,
                              const std::vector<std::unique_ptr<NodeState>>& nodes) {
   MachineReport report;
-  report.topology = net.topology().spec();
+  report.topology = net.topology();
   report.nodes = static_cast<int>(net.topology().size());
   report.threads = runtime.threads();
   report.workers_per_node = options.workers_per_node;
@@ -630,7 +630,7 @@ Executed execute(const tracer::DatabaseHeader& header, const topology::Topology&
 
 MachineResult run_machine(tracer::Database db, const MachineOptions& options) {
   check_options(options, db.header.page_size);
-  const auto topology = topology::parse_topology(options.topology, options.nodes);
+  const topology::Topology& topology = options.topology;
   const std::uint32_t cache_pages = cache_pages_for(options, db.header);
   const PagePlacement placement(options.distribution, static_cast<int>(topology.size()), db.header.page_count);
   auto nodes = distribute(db, placement, cache_pages);
@@ -776,7 +776,7 @@ std::optional<MachineResult> run_machine_rank(std::optional<tracer::Database> db
   check_fields(options);
   if (options.timing)
     throw OptionError("timing", "virtual time cannot run over several processes (one clock orders the machine)");
-  const auto topology = topology::parse_topology(options.topology, options.nodes);
+  const topology::Topology& topology = options.topology;
   const RankPlan plan(topology, transport.size());
   std::vector<std::unique_ptr<NodeState>> nodes(topology.size());
   tracer::DatabaseHeader header;

@@ -36,6 +36,7 @@
 #include "nodes/ranks/bridge.hpp"
 #include "nodes/ranks/rank_plan.hpp"
 #include "nodes/ranks/transport.hpp"
+#include "topology/topology.hpp"
 #include "tracer/database.hpp"
 #include "tracer/image.hpp"
 #include "tracer/render.hpp"
@@ -43,8 +44,7 @@
 namespace nodes {
 
 struct MachineOptions {
-  std::string topology = "hypercube";  // a kind, or a full spec such as "hypercube:4"
-  std::optional<std::size_t> nodes = 16;  // with a bare kind; must agree with a full spec
+  topology::Topology topology = topology::Topology::hypercube(4);  // 16 nodes; topology::parse_topology reads a spec
   unsigned threads = 0;                // 0: thread_count()'s choice; never more than the nodes
   unsigned cpus = 0;                   // the CPUs threads = 0 may use; 0: the host's
   bool relay_between_threads = true;   // links between threads through relays (NetworkOptions)
@@ -99,7 +99,7 @@ inline std::uint16_t max_prefetch(const MachineOptions& options) {
 }
 
 struct MachineReport {
-  std::string topology;  // canonical spec
+  topology::Topology topology = topology::Topology::complete(1);  // the machine's; spec() names it
   int nodes = 0;
   unsigned threads = 0;
   int workers_per_node = 0;
@@ -195,8 +195,7 @@ std::uint32_t default_cache_pages(const tracer::DatabaseHeader& header);
 std::uint32_t cache_pages_for(const MachineOptions& options, const tracer::DatabaseHeader& header);
 
 // Renders db's frame on the machine; consumes db (its pages move to their
-// owners). Throws OptionError for bad options, topology::parse_topology's
-// std::invalid_argument for a bad topology, ResourceError when the system
+// owners). Throws OptionError for bad options, ResourceError when the system
 // has no memory or thread to give, and whatever a process throws.
 MachineResult run_machine(tracer::Database db, const MachineOptions& options);
 

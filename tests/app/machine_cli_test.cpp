@@ -518,8 +518,8 @@ using test::parse;
 TEST(MachineOptions, DefaultIsASixteenNodeHypercubeWithTheDefaultCache) {
   const app::Options o = parse({});
   EXPECT_FALSE(o.single);
-  EXPECT_EQ(o.machine.topology, "hypercube");
-  EXPECT_EQ(o.machine.nodes, 16u);
+  EXPECT_EQ(o.machine.topology.spec(), "hypercube:4");
+  EXPECT_EQ(o.machine.topology.size(), 16u);
   EXPECT_FALSE(o.machine.cache_pages);
   EXPECT_FALSE(o.machine.cache_kb);
   EXPECT_EQ(o.machine.schedule, nodes::Schedule::affinity);
@@ -529,9 +529,9 @@ TEST(MachineOptions, DefaultIsASixteenNodeHypercubeWithTheDefaultCache) {
 
 TEST(MachineOptions, AFullSpecNeedsNoNodeCount) {
   const app::Options o = parse({"--topology", "mesh:4x2"});
-  EXPECT_EQ(o.machine.topology, "mesh:4x2");
-  EXPECT_FALSE(o.machine.nodes);
-  EXPECT_EQ(parse({"--topology", "torus:2x2", "--nodes", "4"}).machine.nodes, 4u);
+  EXPECT_EQ(o.machine.topology.spec(), "mesh:4x2");
+  EXPECT_EQ(o.machine.topology.size(), 8u);  // not the default 16
+  EXPECT_EQ(parse({"--topology", "torus:2x2", "--nodes", "4"}).machine.topology.size(), 4u);
 }
 
 TEST(MachineOptions, ValuesReachTheMachine) {

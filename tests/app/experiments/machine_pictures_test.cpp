@@ -11,6 +11,7 @@
 
 #include "app/experiments/machine_pictures.hpp"
 #include "app/viz/colour.hpp"
+#include "topology/spec.hpp"
 #include "tests/app/viz/xml_check.hpp"
 #include "tracer/generators.hpp"
 
@@ -23,8 +24,7 @@ nodes::MachineResult small_run(bool corners, bool record_tiles = true) {
   scene.camera.width = 12;
   scene.camera.height = 10;
   nodes::MachineOptions options;
-  options.topology = "mesh:2x2";
-  options.nodes = std::nullopt;
+  options.topology = topology::parse_topology("mesh:2x2");
   options.threads = 1;
   options.trace.spd_procedure = corners;
   options.timing = nodes::ipsc2_profile();

@@ -69,8 +69,7 @@ struct Case {
 
 nodes::MachineResult run_case(const Case& c) {
   MachineOptions options;
-  options.topology = c.topology;
-  options.nodes = c.nodes;
+  options.topology = topology::parse_topology(c.topology, c.nodes);
   options.threads = c.threads;
   auto db = make_db(c.scene, c.page_size, c.size);
   options.cache_pages = c.cache_pages ? c.cache_pages : db.header.page_count;
@@ -170,8 +169,7 @@ TEST(Machine, RelaysCarryEveryPacketBetweenThreadsOnce) {
   EXPECT_EQ(received, expected);
 
   MachineOptions options;
-  options.topology = c.topology;
-  options.nodes = c.nodes;
+  options.topology = topology::parse_topology(c.topology, c.nodes);
   options.threads = 2;
   options.relay_between_threads = false;
   auto db = make_db(c.scene, c.page_size, c.size);
@@ -209,7 +207,7 @@ TEST(Machine, RoutingInPlaceComputesWhatTheRoutersAloneCompute) {
       EXPECT_GT(in_place.report.served().served_in_place, 0u);
       EXPECT_LE(in_place.report.served().served_in_place, in_place.report.served().pages_served);
       EXPECT_EQ(in_place.report.served().pages_served, in_place.report.svm().misses);
-      const auto t = topology::parse_topology(in_place.report.topology);
+      const auto& t = in_place.report.topology;
       EXPECT_LE(in_place.report.network.hops.max_hops, t.diameter());
       EXPECT_GT(in_place.report.network.hops.packets, 0u);
     }
@@ -278,8 +276,7 @@ TEST(Machine, EveryPixelIsComputedExactlyOnce) {
 // frame's items, on the collector's one thread.
 TEST(Machine, ProgressStartsAtZeroAndEndsAtTheFrame) {
   MachineOptions options;
-  options.topology = "ring";
-  options.nodes = 4;
+  options.topology = topology::parse_topology("ring", 4);
   options.threads = 2;
   auto db = make_db("teapot:2", 1024, 16);
   options.cache_pages = db.header.page_count;
@@ -369,8 +366,7 @@ TEST(Machine, ResidentSceneBytesStayWithinOwnShareAndCache) {
 
 TEST(Machine, LargeSceneOn64NodesKeepsASmallFractionPerProcessor) {
   MachineOptions options;
-  options.topology = "hypercube";
-  options.nodes = 64;
+  options.topology = topology::parse_topology("hypercube", 64);
   options.threads = 1;
   options.cache_pages = 64;
   auto db = make_db("tetra:7", 1024, 16);
@@ -422,7 +418,7 @@ TEST(Machine, DefaultCacheIsAnEighthOfTheDatabaseButNeverTooSmallForARay) {
   const std::uint32_t pages = db.header.page_count;
   ASSERT_LT(pages, 16u);
   MachineOptions options;
-  options.nodes = 16;
+  options.topology = topology::parse_topology("hypercube", 16);
   options.threads = 1;
   const auto result = nodes::run_machine(std::move(db), options);
   for (const auto& node : result.report.per_node) {
@@ -458,7 +454,7 @@ TEST(Machine, DefaultThreadsLeaveEachThreadTwoPixelComputers) {
 
   // And a run takes what the rule says.
   MachineOptions run;
-  run.nodes = 4;
+  run.topology = topology::parse_topology("hypercube", 4);
   run.cpus = 4;
   EXPECT_EQ(nodes::run_machine(make_db("balls:1", 1024, 16), run).report.threads, 2u);
 }
@@ -470,9 +466,8 @@ TEST(Machine, PageCommunicationsEqualMissesWithSharedCaches) {
 }
 
 void expect_error(const Case& c, MachineOptions options, const std::string& fragment) {
-  options.topology = c.topology;
-  options.nodes = c.nodes;
   try {
+    options.topology = topology::parse_topology(c.topology, c.nodes);
     nodes::run_machine(make_db(c.scene, c.page_size, 8), options);
     ADD_FAILURE() << "no error for " << fragment;
   } catch (const std::invalid_argument& e) {

@@ -26,8 +26,7 @@ struct RecordedRun {
 RecordedRun recorded_run(const std::string& spec, std::size_t nodes, bool virtual_time, std::uint64_t max_packets,
                          unsigned threads = 1, int workers = 1) {
   nodes::MachineOptions options;
-  options.topology = spec;
-  options.nodes = nodes;
+  options.topology = topology::parse_topology(spec, nodes);
   options.threads = threads;
   options.workers_per_node = workers;
   options.cache_pages = 8;
@@ -186,7 +185,7 @@ TEST(Recorder, ABudgetOfNoneCountsEveryPacket) {
 
 TEST(Recorder, AnUnrecordedRunHasNoRecording) {
   nodes::MachineOptions options;
-  options.nodes = 4;
+  options.topology = topology::parse_topology("hypercube", 4);
   options.threads = 1;
   const auto result = nodes::run_machine(test::make_db("teapot:2", 1024, 16), options);
   EXPECT_EQ(result.report.recording, nullptr);

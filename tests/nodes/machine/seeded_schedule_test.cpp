@@ -27,6 +27,7 @@
 #include "nodes/machine/machine.hpp"
 #include "nodes/machine/messages.hpp"
 #include "tests/nodes/machine/test_database.hpp"
+#include "topology/spec.hpp"
 
 namespace {
 
@@ -62,8 +63,7 @@ std::string describe(const Config& c) {
 
 MachineOptions options_for(const Config& c, std::optional<std::uint64_t> seed) {
   MachineOptions o;
-  o.topology = c.topology;
-  o.nodes = c.nodes;
+  o.topology = topology::parse_topology(c.topology, c.nodes);
   o.threads = 1;
   o.cache_pages = c.cache_pages;
   o.schedule = c.schedule;

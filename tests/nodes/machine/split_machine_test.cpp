@@ -91,8 +91,7 @@ std::string describe(const Case& c) {
 
 MachineOptions options_for(const Case& c, const tracer::Database& db) {
   MachineOptions o;
-  o.topology = c.topology;
-  o.nodes = std::nullopt;
+  o.topology = topology::parse_topology(c.topology);
   o.threads = c.threads;
   o.cache_pages = c.cache_pages ? c.cache_pages : db.header.page_count;
   o.schedule = c.schedule;

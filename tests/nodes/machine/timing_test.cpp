@@ -103,8 +103,7 @@ nodes::MachineResult run_timed(const std::string& topology, std::size_t n, unsig
   nodes::MachineOptions options;
   options.workers_per_node = workers_per_node;
   options.record_tiles = record_tiles;
-  options.topology = topology;
-  options.nodes = n;
+  options.topology = topology::parse_topology(topology, n);
   options.threads = threads;
   options.cache_pages = 4;
   options.timing = model;
