@@ -17,10 +17,7 @@ nodes::MachineOptions machine_options(const ExperimentSetup& setup) {
   nodes::MachineOptions options;
   options.topology = topology::parse_topology(setup.topology, setup.nodes);
   options.cache_pages = setup.cache_pages;
-  options.grain = setup.grain;
-  options.prefetch = setup.prefetch;
-  options.schedule = setup.schedule;
-  options.pixel_order = setup.pixel_order;
+  options.farming = setup.farming;
   options.timing = setup.model;
   options.trace = setup.trace;
   return options;

@@ -22,14 +22,16 @@
 
 namespace app {
 
+// The paper's farming: dynamic, scanline, tiles of 4 pixels, each asked for
+// when its processor is idle.
+inline constexpr nodes::Farming paper_farming{
+    .grain = 4, .prefetch = 0, .schedule = nodes::Schedule::dynamic, .pixel_order = nodes::PixelOrder::scanline};
+
 struct ExperimentSetup {
   std::string topology = "hypercube";
   std::size_t nodes = 1;
   std::optional<std::uint32_t> cache_pages;  // default: nodes::default_cache_pages
-  std::uint32_t grain = 4;
-  std::uint16_t prefetch = 0;  // the paper's protocol: a processor asks for work when idle
-  nodes::Schedule schedule = nodes::Schedule::dynamic;
-  nodes::PixelOrder pixel_order = nodes::PixelOrder::scanline;
+  nodes::Farming farming = paper_farming;
   nodes::CostModel model = nodes::ipsc2_profile();
   tracer::TraceOptions trace;
 };

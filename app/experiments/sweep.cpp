@@ -66,7 +66,10 @@ std::vector<std::string> split(const std::string& text) {
 struct RawSweep {
   std::string kind, topologies = "hypercube", nodes, cache, out;
   std::int64_t size = 64, jobs = 0;
-  SharedChoice shared{.grain = 4, .prefetch = 0, .schedule = "dynamic", .pixel_order = "scanline"};
+  SharedChoice shared{.grain = paper_farming.grain,
+                      .prefetch = paper_farming.prefetch,
+                      .schedule = nodes::schedule_name(paper_farming.schedule),
+                      .pixel_order = nodes::pixel_order_name(paper_farming.pixel_order)};
   TimingChoice model;
 };
 
@@ -109,10 +112,7 @@ void check_machines(const SweepOptions& o, bool nodes_given) {
       check_grid_shape(topology, n);
     }
   nodes::MachineOptions machine;
-  machine.grain = o.grain;
-  machine.prefetch = o.prefetch;
-  machine.schedule = o.schedule;
-  machine.pixel_order = o.pixel_order;
+  machine.farming = o.farming;
   try {
     nodes::check_options(machine, o.page_size);
   } catch (const nodes::OptionError& e) {
@@ -130,11 +130,7 @@ void check_sweep(SweepOptions& o, const RawSweep& raw, const po::variables_map& 
   o.accel = database.accel;
   o.bvh_layout = database.bvh_layout;
   o.trace.shadow_rays_to_all_lights = database.shadow_rays_all;
-  const FarmingChoice farming = parse_farming(raw.shared, vm);
-  o.grain = farming.grain;
-  o.prefetch = farming.prefetch;
-  o.schedule = farming.schedule;
-  o.pixel_order = farming.pixel_order;
+  o.farming = parse_farming(raw.shared, vm);
   o.jobs = in_range<unsigned>(raw.jobs, 0, 1024, "--jobs");
   if (o.jobs == 0) o.jobs = usable_cpus();
   if (vm.count("fit-seconds") && !(o.fit_seconds > 0 && std::isfinite(o.fit_seconds)))
@@ -230,10 +226,7 @@ namespace {
 // in its order.
 std::vector<ExperimentSetup> sweep_setups(const SweepOptions& o, const tracer::Database& db) {
   ExperimentSetup setup;
-  setup.grain = o.grain;
-  setup.prefetch = o.prefetch;
-  setup.schedule = o.schedule;
-  setup.pixel_order = o.pixel_order;
+  setup.farming = o.farming;
   setup.model = o.model;
   setup.trace = o.trace;
   setup.nodes = 1;
@@ -265,9 +258,10 @@ SweepTable run_sweep(const SweepOptions& o, std::ostream* progress) {
   table.page_count = db.header.page_count;
   table.tracing = accel_description(o.accel, o.bvh_layout) + ", shadow rays " +
                   (o.trace.shadow_rays_to_all_lights ? "all" : "facing");
-  table.farming = std::string(nodes::schedule_name(o.schedule)) + " schedule" +
-                  (o.schedule == nodes::Schedule::static_split ? "" : ", grain " + std::to_string(o.grain)) +
-                  ", prefetch " + std::to_string(o.prefetch) + ", " + nodes::pixel_order_name(o.pixel_order) +
+  const nodes::Farming& f = o.farming;
+  table.farming = std::string(nodes::schedule_name(f.schedule)) + " schedule" +
+                  (f.schedule == nodes::Schedule::static_split ? "" : ", grain " + std::to_string(f.grain)) +
+                  ", prefetch " + std::to_string(f.prefetch) + ", " + nodes::pixel_order_name(f.pixel_order) +
                   " order";
   const std::vector<ExperimentSetup> setups = sweep_setups(o, db);
   table.model = setups.front().model;

@@ -35,10 +35,7 @@ struct SweepOptions {
   std::vector<std::string> topologies{"hypercube"};
   std::vector<std::size_t> nodes{1, 2, 4, 8, 16, 32, 64};  // sweep nodes: the axis; cache: the first
   std::vector<std::uint32_t> cache_pages;  // sweep cache: the axis; nodes: the first (empty: default)
-  std::uint32_t grain = 4;
-  std::uint16_t prefetch = 0;
-  nodes::Schedule schedule = nodes::Schedule::dynamic;
-  nodes::PixelOrder pixel_order = nodes::PixelOrder::scanline;
+  nodes::Farming farming = paper_farming;
   nodes::CostModel model = nodes::ipsc2_profile();
   tracer::Accel accel = tracer::Accel::bvh;
   tracer::BvhLayout bvh_layout = tracer::BvhLayout::treelet;

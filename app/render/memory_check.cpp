@@ -73,20 +73,20 @@ constexpr std::uint64_t csv_line = 40;                                   // a ti
 // The items of the largest tile a pixel computer gets, one of `workers`.
 std::uint64_t largest_tile(const nodes::MachineOptions& m, std::uint64_t items, std::uint64_t workers) {
   const std::uint64_t share = (items + workers - 1) / workers;
-  switch (m.schedule) {
+  switch (m.farming.schedule) {
     case nodes::Schedule::static_split: return share;
-    case nodes::Schedule::dynamic: return std::min<std::uint64_t>(m.grain, items);
+    case nodes::Schedule::dynamic: return std::min<std::uint64_t>(m.farming.grain, items);
     case nodes::Schedule::affinity: break;
   }
   // The first tile off a worker's own share; what it takes from others later is smaller.
   const std::uint64_t parts = std::max<std::uint64_t>(workers, nodes::WorkPlan::min_affinity_parts);
-  return std::min(share, std::max<std::uint64_t>(m.grain, (share + parts - 1) / parts));
+  return std::min(share, std::max<std::uint64_t>(m.farming.grain, (share + parts - 1) / parts));
 }
 
 // The tiles of a dynamic run whose tiles are recorded; 0 otherwise.
 std::uint64_t recorded_tiles(const nodes::MachineOptions& m, std::uint64_t items) {
-  if ((!m.record_tiles && !m.record) || m.schedule != nodes::Schedule::dynamic) return 0;
-  return (items + m.grain - 1) / m.grain;
+  if ((!m.record_tiles && !m.record) || m.farming.schedule != nodes::Schedule::dynamic) return 0;
+  return (items + m.farming.grain - 1) / m.farming.grain;
 }
 
 // One run of the machine on `workers` pixel computers: the larger of its
@@ -95,7 +95,7 @@ std::uint64_t machine_run_bytes(const Options& o, std::uint64_t pixels, std::uin
                                 std::uint64_t workers) {
   const nodes::MachineOptions& m = o.machine;
   std::uint64_t held = (colour + owner) * items + items / 8;
-  if (m.pixel_order == nodes::PixelOrder::hilbert) held += position * items;
+  if (m.farming.pixel_order == nodes::PixelOrder::hilbert) held += position * items;
   const std::uint64_t largest = largest_tile(m, items, workers);
   const std::uint64_t tiles = std::min(items, workers * largest) + largest;  // kept, and one result on its way
   const std::uint64_t records = recorded_tiles(m, items) * tile_record * 2;

@@ -144,11 +144,7 @@ void check_machine(Options& o, const Raw& raw, const po::variables_map& vm) {
   check_topology(m, raw, vm);
   check_cache(o, raw, vm);
   m.threads = in_range<unsigned>(raw.threads, 0, 4096, "--threads");
-  const FarmingChoice farming = parse_farming(raw.shared, vm);
-  m.grain = farming.grain;
-  m.prefetch = farming.prefetch;
-  m.schedule = farming.schedule;
-  m.pixel_order = farming.pixel_order;
+  m.farming = parse_farming(raw.shared, vm);
   m.workers_per_node = as_field<int>(raw.workers, "--workers-per-node");
   m.trace_routes = in_range<std::uint64_t>(raw.trace_routes, 0, 1 << 20, "--trace-routes");
   if (vm.count("trace-kind")) {
@@ -258,8 +254,8 @@ DatabaseChoice parse_database(const SharedChoice& c) {
           .page_size = checked_page_size(c.page_size)};
 }
 
-FarmingChoice parse_farming(const SharedChoice& c, const po::variables_map& vm) {
-  FarmingChoice f;
+nodes::Farming parse_farming(const SharedChoice& c, const po::variables_map& vm) {
+  nodes::Farming f;
   // Their bounds are the machine's (nodes::check_options, called by the parsers).
   f.grain = as_field<std::uint32_t>(c.grain, "--grain");
   f.prefetch = as_field<std::uint16_t>(c.prefetch, "--prefetch");

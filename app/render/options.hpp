@@ -61,9 +61,9 @@ struct Options {
 struct SharedChoice {
   std::string accel = "bvh", bvh_layout = "treelet", shadow_rays = "facing";
   std::int64_t page_size = tracer::BuildOptions{}.page_size;
-  std::int64_t grain = nodes::MachineOptions{}.grain, prefetch = nodes::MachineOptions{}.prefetch;
-  std::string schedule = nodes::schedule_name(nodes::MachineOptions{}.schedule),
-              pixel_order = nodes::pixel_order_name(nodes::MachineOptions{}.pixel_order);
+  std::int64_t grain = nodes::Farming{}.grain, prefetch = nodes::Farming{}.prefetch;
+  std::string schedule = nodes::schedule_name(nodes::Farming{}.schedule),
+              pixel_order = nodes::pixel_order_name(nodes::Farming{}.pixel_order);
 };
 
 // How the database is built and traced: --accel, --bvh-layout, --shadow-rays, --page-size.
@@ -77,15 +77,9 @@ void add_database_options(boost::program_options::options_description& d, Shared
 DatabaseChoice parse_database(const SharedChoice& choice);
 
 // How the pixels are handed out: --grain, --schedule, --pixel-order, --prefetch.
-struct FarmingChoice {
-  std::uint32_t grain = nodes::MachineOptions{}.grain;
-  std::uint16_t prefetch = nodes::MachineOptions{}.prefetch;
-  nodes::Schedule schedule = nodes::MachineOptions{}.schedule;
-  nodes::PixelOrder pixel_order = nodes::MachineOptions{}.pixel_order;
-};
 void add_farming_options(boost::program_options::options_description& d, SharedChoice& choice);
 // Also refuses a --grain given with the static schedule (check_grain).
-FarmingChoice parse_farming(const SharedChoice& choice, const boost::program_options::variables_map& vm);
+nodes::Farming parse_farming(const SharedChoice& choice, const boost::program_options::variables_map& vm);
 
 // v as a T when lo <= v <= hi; else UsageError "OPTION: expected lo..hi, got v".
 template <class T>

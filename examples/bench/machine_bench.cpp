@@ -192,21 +192,26 @@ int bench_machine(const std::vector<std::string>& args) {
   const std::vector<Line> variants{
       {"  as above (affinity, hilbert, grain 16)", {}},
       {"  BVH nodes in depth-first layout", {}, {.bvh_layout = tracer::BvhLayout::depth_first}},
-      {"  prefetch 0 (ask when idle)", [](nodes::MachineOptions& o, const tracer::DatabaseHeader&) { o.prefetch = 0; }},
+      {"  prefetch 0 (ask when idle)",
+       [](nodes::MachineOptions& o, const tracer::DatabaseHeader&) { o.farming.prefetch = 0; }},
       {"  cache = whole database (first-touch misses)",
        [](nodes::MachineOptions& o, const tracer::DatabaseHeader& h) { o.cache_pages = h.page_count; }},
-      {"  grain 256", [](nodes::MachineOptions& o, const tracer::DatabaseHeader&) { o.grain = 256; }},
+      {"  grain 256", [](nodes::MachineOptions& o, const tracer::DatabaseHeader&) { o.farming.grain = 256; }},
       {"  dynamic schedule",
-       [](nodes::MachineOptions& o, const tracer::DatabaseHeader&) { o.schedule = nodes::Schedule::dynamic; }},
+       [](nodes::MachineOptions& o, const tracer::DatabaseHeader&) { o.farming.schedule = nodes::Schedule::dynamic; }},
       {"  scanline order",
-       [](nodes::MachineOptions& o, const tracer::DatabaseHeader&) { o.pixel_order = nodes::PixelOrder::scanline; }},
+       [](nodes::MachineOptions& o, const tracer::DatabaseHeader&) {
+         o.farming.pixel_order = nodes::PixelOrder::scanline;
+       }},
       {"  dynamic schedule, scanline order (the paper)",
        [](nodes::MachineOptions& o, const tracer::DatabaseHeader&) {
-         o.schedule = nodes::Schedule::dynamic;
-         o.pixel_order = nodes::PixelOrder::scanline;
+         o.farming.schedule = nodes::Schedule::dynamic;
+         o.farming.pixel_order = nodes::PixelOrder::scanline;
        }},
       {"  static schedule (no farming, no balancing)",
-       [](nodes::MachineOptions& o, const tracer::DatabaseHeader&) { o.schedule = nodes::Schedule::static_split; }},
+       [](nodes::MachineOptions& o, const tracer::DatabaseHeader&) {
+         o.farming.schedule = nodes::Schedule::static_split;
+       }},
       {"  recorded for a replay (--replay)",
        [](nodes::MachineOptions& o, const tracer::DatabaseHeader&) { o.record = true; }},
   };

@@ -63,7 +63,7 @@ void check_fields(const MachineOptions& options) {
     if (value > hi) throw OptionError(field, "must be at most " + std::to_string(hi) + ", got " + std::to_string(value));
   };
   within("workers_per_node", options.workers_per_node, max_workers_per_node);
-  within("grain", options.grain, max_grain);
+  within("grain", options.farming.grain, max_grain);
   within("buffer_capacity", static_cast<std::int64_t>(std::min<std::size_t>(options.buffer_capacity, INT64_MAX)),
          INT64_MAX);
   if (options.schedule_seed && options.timing)
@@ -71,9 +71,9 @@ void check_fields(const MachineOptions& options) {
   if (options.schedule_seed && options.threads != 1)
     throw OptionError("schedule_seed", "needs threads = 1 (a seed replays its schedule on one thread only), got " +
                                            std::to_string(options.threads));
-  if (options.prefetch > max_prefetch(options))
+  if (options.farming.prefetch > max_prefetch(options))
     throw OptionError("prefetch", "must be at most " + std::to_string(max_prefetch(options)) + ", got " +
-                                      std::to_string(options.prefetch) +
+                                      std::to_string(options.farming.prefetch) +
                                       " (a worker's answers and a page reply must fit the network buffer of " +
                                       std::to_string(options.buffer_capacity) + " packets)");
 }
@@ -210,8 +210,8 @@ void spawn_node(const Wiring& w, NodeId n, NodeState& node) {
     w.runtime.spawn(
         name + " pixel computer " + std::to_string(i), thread,
         [&w, port, &source, &in, &out, &counters, charge, timeslice] {
-          PixelComputer(port, w.options.prefetch, source, w.header, w.options.trace, w.grid, in, out, counters, charge,
-                        timeslice, w.tile_clock)
+          PixelComputer(port, w.options.farming.prefetch, source, w.header, w.options.trace, w.grid, in, out,
+                        counters, charge, timeslice, w.tile_clock)
               .run();
         },
         prioritised ? csp::Priority::low : csp::Priority::high);
@@ -222,7 +222,7 @@ void spawn_host(const Wiring& w, Host& host) {
   const unsigned thread = w.net.thread_of(0);
   const auto nodes = static_cast<std::size_t>(w.net.topology().size());
   const csp::In<Packet> requests =
-      drained_port(w, 0, Ports::farmer, farmer_bound(nodes, w.options.workers_per_node, w.options.prefetch),
+      drained_port(w, 0, Ports::farmer, farmer_bound(nodes, w.options.workers_per_node, w.options.farming.prefetch),
                    "farmer", host.mailbox);
   host.results = std::make_unique<csp::Channel<Packet>>("results", results_buffer);
   w.runtime.spawn("farmer", thread, [&w, &host, nodes, requests, out = w.outbox(0, Ports::farmer)] {
@@ -393,7 +393,7 @@ NetworkOptions network_options(const MachineOptions& options, const MachineTimin
     const std::size_t nodes = topology_size;
     net.port_capacity.assign(Ports::first_worker, 0);
     net.port_capacity[Ports::page_server] = page_requests_bound(nodes, options.workers_per_node);
-    net.port_capacity[Ports::farmer] = farmer_bound(nodes, options.workers_per_node, options.prefetch);
+    net.port_capacity[Ports::farmer] = farmer_bound(nodes, options.workers_per_node, options.farming.prefetch);
   }
   net.relay_between_threads = options.relay_between_threads && !timing;
   net.forward_in_place = options.forward_in_place && !timing;
@@ -418,7 +418,7 @@ struct Items {
     const bool corners = options.trace.spd_procedure;
     const int rows = header.camera.height + (corners ? 1 : 0);
     grid = {header.camera.width + (corners ? 1 : 0), corners, {}};
-    positions = item_positions(grid.width, rows, options.pixel_order);
+    positions = item_positions(grid.width, rows, options.farming.pixel_order);
     grid.positions = positions;
     count = static_cast<std::uint32_t>(grid.width) * static_cast<std::uint32_t>(rows);
   }
@@ -434,7 +434,7 @@ void spawn_machine(const Wiring& wiring, std::vector<std::unique_ptr<NodeState>>
     if (nodes[n]) spawn_node(wiring, static_cast<NodeId>(n), *nodes[n]);
   if (share.runs(0)) {
     const MachineOptions& options = wiring.options;
-    host.plan = std::make_unique<WorkPlan>(items.count, options.grain, options.schedule,
+    host.plan = std::make_unique<WorkPlan>(items.count, options.farming.grain, options.farming.schedule,
                                            static_cast<int>(wiring.net.topology().size()), options.workers_per_node);
     host.frame = std::make_unique<FrameAssembler>(items.count, items.grid.positions);
     host.owners.assign(items.count, 0);
@@ -500,10 +500,10 @@ MachineReport machine_report(const csp::Runtime& runtime, const Network& net, co
   report.nodes = static_cast<int>(net.topology().size());
   report.threads = runtime.threads();
   report.workers_per_node = options.workers_per_node;
-  report.prefetch = options.prefetch;
-  report.schedule = options.schedule;
-  report.pixel_order = options.pixel_order;
-  report.grain = options.grain;
+  report.prefetch = options.farming.prefetch;
+  report.schedule = options.farming.schedule;
+  report.pixel_order = options.farming.pixel_order;
+  report.grain = options.farming.grain;
   report.cache_pages = cache_pages;
   report.page_size = header.page_size;
   report.page_count = header.page_count;

@@ -43,6 +43,16 @@
 
 namespace nodes {
 
+// How the frame's items are handed out. The defaults take each processor's
+// own compact patch first: the fewest page misses and farming messages
+// (the paper: dynamic, scanline, grain 4, prefetch 0).
+struct Farming {
+  std::uint32_t grain = 16;      // items per tile (1..max_grain): balance vs farming traffic
+  std::uint16_t prefetch = 1;    // tiles a worker has asked for beyond the one it traces (..max_prefetch)
+  Schedule schedule = Schedule::affinity;
+  PixelOrder pixel_order = PixelOrder::hilbert;  // how items are numbered, so where a tile lies
+};
+
 struct MachineOptions {
   topology::Topology topology = topology::Topology::hypercube(4);  // 16 nodes; topology::parse_topology reads a spec
   unsigned threads = 0;                // 0: thread_count()'s choice; never more than the nodes
@@ -52,13 +62,8 @@ struct MachineOptions {
   bool shared_cores = false;           // other processes share the cores (csp::RuntimeOptions::shared_cores)
   std::optional<std::uint32_t> cache_pages;  // remote pages cached per node
   std::optional<std::uint64_t> cache_kb;     // the same in KB; default (neither): default_cache_pages()
-  std::uint32_t grain = 16;            // items per tile (1..max_grain): balance vs farming traffic
-  // Each processor's own compact patch first: the fewest page misses and
-  // farming messages (the paper: dynamic, scanline).
-  Schedule schedule = Schedule::affinity;
-  PixelOrder pixel_order = PixelOrder::hilbert;  // how items are numbered, so where a tile lies
+  Farming farming;
   int workers_per_node = 1;            // 1..max_workers_per_node
-  std::uint16_t prefetch = 1;          // tiles a worker has asked for beyond the one it traces (..max_prefetch)
   Distribution distribution = Distribution::modulo;
   std::uint64_t trace_routes = 0;      // record the routes of the first N packets
   std::vector<std::uint8_t> trace_kinds;  // of these MessageKinds only (empty: every kind)

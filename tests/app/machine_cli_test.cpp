@@ -522,8 +522,8 @@ TEST(MachineOptions, DefaultIsASixteenNodeHypercubeWithTheDefaultCache) {
   EXPECT_EQ(o.machine.topology.size(), 16u);
   EXPECT_FALSE(o.machine.cache_pages);
   EXPECT_FALSE(o.machine.cache_kb);
-  EXPECT_EQ(o.machine.schedule, nodes::Schedule::affinity);
-  EXPECT_EQ(o.machine.pixel_order, nodes::PixelOrder::hilbert);
+  EXPECT_EQ(o.machine.farming.schedule, nodes::Schedule::affinity);
+  EXPECT_EQ(o.machine.farming.pixel_order, nodes::PixelOrder::hilbert);
   EXPECT_EQ(o.machine.distribution, nodes::Distribution::modulo);
 }
 
@@ -539,17 +539,17 @@ TEST(MachineOptions, ValuesReachTheMachine) {
                                 "--workers-per-node", "3", "--distribution", "block",
                                 "--trace-routes", "5", "--threads", "2", "--compare-serial", "--prefetch", "2"});
   EXPECT_EQ(o.machine.cache_kb, 8u);
-  EXPECT_EQ(o.machine.grain, 9u);
-  EXPECT_EQ(o.machine.schedule, nodes::Schedule::dynamic);
-  EXPECT_EQ(parse({"--schedule", "static"}).machine.schedule, nodes::Schedule::static_split);
-  EXPECT_EQ(parse({"--schedule", "affinity"}).machine.schedule, nodes::Schedule::affinity);
-  EXPECT_EQ(parse({"--pixel-order", "scanline"}).machine.pixel_order, nodes::PixelOrder::scanline);
-  EXPECT_EQ(parse({"--schedule", "dynamic"}).machine.schedule, nodes::Schedule::dynamic);
+  EXPECT_EQ(o.machine.farming.grain, 9u);
+  EXPECT_EQ(o.machine.farming.schedule, nodes::Schedule::dynamic);
+  EXPECT_EQ(parse({"--schedule", "static"}).machine.farming.schedule, nodes::Schedule::static_split);
+  EXPECT_EQ(parse({"--schedule", "affinity"}).machine.farming.schedule, nodes::Schedule::affinity);
+  EXPECT_EQ(parse({"--pixel-order", "scanline"}).machine.farming.pixel_order, nodes::PixelOrder::scanline);
+  EXPECT_EQ(parse({"--schedule", "dynamic"}).machine.farming.schedule, nodes::Schedule::dynamic);
   EXPECT_EQ(o.machine.workers_per_node, 3);
   EXPECT_EQ(o.machine.distribution, nodes::Distribution::block);
   EXPECT_EQ(o.machine.trace_routes, 5u);
   EXPECT_EQ(o.machine.threads, 2u);
-  EXPECT_EQ(o.machine.prefetch, 2);
+  EXPECT_EQ(o.machine.farming.prefetch, 2);
   EXPECT_TRUE(o.compare_serial);
 }
 

@@ -84,7 +84,7 @@ TEST(Options, OptionsThatWouldChangeNothingAreErrors) {
             "--grain: the static schedule hands out fixed shares, not tiles of a grain");
   EXPECT_EQ(error_of({"--timing", "virtual", "--compare-serial"}),
             "--compare-serial: a virtual-time run always reports speedup against the 1-node machine");
-  EXPECT_EQ(parse({"--schedule", "static"}).machine.schedule, nodes::Schedule::static_split);
+  EXPECT_EQ(parse({"--schedule", "static"}).machine.farming.schedule, nodes::Schedule::static_split);
   EXPECT_TRUE(parse({"--compare-serial"}).compare_serial);
 }
 
@@ -110,9 +110,9 @@ TEST(Options, TheMachinesBoundsAreCheckedByTheMachine) {
   EXPECT_EQ(error_of({"--workers-per-node", "3000000000"}), "--workers-per-node: is too large, got 3000000000");
   EXPECT_EQ(error_of({"--prefetch", "4"}).rfind("--prefetch: must be at most 3, got 4", 0), 0u);
   const Options o = parse({"--grain", "1048576", "--workers-per-node", "64", "--prefetch", "3"});
-  EXPECT_EQ(o.machine.grain, nodes::max_grain);
+  EXPECT_EQ(o.machine.farming.grain, nodes::max_grain);
   EXPECT_EQ(o.machine.workers_per_node, nodes::max_workers_per_node);
-  EXPECT_EQ(o.machine.prefetch, 3);
+  EXPECT_EQ(o.machine.farming.prefetch, 3);
 }
 
 // --single has no machine to give these to; ignoring them would mislead.

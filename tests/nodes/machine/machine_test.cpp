@@ -73,11 +73,11 @@ nodes::MachineResult run_case(const Case& c) {
   options.threads = c.threads;
   auto db = make_db(c.scene, c.page_size, c.size);
   options.cache_pages = c.cache_pages ? c.cache_pages : db.header.page_count;
-  options.grain = c.grain;
-  options.schedule = c.schedule;
+  options.farming.grain = c.grain;
+  options.farming.schedule = c.schedule;
   options.workers_per_node = c.workers;
-  options.prefetch = c.prefetch;
-  options.pixel_order = c.order;
+  options.farming.prefetch = c.prefetch;
+  options.farming.pixel_order = c.order;
   options.trace.spd_procedure = c.spd;
   options.record_tiles = c.record_tiles;
   options.forward_in_place = c.forward_in_place;
@@ -174,7 +174,7 @@ TEST(Machine, RelaysCarryEveryPacketBetweenThreadsOnce) {
   options.relay_between_threads = false;
   auto db = make_db(c.scene, c.page_size, c.size);
   options.cache_pages = c.cache_pages;
-  options.grain = c.grain;
+  options.farming.grain = c.grain;
   const auto plain = nodes::run_machine(std::move(db), options);
   EXPECT_TRUE(plain.report.relays.empty());
   EXPECT_EQ(plain.report.relayed_links, 0u);
@@ -491,12 +491,12 @@ TEST(Machine, BadOptionsFailWithOneLineNamingTheField) {
   workers.workers_per_node = nodes::max_workers_per_node + 1;
   expect_error(c, workers, "workers_per_node: must be at most 64, got 65");
   MachineOptions grain;
-  grain.grain = 0;
+  grain.farming.grain = 0;
   expect_error(c, grain, "grain");
-  grain.grain = nodes::max_grain + 1;
+  grain.farming.grain = nodes::max_grain + 1;
   expect_error(c, grain, "grain: must be at most 1048576");
   MachineOptions prefetch;
-  prefetch.prefetch = 4;  // the network buffers 4 packets per queue
+  prefetch.farming.prefetch = 4;  // the network buffers 4 packets per queue
   expect_error(c, prefetch, "prefetch");
   expect_error({"hypercube", 48, 1, 1024, 4, Schedule::dynamic, 1, 1}, MachineOptions{}, "48");
   expect_error({"mesh:8x8", 32, 1, 1024, 4, Schedule::dynamic, 1, 1}, MachineOptions{}, "32");

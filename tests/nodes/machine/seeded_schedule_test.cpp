@@ -66,12 +66,12 @@ MachineOptions options_for(const Config& c, std::optional<std::uint64_t> seed) {
   o.topology = topology::parse_topology(c.topology, c.nodes);
   o.threads = 1;
   o.cache_pages = c.cache_pages;
-  o.schedule = c.schedule;
+  o.farming.schedule = c.schedule;
   o.workers_per_node = c.workers;
-  o.prefetch = c.prefetch;
-  o.grain = c.grain;
+  o.farming.prefetch = c.prefetch;
+  o.farming.grain = c.grain;
   o.buffer_capacity = c.buffer_capacity;
-  o.pixel_order = c.order;
+  o.farming.pixel_order = c.order;
   o.schedule_seed = seed;
   return o;
 }

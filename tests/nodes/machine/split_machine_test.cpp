@@ -94,8 +94,8 @@ MachineOptions options_for(const Case& c, const tracer::Database& db) {
   o.topology = topology::parse_topology(c.topology);
   o.threads = c.threads;
   o.cache_pages = c.cache_pages ? c.cache_pages : db.header.page_count;
-  o.schedule = c.schedule;
-  o.grain = 4;
+  o.farming.schedule = c.schedule;
+  o.farming.grain = 4;
   o.workers_per_node = c.workers;
   return o;
 }
