@@ -328,8 +328,8 @@ nodes::RecordedTraffic record_render_traffic(const NetworkStudyOptions& o, const
   m.topology = t;
   m.threads = 1;
   m.timing = o.model;
-  m.record = true;
-  m.record_packets = std::numeric_limits<std::uint64_t>::max();
+  m.observe.record = true;
+  m.observe.record_packets = std::numeric_limits<std::uint64_t>::max();
   const nodes::MachineResult r = nodes::run_machine(tracer::build_database(*o.render_scene, build_options(render)), m);
   nodes::RecordedTraffic traffic;
   traffic.by_source.resize(t.size());

@@ -49,8 +49,8 @@ SerialComparison run_serial(const tracer::Database& db, const nodes::MachineOpti
                             const Options& o) {
   nodes::MachineOptions one = machine;
   one.topology = topology::Topology::complete(1);
-  one.trace_routes = 0;
-  one.record = false;
+  one.observe.trace_routes = 0;
+  one.observe.record = false;
   const nodes::MachineResult r = run_with_progress(db, one, o, " (1 node)");
   return {machine.timing ? r.report.predicted_seconds : r.report.wall_seconds, r.report.threads};
 }

@@ -85,7 +85,7 @@ std::uint64_t largest_tile(const nodes::MachineOptions& m, std::uint64_t items, 
 
 // The tiles of a dynamic run whose tiles are recorded; 0 otherwise.
 std::uint64_t recorded_tiles(const nodes::MachineOptions& m, std::uint64_t items) {
-  if ((!m.record_tiles && !m.record) || m.farming.schedule != nodes::Schedule::dynamic) return 0;
+  if ((!m.observe.record_tiles && !m.observe.record) || m.farming.schedule != nodes::Schedule::dynamic) return 0;
   return (items + m.farming.grain - 1) / m.farming.grain;
 }
 
@@ -284,7 +284,8 @@ MachineMemory machine_memory(const Options& o, std::uint32_t page_count) {
   const std::uint64_t ring_entries = m.buffer_capacity + nodes::ThreadRelays::credit_entries(m.buffer_capacity);
   r.relay_bytes = r.relayed_link_queues * (relayed_link_bytes + ring_entries * ring_entry_bytes);
   const double per_packet = recorded_packet_bytes + t.average_distance() * recorded_hop_bytes;
-  r.recording_bytes = m.record ? static_cast<std::uint64_t>(static_cast<double>(m.record_packets) * per_packet) : 0;
+  r.recording_bytes =
+      m.observe.record ? static_cast<std::uint64_t>(static_cast<double>(m.observe.record_packets) * per_packet) : 0;
   // Every process's stack is mapped whole as it starts, with its guard
   // page, resident or not: per node its router, page server and pixel
   // computers, in virtual time its page mailbox and a link process per

@@ -146,10 +146,11 @@ void check_machine(Options& o, const Raw& raw, const po::variables_map& vm) {
   m.threads = in_range<unsigned>(raw.threads, 0, 4096, "--threads");
   m.farming = parse_farming(raw.shared, vm);
   m.workers_per_node = as_field<int>(raw.workers, "--workers-per-node");
-  m.trace_routes = in_range<std::uint64_t>(raw.trace_routes, 0, 1 << 20, "--trace-routes");
+  m.observe.trace_routes = in_range<std::uint64_t>(raw.trace_routes, 0, 1 << 20, "--trace-routes");
   if (vm.count("trace-kind")) {
-    if (m.trace_routes == 0) throw UsageError("--trace-kind: chooses the packets --trace-routes N traces; give that too");
-    m.trace_kinds = parse_trace_kinds(raw.trace_kind);
+    if (m.observe.trace_routes == 0)
+      throw UsageError("--trace-kind: chooses the packets --trace-routes N traces; give that too");
+    m.observe.trace_kinds = parse_trace_kinds(raw.trace_kind);
   }
   if (raw.distribution == "modulo") m.distribution = nodes::Distribution::modulo;
   else if (raw.distribution == "block") m.distribution = nodes::Distribution::block;
@@ -159,10 +160,10 @@ void check_machine(Options& o, const Raw& raw, const po::variables_map& vm) {
   if (m.timing && o.compare_serial)
     throw UsageError("--compare-serial: a virtual-time run always reports speedup against the 1-node machine");
   // The tile CSV, the timeline and the report (which shows the timeline) need the tiles.
-  m.record_tiles = !o.tiles_csv.empty() || !o.pictures.timeline_svg.empty() || !o.pictures.report_html.empty();
-  m.record = !o.replay_html.empty();
-  m.record_packets = in_range<std::uint64_t>(raw.replay_packets, 0, 1 << 22, "--replay-packets");
-  if (!vm["replay-packets"].defaulted() && !m.record)
+  m.observe.record_tiles = !o.tiles_csv.empty() || !o.pictures.timeline_svg.empty() || !o.pictures.report_html.empty();
+  m.observe.record = !o.replay_html.empty();
+  m.observe.record_packets = in_range<std::uint64_t>(raw.replay_packets, 0, 1 << 22, "--replay-packets");
+  if (!vm["replay-packets"].defaulted() && !m.observe.record)
     throw UsageError("--replay-packets: bounds what --replay records; give that too");
   // The machine's own rules, now rather than after the scene is read.
   try {

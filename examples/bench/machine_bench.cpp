@@ -213,7 +213,7 @@ int bench_machine(const std::vector<std::string>& args) {
          o.farming.schedule = nodes::Schedule::static_split;
        }},
       {"  recorded for a replay (--replay)",
-       [](nodes::MachineOptions& o, const tracer::DatabaseHeader&) { o.record = true; }},
+       [](nodes::MachineOptions& o, const tracer::DatabaseHeader&) { o.observe.record = true; }},
   };
   std::vector<MachineRun> runs(variants.size());
   Times baseline;  // the single process on T threads, in the same rounds

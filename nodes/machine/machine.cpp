@@ -384,8 +384,8 @@ NetworkOptions network_options(const MachineOptions& options, const MachineTimin
   NetworkOptions net;
   net.buffer_capacity = options.buffer_capacity;
   net.ports_per_node = Ports::count(options.workers_per_node);
-  net.trace_routes = options.trace_routes;
-  net.trace_kinds = options.trace_kinds;
+  net.trace_routes = options.observe.trace_routes;
+  net.trace_kinds = options.observe.trace_kinds;
   net.recorder = recorder;
   if (timing) net.link = timing->model().link_model();
   if (!net.link.enabled()) {
@@ -581,10 +581,10 @@ Executed execute(const tracer::DatabaseHeader& header, const topology::Topology&
   Network* network = nullptr;  // for the runtime's failure handler, once it exists
   csp::Runtime runtime(runtime_options(options, local_nodes, timing, split, share.rank, network));
   // Over several ranks each records its share of the packets, on its own clock.
-  const std::uint64_t budget =
-      share.plan ? rank_budget(options.record_packets, share.plan->ranks(), share.rank) : options.record_packets;
+  const std::uint64_t packets = options.observe.record_packets;
+  const std::uint64_t budget = share.plan ? rank_budget(packets, share.plan->ranks(), share.rank) : packets;
   std::unique_ptr<Recorder> recorder =
-      options.record ? std::make_unique<Recorder>(topology.size(), budget, timing != nullptr, started) : nullptr;
+      options.observe.record ? std::make_unique<Recorder>(topology.size(), budget, timing != nullptr, started) : nullptr;
   Network net(runtime, topology,
               network_options(options, timing, share, topology.size(), local_nodes, runtime.threads(), recorder.get()));
   network = &net;
@@ -597,7 +597,7 @@ Executed execute(const tracer::DatabaseHeader& header, const topology::Topology&
                       items.grid,
                       topology.size() * Ports::count(options.workers_per_node),
                       timing,
-                      options.record_tiles || options.record ? run_clock(started, timing != nullptr) : RunClock{},
+                      options.observe.tiles() ? run_clock(started, timing != nullptr) : RunClock{},
                       recorder.get(),
                       split != nullptr};
   Host host;
@@ -807,12 +807,13 @@ std::optional<MachineResult> run_machine_rank(std::optional<tracer::Database> db
     merge_rank(transport.receive(Tag::report, q), plan, report, executed.routers, executed.recorder.get());
   if (executed.recorder)
     report.recording =
-        split_recording(transport, plan, topology, report, *executed.recorder, options.record_packets);
+        split_recording(transport, plan, topology, report, *executed.recorder, options.observe.record_packets);
   std::vector<const RouterCounters*> routers;
   for (const auto& r : executed.routers) routers.push_back(&r);
   report.network = network_stats(topology, routers);
   // Each rank traced its own first packets: keep the first ones of the machine.
-  if (report.network.routes.size() > options.trace_routes) report.network.routes.resize(options.trace_routes);
+  const std::uint64_t traced = options.observe.trace_routes;
+  if (report.network.routes.size() > traced) report.network.routes.resize(traced);
   return std::move(executed.result);
 }
 

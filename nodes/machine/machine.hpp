@@ -53,6 +53,16 @@ struct Farming {
   PixelOrder pixel_order = PixelOrder::hilbert;  // how items are numbered, so where a tile lies
 };
 
+// What a run records beside its image, for the reports and pictures.
+struct Observation {
+  std::uint64_t trace_routes = 0;         // record the routes of the first N packets
+  std::vector<std::uint8_t> trace_kinds;  // of these MessageKinds only (empty: every kind)
+  bool record_tiles = false;              // a TileSpan per tile in each NodeReport's work.spans
+  bool record = false;                    // a Recording of the run for its replay (recorder.hpp); implies record_tiles
+  std::uint64_t record_packets = 100000;  // with record: packets recorded hop by hop, the rest only counted
+  bool tiles() const { return record_tiles || record; }  // the tiles' times are taken
+};
+
 struct MachineOptions {
   topology::Topology topology = topology::Topology::hypercube(4);  // 16 nodes; topology::parse_topology reads a spec
   unsigned threads = 0;                // 0: thread_count()'s choice; never more than the nodes
@@ -65,11 +75,7 @@ struct MachineOptions {
   Farming farming;
   int workers_per_node = 1;            // 1..max_workers_per_node
   Distribution distribution = Distribution::modulo;
-  std::uint64_t trace_routes = 0;      // record the routes of the first N packets
-  std::vector<std::uint8_t> trace_kinds;  // of these MessageKinds only (empty: every kind)
-  bool record_tiles = false;           // a TileSpan per tile in each NodeReport's work.spans
-  bool record = false;                 // a Recording of the run for its replay (recorder.hpp); implies record_tiles
-  std::uint64_t record_packets = 100000;  // with record: packets recorded hop by hop, the rest only counted
+  Observation observe;
   std::size_t buffer_capacity = 4;     // packets per network queue
   tracer::TraceOptions trace;
   std::optional<CostModel> timing;     // virtual time under this model (the run takes one thread)

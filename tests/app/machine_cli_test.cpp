@@ -408,7 +408,7 @@ TEST_F(MachineCli, TraceKindTracesPacketsOfThoseKindsOnly) {
 }
 
 TEST(MachineOptions, TraceKindNamesKnownKindsAndNeedsTraceRoutes) {
-  EXPECT_EQ(test::parse({"--trace-routes", "2", "--trace-kind", "page_reply,work"}).machine.trace_kinds,
+  EXPECT_EQ(test::parse({"--trace-routes", "2", "--trace-kind", "page_reply,work"}).machine.observe.trace_kinds,
             (std::vector<std::uint8_t>{6, 2}));
   for (const auto& [args, message] :
        {std::pair<std::vector<const char*>, std::string>{
@@ -547,7 +547,7 @@ TEST(MachineOptions, ValuesReachTheMachine) {
   EXPECT_EQ(parse({"--schedule", "dynamic"}).machine.farming.schedule, nodes::Schedule::dynamic);
   EXPECT_EQ(o.machine.workers_per_node, 3);
   EXPECT_EQ(o.machine.distribution, nodes::Distribution::block);
-  EXPECT_EQ(o.machine.trace_routes, 5u);
+  EXPECT_EQ(o.machine.observe.trace_routes, 5u);
   EXPECT_EQ(o.machine.threads, 2u);
   EXPECT_EQ(o.machine.farming.prefetch, 2);
   EXPECT_TRUE(o.compare_serial);

@@ -151,10 +151,10 @@ TEST_F(ReplayCli, BadUsesFailInOneLineBeforeAnyWork) {
 
 TEST(ReplayOptions, ReplayAsksTheMachineToRecordWithItsBound) {
   const app::Options o = test::parse_words("teapot --replay r.html --replay-packets 123");
-  EXPECT_TRUE(o.machine.record);
-  EXPECT_EQ(o.machine.record_packets, 123u);
-  EXPECT_FALSE(test::parse_words("teapot").machine.record);
-  EXPECT_EQ(test::parse_words("teapot --replay r.html").machine.record_packets, 100000u);
+  EXPECT_TRUE(o.machine.observe.record);
+  EXPECT_EQ(o.machine.observe.record_packets, 123u);
+  EXPECT_FALSE(test::parse_words("teapot").machine.observe.record);
+  EXPECT_EQ(test::parse_words("teapot --replay r.html").machine.observe.record_packets, 100000u);
 }
 
 TEST(ReplayOptions, IsTakenOverSeveralRanks) {

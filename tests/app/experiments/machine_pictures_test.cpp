@@ -28,7 +28,7 @@ nodes::MachineResult small_run(bool corners, bool record_tiles = true) {
   options.threads = 1;
   options.trace.spd_procedure = corners;
   options.timing = nodes::ipsc2_profile();
-  options.record_tiles = record_tiles;
+  options.observe.record_tiles = record_tiles;
   return nodes::run_machine(tracer::build_database(scene, {}), options);
 }
 

@@ -79,7 +79,7 @@ nodes::MachineResult run_case(const Case& c) {
   options.farming.prefetch = c.prefetch;
   options.farming.pixel_order = c.order;
   options.trace.spd_procedure = c.spd;
-  options.record_tiles = c.record_tiles;
+  options.observe.record_tiles = c.record_tiles;
   options.forward_in_place = c.forward_in_place;
   return nodes::run_machine(std::move(db), options);
 }

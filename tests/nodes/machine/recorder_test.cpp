@@ -30,8 +30,8 @@ RecordedRun recorded_run(const std::string& spec, std::size_t nodes, bool virtua
   options.threads = threads;
   options.workers_per_node = workers;
   options.cache_pages = 8;
-  options.record = true;
-  options.record_packets = max_packets;
+  options.observe.record = true;
+  options.observe.record_packets = max_packets;
   if (virtual_time) options.timing = nodes::profile_named("ipsc2");
   auto result = nodes::run_machine(test::make_db("teapot:2", 1024, 24), options);
   return {std::move(result), topology::parse_topology(spec, nodes)};

@@ -222,7 +222,7 @@ TEST(SplitMachine, NoRankHoldsMoreThanItsNodesPagesAndCaches) {
 TEST(SplitMachine, TracedRoutesThatCrossRanksHaveHopsEqualToDistance) {
   auto db = make_db("teapot:2", 1024, 16);
   MachineOptions options = options_for({"hypercube:4", 4}, db);
-  options.trace_routes = 200;
+  options.observe.trace_routes = 200;
   const auto run = run_split(std::move(db), options, 4);
   ASSERT_TRUE(run.result) << what(run.errors[0]);
   const auto& routes = run.result->report.network.routes;
@@ -248,8 +248,8 @@ TEST(SplitMachine, AReplayRecordedOverRanksCountsWhatOneProcessCounts) {
     SCOPED_TRACE(std::to_string(ranks) + " ranks");
     auto db = make_db("teapot:2", 1024, 16);
     MachineOptions options = options_for({"hypercube:3", ranks, Schedule::static_split}, db);
-    options.record = true;
-    options.record_packets = 1u << 20;
+    options.observe.record = true;
+    options.observe.record_packets = 1u << 20;
     const auto whole = nodes::run_machine(make_db("teapot:2", 1024, 16), options);
     const auto run = run_split(std::move(db), options, ranks);
     for (int r = 0; r < ranks; ++r)
@@ -262,7 +262,7 @@ TEST(SplitMachine, AReplayRecordedOverRanksCountsWhatOneProcessCounts) {
     EXPECT_EQ(split.packets.size(), one.packets.size());
     EXPECT_EQ(split.packets.size(), run.result->report.network.hops.packets);
     EXPECT_EQ(split.recorded_hops(), one.recorded_hops());
-    EXPECT_EQ(split.max_packets, options.record_packets);
+    EXPECT_EQ(split.max_packets, options.observe.record_packets);
     const auto by_kind = [](const nodes::Recording& r) {
       std::vector<std::uint64_t> k(256, 0);
       for (const auto& p : r.packets) ++k[p.kind];

@@ -102,7 +102,7 @@ nodes::MachineResult run_timed(const std::string& topology, std::size_t n, unsig
                                const CostModel& model, bool record_tiles = false, int workers_per_node = 1) {
   nodes::MachineOptions options;
   options.workers_per_node = workers_per_node;
-  options.record_tiles = record_tiles;
+  options.observe.record_tiles = record_tiles;
   options.topology = topology::parse_topology(topology, n);
   options.threads = threads;
   options.cache_pages = 4;
