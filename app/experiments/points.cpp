@@ -16,7 +16,7 @@ namespace app {
 nodes::MachineOptions machine_options(const ExperimentSetup& setup) {
   nodes::MachineOptions options;
   options.topology = topology::parse_topology(setup.topology, setup.nodes);
-  options.cache_pages = setup.cache_pages;
+  options.cache.pages = setup.cache_pages;
   options.farming = setup.farming;
   options.timing = setup.model;
   options.trace = setup.trace;

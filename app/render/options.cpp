@@ -135,8 +135,8 @@ void check_topology(nodes::MachineOptions& m, const Raw& raw, const po::variable
 void check_cache(Options& o, const Raw& raw, const po::variables_map& vm) {
   nodes::MachineOptions& m = o.machine;
   if (vm.count("cache-pages"))
-    m.cache_pages = in_range<std::uint32_t>(raw.cache_pages, 1, UINT32_MAX, "--cache-pages");
-  if (vm.count("cache-kb")) m.cache_kb = in_range<std::uint64_t>(raw.cache_kb, 1, std::int64_t(1) << 40, "--cache-kb");
+    m.cache.pages = in_range<std::uint32_t>(raw.cache_pages, 1, UINT32_MAX, "--cache-pages");
+  if (vm.count("cache-kb")) m.cache.kb = in_range<std::uint64_t>(raw.cache_kb, 1, std::int64_t(1) << 40, "--cache-kb");
 }
 
 void check_machine(Options& o, const Raw& raw, const po::variables_map& vm) {

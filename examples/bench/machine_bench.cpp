@@ -95,7 +95,7 @@ void run_machine_once(MachineRun& run, const std::string& spec, int size, int no
     nodes::MachineOptions options;
     options.topology = topology::parse_topology("hypercube", static_cast<std::size_t>(nodes));
     options.threads = threads;
-    options.cache_pages = std::max<std::uint32_t>(1, db.header.page_count / 8);
+    options.cache.pages = std::max<std::uint32_t>(1, db.header.page_count / 8);
     if (variant) variant(options, db.header);
     const auto start = Clock::now();
     const auto result = nodes::run_machine(std::move(db), options);
@@ -195,7 +195,7 @@ int bench_machine(const std::vector<std::string>& args) {
       {"  prefetch 0 (ask when idle)",
        [](nodes::MachineOptions& o, const tracer::DatabaseHeader&) { o.farming.prefetch = 0; }},
       {"  cache = whole database (first-touch misses)",
-       [](nodes::MachineOptions& o, const tracer::DatabaseHeader& h) { o.cache_pages = h.page_count; }},
+       [](nodes::MachineOptions& o, const tracer::DatabaseHeader& h) { o.cache.pages = h.page_count; }},
       {"  grain 256", [](nodes::MachineOptions& o, const tracer::DatabaseHeader&) { o.farming.grain = 256; }},
       {"  dynamic schedule",
        [](nodes::MachineOptions& o, const tracer::DatabaseHeader&) { o.farming.schedule = nodes::Schedule::dynamic; }},

@@ -133,7 +133,7 @@ MachineSample run_machine(const Case& c, const tracer::Database& source, unsigne
   options.topology = topology::parse_topology("hypercube", static_cast<std::size_t>(c.nodes));
   options.threads = threads;  // 0: the default rule
   options.workers_per_node = c.workers;
-  if (c.cache_pages) options.cache_pages = c.cache_pages;
+  if (c.cache_pages) options.cache.pages = c.cache_pages;
   const auto start = Clock::now();
   const nodes::MachineResult result = nodes::run_machine(std::move(db), options);
   MachineSample s;

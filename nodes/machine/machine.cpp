@@ -303,16 +303,16 @@ namespace {
 
 // The cache asked for, in pages of page_size bytes; none when neither field is set.
 std::optional<std::uint32_t> asked_cache_pages(const MachineOptions& options, std::uint32_t page_size) {
-  if (options.cache_pages && options.cache_kb)
+  if (options.cache.pages && options.cache.kb)
     throw OptionError("cache_kb", "given with the cache in pages: give one of them, not both");
-  if (options.cache_pages) {
-    if (*options.cache_pages == 0) throw OptionError("cache_pages", "must be at least 1, got 0");
-    return *options.cache_pages;
+  if (options.cache.pages) {
+    if (*options.cache.pages == 0) throw OptionError("cache_pages", "must be at least 1, got 0");
+    return *options.cache.pages;
   }
-  if (!options.cache_kb) return std::nullopt;
-  const std::uint64_t pages = *options.cache_kb * 1024 / page_size;
+  if (!options.cache.kb) return std::nullopt;
+  const std::uint64_t pages = *options.cache.kb * 1024 / page_size;
   if (pages == 0)
-    throw OptionError("cache_kb", std::to_string(*options.cache_kb) + " KB is less than one page (" +
+    throw OptionError("cache_kb", std::to_string(*options.cache.kb) + " KB is less than one page (" +
                                       std::to_string(page_size) + " bytes)");
   return static_cast<std::uint32_t>(std::min<std::uint64_t>(pages, UINT32_MAX));
 }

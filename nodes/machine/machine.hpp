@@ -53,6 +53,13 @@ struct Farming {
   PixelOrder pixel_order = PixelOrder::hilbert;  // how items are numbered, so where a tile lies
 };
 
+// Remote pages each node caches: at most one of the two; neither, the
+// default (default_cache_pages()).
+struct CacheSize {
+  std::optional<std::uint32_t> pages;
+  std::optional<std::uint64_t> kb;  // the same in KB
+};
+
 // What a run records beside its image, for the reports and pictures.
 struct Observation {
   std::uint64_t trace_routes = 0;         // record the routes of the first N packets
@@ -70,8 +77,7 @@ struct MachineOptions {
   bool relay_between_threads = true;   // links between threads through relays (NetworkOptions)
   bool forward_in_place = true;        // routers of one thread route in place (NetworkOptions); real time only
   bool shared_cores = false;           // other processes share the cores (csp::RuntimeOptions::shared_cores)
-  std::optional<std::uint32_t> cache_pages;  // remote pages cached per node
-  std::optional<std::uint64_t> cache_kb;     // the same in KB; default (neither): default_cache_pages()
+  CacheSize cache;
   Farming farming;
   int workers_per_node = 1;            // 1..max_workers_per_node
   Distribution distribution = Distribution::modulo;
@@ -155,8 +161,9 @@ struct MachineResult {
   MachineReport report;
 };
 
-// A MachineOptions field the machine cannot run with: field() is its name
-// in MachineOptions ("grain", "cache_kb", ...), reason() what is wrong with
+// A MachineOptions field the machine cannot run with: field() is its name,
+// the last part of its path in MachineOptions ("grain", "workers_per_node")
+// or, for the cache, "cache_pages" or "cache_kb"; reason() what is wrong with
 // its value; what() is "FIELD: REASON", one line. A caller with other names
 // for the fields (command-line options) says reason() under its own.
 class OptionError : public std::invalid_argument {

@@ -520,8 +520,8 @@ TEST(MachineOptions, DefaultIsASixteenNodeHypercubeWithTheDefaultCache) {
   EXPECT_FALSE(o.single);
   EXPECT_EQ(o.machine.topology.spec(), "hypercube:4");
   EXPECT_EQ(o.machine.topology.size(), 16u);
-  EXPECT_FALSE(o.machine.cache_pages);
-  EXPECT_FALSE(o.machine.cache_kb);
+  EXPECT_FALSE(o.machine.cache.pages);
+  EXPECT_FALSE(o.machine.cache.kb);
   EXPECT_EQ(o.machine.farming.schedule, nodes::Schedule::affinity);
   EXPECT_EQ(o.machine.farming.pixel_order, nodes::PixelOrder::hilbert);
   EXPECT_EQ(o.machine.distribution, nodes::Distribution::modulo);
@@ -538,7 +538,7 @@ TEST(MachineOptions, ValuesReachTheMachine) {
   const app::Options o = parse({"--cache-kb", "8", "--grain", "9", "--schedule", "dynamic",
                                 "--workers-per-node", "3", "--distribution", "block",
                                 "--trace-routes", "5", "--threads", "2", "--compare-serial", "--prefetch", "2"});
-  EXPECT_EQ(o.machine.cache_kb, 8u);
+  EXPECT_EQ(o.machine.cache.kb, 8u);
   EXPECT_EQ(o.machine.farming.grain, 9u);
   EXPECT_EQ(o.machine.farming.schedule, nodes::Schedule::dynamic);
   EXPECT_EQ(parse({"--schedule", "static"}).machine.farming.schedule, nodes::Schedule::static_split);

@@ -72,7 +72,7 @@ nodes::MachineResult run_case(const Case& c) {
   options.topology = topology::parse_topology(c.topology, c.nodes);
   options.threads = c.threads;
   auto db = make_db(c.scene, c.page_size, c.size);
-  options.cache_pages = c.cache_pages ? c.cache_pages : db.header.page_count;
+  options.cache.pages = c.cache_pages ? c.cache_pages : db.header.page_count;
   options.farming.grain = c.grain;
   options.farming.schedule = c.schedule;
   options.workers_per_node = c.workers;
@@ -173,7 +173,7 @@ TEST(Machine, RelaysCarryEveryPacketBetweenThreadsOnce) {
   options.threads = 2;
   options.relay_between_threads = false;
   auto db = make_db(c.scene, c.page_size, c.size);
-  options.cache_pages = c.cache_pages;
+  options.cache.pages = c.cache_pages;
   options.farming.grain = c.grain;
   const auto plain = nodes::run_machine(std::move(db), options);
   EXPECT_TRUE(plain.report.relays.empty());
@@ -279,7 +279,7 @@ TEST(Machine, ProgressStartsAtZeroAndEndsAtTheFrame) {
   options.topology = topology::parse_topology("ring", 4);
   options.threads = 2;
   auto db = make_db("teapot:2", 1024, 16);
-  options.cache_pages = db.header.page_count;
+  options.cache.pages = db.header.page_count;
   std::vector<std::uint64_t> seen;
   std::set<std::thread::id> threads;
   options.progress = [&](std::uint64_t done, std::uint64_t total) {
@@ -368,7 +368,7 @@ TEST(Machine, LargeSceneOn64NodesKeepsASmallFractionPerProcessor) {
   MachineOptions options;
   options.topology = topology::parse_topology("hypercube", 64);
   options.threads = 1;
-  options.cache_pages = 64;
+  options.cache.pages = 64;
   auto db = make_db("tetra:7", 1024, 16);
   const std::uint64_t database_bytes = db.header.bytes();
   ASSERT_GT(db.header.page_count, 64u * 8u);
@@ -480,10 +480,10 @@ void expect_error(const Case& c, MachineOptions options, const std::string& frag
 TEST(Machine, BadOptionsFailWithOneLineNamingTheField) {
   const Case c{"hypercube", 4, 1, 1024, 4, Schedule::dynamic, 1, 1};
   MachineOptions zero_cache;
-  zero_cache.cache_pages = 0;
+  zero_cache.cache.pages = 0;
   expect_error(c, zero_cache, "cache_pages");
   MachineOptions tiny_kb;
-  tiny_kb.cache_kb = 0;
+  tiny_kb.cache.kb = 0;
   expect_error(c, tiny_kb, "cache_kb");
   MachineOptions workers;
   workers.workers_per_node = 0;

@@ -29,7 +29,7 @@ RecordedRun recorded_run(const std::string& spec, std::size_t nodes, bool virtua
   options.topology = topology::parse_topology(spec, nodes);
   options.threads = threads;
   options.workers_per_node = workers;
-  options.cache_pages = 8;
+  options.cache.pages = 8;
   options.observe.record = true;
   options.observe.record_packets = max_packets;
   if (virtual_time) options.timing = nodes::profile_named("ipsc2");

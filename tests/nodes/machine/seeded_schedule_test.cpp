@@ -65,7 +65,7 @@ MachineOptions options_for(const Config& c, std::optional<std::uint64_t> seed) {
   MachineOptions o;
   o.topology = topology::parse_topology(c.topology, c.nodes);
   o.threads = 1;
-  o.cache_pages = c.cache_pages;
+  o.cache.pages = c.cache_pages;
   o.farming.schedule = c.schedule;
   o.workers_per_node = c.workers;
   o.farming.prefetch = c.prefetch;

@@ -93,7 +93,7 @@ MachineOptions options_for(const Case& c, const tracer::Database& db) {
   MachineOptions o;
   o.topology = topology::parse_topology(c.topology);
   o.threads = c.threads;
-  o.cache_pages = c.cache_pages ? c.cache_pages : db.header.page_count;
+  o.cache.pages = c.cache_pages ? c.cache_pages : db.header.page_count;
   o.farming.schedule = c.schedule;
   o.farming.grain = 4;
   o.workers_per_node = c.workers;
@@ -203,7 +203,7 @@ TEST(SplitMachine, NoRankHoldsMoreThanItsNodesPagesAndCaches) {
   auto db = make_db("tetra:5", 256, 16);
   const std::uint64_t database = db.header.bytes();
   MachineOptions options = options_for({"hypercube:6", 4}, db);
-  options.cache_pages = 4;
+  options.cache.pages = 4;
   const auto run = run_split(std::move(db), options, 4);
   ASSERT_TRUE(run.result) << what(run.errors[0]);
   const auto& r = run.result->report;
@@ -313,8 +313,8 @@ TEST(SplitMachine, RefusesMoreRanksThanNodesAndVirtualTimeOnEveryRank) {
 TEST(SplitMachine, BadSetUpOnRankZeroEndsEveryRankWithItsLine) {
   auto db = make_db("teapot:2", 1024, 8);
   MachineOptions options = options_for({"hypercube:2", 3}, db);
-  options.cache_pages.reset();
-  options.cache_kb = 0;  // less than a page: refused on rank 0, which alone knows the page size
+  options.cache.pages.reset();
+  options.cache.kb = 0;  // less than a page: refused on rank 0, which alone knows the page size
   const auto run = run_split(std::move(db), options, 3);
   for (std::size_t r = 0; r < run.errors.size(); ++r) {
     ASSERT_TRUE(run.errors[r]) << "rank " << r;

@@ -105,7 +105,7 @@ nodes::MachineResult run_timed(const std::string& topology, std::size_t n, unsig
   options.observe.record_tiles = record_tiles;
   options.topology = topology::parse_topology(topology, n);
   options.threads = threads;
-  options.cache_pages = 4;
+  options.cache.pages = 4;
   options.timing = model;
   return nodes::run_machine(make_db("teapot:2", 16), options);
 }
