@@ -105,7 +105,7 @@ on_hosts() {
   : >"hosts$n"
   for ((h = 1; h <= n; ++h)); do echo "$subnet.$((h + 1)) slots=1" >>"hosts$n"; done
   # shellcheck disable=SC2054  # the commas are inside MCA values
-  launch=(timeout -k 5 120 mpirun --hostfile "hosts$n" -np "$n" --mca plm_rsh_agent "$work/agent"
+  launch=(timeout -k 5 120 mpirun --hostfile "hosts$n" -np "$n" --bind-to none --mca plm_rsh_agent "$work/agent"
     --mca plm_rsh_no_tree_spawn 1 --mca oob_tcp_if_include "$subnet.0/24"
     --mca btl self,tcp --mca btl_tcp_if_include "$subnet.0/24")
 }
@@ -131,7 +131,7 @@ bench() {
       declare -A times=() ratio_of=()
       for ((round = 0; round < bench_rounds; ++round)); do
         for c in "${configs[@]}"; do
-          local args=("$vmpray" "$scene" --topology "$topology" --width "$bench_size" --height "$bench_size" -q
+          local args=("$vmpray" "$scene" --topology "$topology" --width "$bench_size" --height "$bench_size" --threads 1 -q
             -o "$c.png" --stats "$c.json")
           case $c in
             veth) on_hosts 2; "${launch[@]}" "${args[@]}" ;;
