@@ -204,13 +204,7 @@ NetworkStudyOptions parse_network_options(int argc, const char* const argv[]) {
   NetworkStudyOptions o;
   RawNetwork raw;
   po::options_description all = describe(o, raw);
-  po::variables_map vm;
-  try {
-    po::store(po::command_line_parser(argc, argv).options(all).run(), vm);
-    po::notify(vm);
-  } catch (const po::error& e) {
-    throw UsageError(e.what());
-  }
+  const po::variables_map vm = read_command_line(argc, argv, all);
   if (vm.count("help")) throw UsageError("help");
   check_network(o, raw);
   o.model = cost_model_from(raw.model.profile, raw.model.costs);

@@ -182,13 +182,7 @@ SweepOptions parse_sweep_options(int argc, const char* const argv[]) {
   all.add_options()("kind", po::value(&raw.kind));
   po::positional_options_description positional;
   positional.add("kind", 1).add("scene", 1);
-  po::variables_map vm;
-  try {
-    po::store(po::command_line_parser(argc, argv).options(all).positional(positional).run(), vm);
-    po::notify(vm);
-  } catch (const po::error& e) {
-    throw UsageError(e.what());
-  }
+  const po::variables_map vm = read_command_line(argc, argv, all, positional);
   if (vm.count("help")) throw UsageError("help");
   check_sweep(o, raw, vm);
   o.model = cost_model_from(raw.model.profile, raw.model.costs);

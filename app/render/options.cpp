@@ -383,13 +383,7 @@ Options parse_options(int argc, const char* const argv[]) {
   all.add(describe_render(o, raw)).add(machine).add(hidden);
   po::positional_options_description positional;
   positional.add("scene", 1);
-  po::variables_map vm;
-  try {
-    po::store(po::command_line_parser(argc, argv).options(all).positional(positional).run(), vm);
-    po::notify(vm);
-  } catch (const po::error& e) {
-    throw UsageError(e.what());
-  }
+  const po::variables_map vm = read_command_line(argc, argv, all, positional);
   if (vm.count("help")) o.action = Options::Action::help;
   else if (vm.count("version")) o.action = Options::Action::version;
   else if (vm.count("manpage")) o.action = Options::Action::manpage;

@@ -6,6 +6,8 @@
 #include <stdexcept>
 #include <string>
 
+#include <boost/program_options.hpp>
+
 #include "nodes/machine/machine.hpp"
 
 namespace app {
@@ -21,5 +23,11 @@ class UsageError : public std::runtime_error {
 // keeps its own name), and an OptionError becomes UsageError "OPTION: REASON".
 std::string option_of_field(const std::string& field);
 UsageError usage_error(const nodes::OptionError& error);
+
+// The command line read against `options` (and `positional`), notified;
+// Boost's errors become UsageError with Boost's one-line message.
+boost::program_options::variables_map read_command_line(
+    int argc, const char* const argv[], const boost::program_options::options_description& options,
+    const boost::program_options::positional_options_description& positional = {});
 
 }  // namespace app
