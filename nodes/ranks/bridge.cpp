@@ -138,18 +138,18 @@ void Bridge::carry() {
 }
 
 // After a packet for the wire: the rest of this pass (the routers ready
-// now may have more), then, while the frames are small and the window
+// now may have more), then, where messages are dear and while the window
 // lasts, every process ready on the thread, each in its turn, with what
 // came over the wire meanwhile: the packets of a pass leave in one message
-// per rank, and the message leaves at once when the thread has nothing
-// else to run, so gathering adds no wait where a rank would idle.
+// per rank (take_outgoing posts a frame as it fills), and the message
+// leaves at once when the thread has nothing else to run, so gathering
+// adds no wait where a rank would idle.
 void Bridge::gather() {
   const auto start = std::chrono::steady_clock::now();
   csp::yield();
   take_ready();
   if (!dear()) return;
-  while (gathered_bytes() < gathered_frame_bytes && std::chrono::steady_clock::now() - start < gathering_.window &&
-         csp::yield_to_all()) {
+  while (std::chrono::steady_clock::now() - start < gathering_.window && csp::yield_to_all()) {
     if (receive_all()) {
       if (stopping_) return;
       deliver_staged();
@@ -160,12 +160,6 @@ void Bridge::gather() {
 
 bool Bridge::dear() const {
   return gathering_.window.count() > 0 && post_cost_ >= static_cast<double>(gathering_.dear_message.count());
-}
-
-std::size_t Bridge::gathered_bytes() const {
-  std::size_t bytes = 0;
-  for (const WireWriter& w : frames_) bytes = std::max(bytes, w.size());
-  return bytes;
 }
 
 // What a ready guard offers: the packets of an outgoing link (true), or room

@@ -99,7 +99,6 @@ class Bridge {
   bool take(std::size_t guard);
   void take_ready();
   void gather();
-  std::size_t gathered_bytes() const;
   bool dear() const;  // messages cost enough to gather
   void take_outgoing(Outgoing& out);
   void queue_credits(bool all);
