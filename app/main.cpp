@@ -170,10 +170,10 @@ int rank_main(int argc, char** argv, const vmpi::MpiSession& mpi) {
   }
   if (options.action != app::Options::Action::render) return host ? print_help_or_version(options) : 0;
   // --threads 0: the rank's share of the CPUs, then nodes::thread_count's choice.
-  if (options.machine.threads == 0)
-    options.machine.cpus = app::threads_per_rank(0, mpi.ranks_on_this_host());
-  const unsigned at_most = options.machine.threads ? options.machine.threads : options.machine.cpus;
-  options.machine.shared_cores = app::cores_shared(at_most, mpi.ranks_on_this_host());
+  if (options.machine.threads.count == 0)
+    options.machine.threads.cpus = app::threads_per_rank(0, mpi.ranks_on_this_host());
+  const unsigned at_most = options.machine.threads.count ? options.machine.threads.count : options.machine.threads.cpus;
+  options.machine.threads.shared_cores = app::cores_shared(at_most, mpi.ranks_on_this_host());
   try {
     vmpi::MpiTransport transport;
     if (host) return run(options, std::vector<std::string>(argv, argv + argc), &transport);

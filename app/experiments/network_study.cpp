@@ -320,7 +320,7 @@ nodes::RecordedTraffic record_render_traffic(const NetworkStudyOptions& o, const
   render.width = render.height = o.scene_size;
   nodes::MachineOptions m;
   m.topology = t;
-  m.threads = 1;
+  m.threads.count = 1;
   m.timing = o.model;
   m.observe.record = true;
   m.observe.record_packets = std::numeric_limits<std::uint64_t>::max();

@@ -67,7 +67,8 @@ std::string with_hint(const nodes::ResourceError& error, const std::string& fewe
 
 nodes::MachineOptions machine_options(const Options& o) {
   nodes::MachineOptions machine = o.machine;
-  if (machine.threads == 0 && machine.cpus == 0) machine.cpus = usable_cpus();  // affinity and CPU quota
+  if (machine.threads.count == 0 && machine.threads.cpus == 0)
+    machine.threads.cpus = usable_cpus();  // affinity and CPU quota
   machine.trace = {.max_depth = o.max_depth,
                    .spd_procedure = o.spd_procedure,
                    .shadow_rays_to_all_lights = o.shadow_rays_all};
@@ -106,7 +107,7 @@ RenderResult render_machine(const Options& o, const tracer::Scene& scene, nodes:
   // In virtual time T1 is cheap and deterministic: always there for speedup and efficiency.
   if (o.compare_serial || machine.timing) serial = run_serial(db, machine, o);
   nodes::MachineResult result = run_with_progress(std::move(db), machine, o, "", ranks);
-  note_threads_lowered(o.machine.threads, result.report);
+  note_threads_lowered(o.machine.threads.count, result.report);
   report.rays = result.report.rays();
   report.render_seconds = result.report.wall_seconds;
   report.machine = MachineSummary{std::move(result.report), serial, o.spd_procedure};

@@ -126,7 +126,7 @@ std::uint64_t image_memory_bytes(const Options& o, int width, int height) {
   if (o.single) return (colour + rgb8) * pixels;  // its outputs: more than the render takes
   const std::uint64_t items =
       o.spd_procedure ? static_cast<std::uint64_t>(width + 1) * static_cast<std::uint64_t>(height + 1) : pixels;
-  const std::uint64_t per_node = static_cast<std::uint64_t>(o.machine.workers_per_node);
+  const std::uint64_t per_node = static_cast<std::uint64_t>(o.machine.shape.workers_per_node);
   const std::uint64_t nodes = o.machine.topology.size();
   std::uint64_t bytes = std::max(machine_run_bytes(o, pixels, items, nodes * per_node),
                                  machine_output_bytes(o, pixels, items));
@@ -247,7 +247,7 @@ std::uint64_t link_queues(const topology::Topology& t) {
 // The threads a run of `nodes` nodes gets (nodes::thread_count), with the
 // CPUs this process may use.
 unsigned run_threads(nodes::MachineOptions m, std::size_t nodes) {
-  if (m.threads == 0 && m.cpus == 0) m.cpus = usable_cpus();
+  if (m.threads.count == 0 && m.threads.cpus == 0) m.threads.cpus = usable_cpus();
   return nodes::thread_count(m, nodes);
 }
 
@@ -255,7 +255,7 @@ unsigned run_threads(nodes::MachineOptions m, std::size_t nodes) {
 // (nodes::Network::block_placement); none when links between threads are
 // plain channels or in virtual time (one thread).
 std::uint64_t relayed_link_queues(const nodes::MachineOptions& m, const topology::Topology& t, unsigned threads) {
-  if (threads < 2 || !m.relay_between_threads || m.timing) return 0;
+  if (threads < 2 || !m.threads.relay_between || m.timing) return 0;
   std::uint64_t relayed = 0;
   for (topology::NodeId n = 0; n < t.size(); ++n) {
     const unsigned from = nodes::Network::block_placement(n, t.size(), threads);
@@ -271,7 +271,7 @@ MachineMemory machine_memory(const Options& o, std::uint32_t page_count) {
   const nodes::MachineOptions& m = o.machine;
   const topology::Topology& t = m.topology;
   const bool virtual_time = m.timing.has_value();
-  const auto workers = static_cast<std::uint64_t>(m.workers_per_node);
+  const auto workers = static_cast<std::uint64_t>(m.shape.workers_per_node);
   MachineMemory r;
   r.spec = t.spec();
   r.nodes = t.size();
@@ -281,7 +281,8 @@ MachineMemory machine_memory(const Options& o, std::uint32_t page_count) {
   r.node_bytes = t.size() * ((virtual_time ? virtual_node_bytes : node_bytes) + workers * worker_bytes +
                              (1 + workers) * page_entry * page_count);
   r.link_bytes = r.link_queues * (virtual_time ? virtual_link_queue_bytes : link_queue_bytes);
-  const std::uint64_t ring_entries = m.buffer_capacity + nodes::ThreadRelays::credit_entries(m.buffer_capacity);
+  const std::uint64_t ring_entries =
+      m.shape.buffer_capacity + nodes::ThreadRelays::credit_entries(m.shape.buffer_capacity);
   r.relay_bytes = r.relayed_link_queues * (relayed_link_bytes + ring_entries * ring_entry_bytes);
   const double per_packet = recorded_packet_bytes + t.average_distance() * recorded_hop_bytes;
   r.recording_bytes =

@@ -143,17 +143,17 @@ void check_machine(Options& o, const Raw& raw, const po::variables_map& vm) {
   nodes::MachineOptions& m = o.machine;
   check_topology(m, raw, vm);
   check_cache(o, raw, vm);
-  m.threads = in_range<unsigned>(raw.threads, 0, 4096, "--threads");
+  m.threads.count = in_range<unsigned>(raw.threads, 0, 4096, "--threads");
   m.farming = parse_farming(raw.shared, vm);
-  m.workers_per_node = as_field<int>(raw.workers, "--workers-per-node");
+  m.shape.workers_per_node = as_field<int>(raw.workers, "--workers-per-node");
   m.observe.trace_routes = in_range<std::uint64_t>(raw.trace_routes, 0, 1 << 20, "--trace-routes");
   if (vm.count("trace-kind")) {
     if (m.observe.trace_routes == 0)
       throw UsageError("--trace-kind: chooses the packets --trace-routes N traces; give that too");
     m.observe.trace_kinds = parse_trace_kinds(raw.trace_kind);
   }
-  if (raw.distribution == "modulo") m.distribution = nodes::Distribution::modulo;
-  else if (raw.distribution == "block") m.distribution = nodes::Distribution::block;
+  if (raw.distribution == "modulo") m.shape.distribution = nodes::Distribution::modulo;
+  else if (raw.distribution == "block") m.shape.distribution = nodes::Distribution::block;
   else throw UsageError("--distribution: expected modulo or block, got '" + raw.distribution + "'");
   m.timing = timing_from(raw.timing);
   // Options that would change nothing here are errors, as with --single.
@@ -356,7 +356,7 @@ tracer::BuildOptions build_options(const Options& o) {
   return {.accel = o.accel,
           .bvh_layout = o.bvh_layout,
           .page_size = o.page_size,
-          .threads = o.machine.threads == 0 ? usable_cpus() : o.machine.threads};
+          .threads = o.machine.threads.count == 0 ? usable_cpus() : o.machine.threads.count};
 }
 
 std::string default_output(const std::string& scene) {

@@ -44,8 +44,8 @@ RenderResult render_single(const Options& o, const tracer::Scene& scene) {
   ProgressBar bar(std::uint64_t(w) * h, "pixels", !o.quiet && stderr_is_terminal());
   const auto t0 = std::chrono::steady_clock::now();
   // Rows are what the threads share out: more threads than rows would only wait.
-  const unsigned threads =
-      std::min<unsigned>(o.machine.threads == 0 ? usable_cpus() : o.machine.threads, unsigned(scene.camera.height));
+  const unsigned threads = std::min<unsigned>(o.machine.threads.count == 0 ? usable_cpus() : o.machine.threads.count,
+                                              unsigned(scene.camera.height));
   report.render_threads = threads;
   std::vector<tracer::Color> pixels =
       tracer::render_frame(db, trace, report.rays, threads, [&](int rows) { bar.update(std::uint64_t(rows) * w); });

@@ -94,7 +94,7 @@ void run_machine_once(MachineRun& run, const std::string& spec, int size, int no
     auto db = make_db(spec, size, build);  // not timed, as for the single process
     nodes::MachineOptions options;
     options.topology = topology::parse_topology("hypercube", static_cast<std::size_t>(nodes));
-    options.threads = threads;
+    options.threads.count = threads;
     options.cache.pages = std::max<std::uint32_t>(1, db.header.page_count / 8);
     if (variant) variant(options, db.header);
     const auto start = Clock::now();
@@ -143,10 +143,10 @@ int bench_machine(const std::vector<std::string>& args) {
   for (int nodes : {16, 64}) {
     MachineRun one, many, plain, one_routers, many_routers;
     const Variant no_relays = [](nodes::MachineOptions& o, const tracer::DatabaseHeader&) {
-      o.relay_between_threads = false;
+      o.threads.relay_between = false;
     };
     const Variant no_steps_in_place = [](nodes::MachineOptions& o, const tracer::DatabaseHeader&) {
-      o.forward_in_place = false;
+      o.threads.forward_in_place = false;
     };
     for (int r = 0; r < repeats; ++r) {
       std::vector<tracer::Color> frame;

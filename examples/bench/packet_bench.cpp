@@ -96,7 +96,7 @@ bool run_case(const Case& c, int size, int repeats) {
       tracer::Database copy = db;  // run_machine takes the database; the copy is not timed
       nodes::MachineOptions options;
       options.topology = topology::parse_topology("hypercube", static_cast<std::size_t>(c.nodes));
-      options.threads = 1;
+      options.threads.count = 1;
       const double start = cpu_seconds();
       const nodes::MachineResult result = nodes::run_machine(std::move(copy), options);
       machine.push_back(cpu_seconds() - start);

@@ -131,8 +131,8 @@ MachineSample run_machine(const Case& c, const tracer::Database& source, unsigne
   tracer::Database db = source;  // copied outside the timed part, as the plain side's is built
   nodes::MachineOptions options;
   options.topology = topology::parse_topology("hypercube", static_cast<std::size_t>(c.nodes));
-  options.threads = threads;  // 0: the default rule
-  options.workers_per_node = c.workers;
+  options.threads.count = threads;  // 0: the default rule
+  options.shape.workers_per_node = c.workers;
   if (c.cache_pages) options.cache.pages = c.cache_pages;
   const auto start = Clock::now();
   const nodes::MachineResult result = nodes::run_machine(std::move(db), options);

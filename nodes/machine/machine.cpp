@@ -62,20 +62,20 @@ void check_fields(const MachineOptions& options) {
     if (value < 1) throw OptionError(field, "must be at least 1, got " + std::to_string(value));
     if (value > hi) throw OptionError(field, "must be at most " + std::to_string(hi) + ", got " + std::to_string(value));
   };
-  within("workers_per_node", options.workers_per_node, max_workers_per_node);
+  within("workers_per_node", options.shape.workers_per_node, max_workers_per_node);
   within("grain", options.farming.grain, max_grain);
-  within("buffer_capacity", static_cast<std::int64_t>(std::min<std::size_t>(options.buffer_capacity, INT64_MAX)),
+  within("buffer_capacity", static_cast<std::int64_t>(std::min<std::size_t>(options.shape.buffer_capacity, INT64_MAX)),
          INT64_MAX);
   if (options.schedule_seed && options.timing)
     throw OptionError("schedule_seed", "cannot be given with timing (virtual time orders the processes by its clock)");
-  if (options.schedule_seed && options.threads != 1)
+  if (options.schedule_seed && options.threads.count != 1)
     throw OptionError("schedule_seed", "needs threads = 1 (a seed replays its schedule on one thread only), got " +
-                                           std::to_string(options.threads));
+                                           std::to_string(options.threads.count));
   if (options.farming.prefetch > max_prefetch(options))
     throw OptionError("prefetch", "must be at most " + std::to_string(max_prefetch(options)) + ", got " +
                                       std::to_string(options.farming.prefetch) +
                                       " (a worker's answers and a page reply must fit the network buffer of " +
-                                      std::to_string(options.buffer_capacity) + " packets)");
+                                      std::to_string(options.shape.buffer_capacity) + " packets)");
 }
 
 // Moves each page from the host's database into its owner's memory.
@@ -115,7 +115,7 @@ struct Wiring {
   bool split = false;       // other processes run the other nodes (a bridge serves the wire)
 
   Outbox outbox(NodeId n, std::uint16_t port) const {
-    const std::uint64_t ports = Ports::count(options.workers_per_node);
+    const std::uint64_t ports = Ports::count(options.shape.workers_per_node);
     return Outbox(net.in_place_injector(n, port), n * ports + port, processes);
   }
 };
@@ -162,7 +162,7 @@ PageFetch recording_fetch(Recorder& recorder, NodeId n, int worker, PageFetch in
 void spawn_node(const Wiring& w, NodeId n, NodeState& node) {
   const unsigned thread = w.net.thread_of(n);
   const std::string name = "node " + std::to_string(n);
-  const int k = w.options.workers_per_node;
+  const int k = w.options.shape.workers_per_node;
   const csp::In<Packet> requests =
       drained_port(w, n, Ports::page_server, page_requests_bound(w.net.topology().size(), k), name + " page",
                    node.mailbox);
@@ -221,12 +221,12 @@ void spawn_node(const Wiring& w, NodeId n, NodeState& node) {
 void spawn_host(const Wiring& w, Host& host) {
   const unsigned thread = w.net.thread_of(0);
   const auto nodes = static_cast<std::size_t>(w.net.topology().size());
-  const csp::In<Packet> requests =
-      drained_port(w, 0, Ports::farmer, farmer_bound(nodes, w.options.workers_per_node, w.options.farming.prefetch),
-                   "farmer", host.mailbox);
+  const csp::In<Packet> requests = drained_port(
+      w, 0, Ports::farmer, farmer_bound(nodes, w.options.shape.workers_per_node, w.options.farming.prefetch), "farmer",
+      host.mailbox);
   host.results = std::make_unique<csp::Channel<Packet>>("results", results_buffer);
   w.runtime.spawn("farmer", thread, [&w, &host, nodes, requests, out = w.outbox(0, Ports::farmer)] {
-    Farmer(*host.plan, static_cast<int>(nodes), w.options.workers_per_node, requests, out,
+    Farmer(*host.plan, static_cast<int>(nodes), w.options.shape.workers_per_node, requests, out,
            host.results->writer(), [&net = w.net] { net.shutdown(); }, host.farmer)
         .run();
   });
@@ -287,9 +287,10 @@ double imbalance(const std::vector<double>& values) {
 
 unsigned thread_count(const MachineOptions& options, std::size_t nodes) {
   nodes = std::max<std::size_t>(nodes, 1);
-  if (options.threads) return static_cast<unsigned>(std::min<std::size_t>(options.threads, nodes));
-  const std::size_t cpus = options.cpus ? options.cpus : std::max(1u, std::thread::hardware_concurrency());
-  const std::size_t workers = static_cast<std::size_t>(std::max(options.workers_per_node, 1));
+  if (options.threads.count) return static_cast<unsigned>(std::min<std::size_t>(options.threads.count, nodes));
+  const std::size_t cpus =
+      options.threads.cpus ? options.threads.cpus : std::max(1u, std::thread::hardware_concurrency());
+  const std::size_t workers = static_cast<std::size_t>(std::max(options.shape.workers_per_node, 1));
   const std::size_t by_workers = std::max<std::size_t>(nodes * workers / min_pixel_computers_per_thread, 1);
   return static_cast<unsigned>(std::min({cpus, by_workers, nodes}));
 }
@@ -367,7 +368,7 @@ csp::RuntimeOptions runtime_options(const MachineOptions& options, std::size_t l
                                     SplitState* split, int rank, Network* const& network) {
   csp::RuntimeOptions r;
   r.threads = thread_count(options, local_nodes);
-  r.shared_cores = options.shared_cores;
+  r.shared_cores = options.threads.shared_cores;
   if (timing) r = timing->runtime_options(r.stack_size);
   if (options.schedule_seed) r.scheduler = csp::seeded_scheduler(csp::seed_of_stream(*options.schedule_seed, rank));
   if (split)
@@ -382,8 +383,8 @@ NetworkOptions network_options(const MachineOptions& options, const MachineTimin
                                std::size_t topology_size, std::size_t local_nodes, unsigned threads,
                                Recorder* recorder) {
   NetworkOptions net;
-  net.buffer_capacity = options.buffer_capacity;
-  net.ports_per_node = Ports::count(options.workers_per_node);
+  net.buffer_capacity = options.shape.buffer_capacity;
+  net.ports_per_node = Ports::count(options.shape.workers_per_node);
   net.trace_routes = options.observe.trace_routes;
   net.trace_kinds = options.observe.trace_kinds;
   net.recorder = recorder;
@@ -392,11 +393,11 @@ NetworkOptions network_options(const MachineOptions& options, const MachineTimin
     // The page servers and the farmer read their ports directly (spawn_node, spawn_host).
     const std::size_t nodes = topology_size;
     net.port_capacity.assign(Ports::first_worker, 0);
-    net.port_capacity[Ports::page_server] = page_requests_bound(nodes, options.workers_per_node);
-    net.port_capacity[Ports::farmer] = farmer_bound(nodes, options.workers_per_node, options.farming.prefetch);
+    net.port_capacity[Ports::page_server] = page_requests_bound(nodes, options.shape.workers_per_node);
+    net.port_capacity[Ports::farmer] = farmer_bound(nodes, options.shape.workers_per_node, options.farming.prefetch);
   }
-  net.relay_between_threads = options.relay_between_threads && !timing;
-  net.forward_in_place = options.forward_in_place && !timing;
+  net.relay_between_threads = options.threads.relay_between && !timing;
+  net.forward_in_place = options.threads.forward_in_place && !timing;
   if (share.plan) {
     net.local = [share](NodeId n) { return share.runs(n); };
     net.placement = [first = share.first_node(), local_nodes, threads](NodeId n) {
@@ -434,8 +435,9 @@ void spawn_machine(const Wiring& wiring, std::vector<std::unique_ptr<NodeState>>
     if (nodes[n]) spawn_node(wiring, static_cast<NodeId>(n), *nodes[n]);
   if (share.runs(0)) {
     const MachineOptions& options = wiring.options;
-    host.plan = std::make_unique<WorkPlan>(items.count, options.farming.grain, options.farming.schedule,
-                                           static_cast<int>(wiring.net.topology().size()), options.workers_per_node);
+    host.plan =
+        std::make_unique<WorkPlan>(items.count, options.farming.grain, options.farming.schedule,
+                                   static_cast<int>(wiring.net.topology().size()), options.shape.workers_per_node);
     host.frame = std::make_unique<FrameAssembler>(items.count, items.grid.positions);
     host.owners.assign(items.count, 0);
     spawn_host(wiring, host);
@@ -499,7 +501,7 @@ MachineReport machine_report(const csp::Runtime& runtime, const Network& net, co
   report.topology = net.topology();
   report.nodes = static_cast<int>(net.topology().size());
   report.threads = runtime.threads();
-  report.workers_per_node = options.workers_per_node;
+  report.workers_per_node = options.shape.workers_per_node;
   report.prefetch = options.farming.prefetch;
   report.schedule = options.farming.schedule;
   report.pixel_order = options.farming.pixel_order;
@@ -595,7 +597,7 @@ Executed execute(const tracer::DatabaseHeader& header, const topology::Topology&
                       header,
                       options,
                       items.grid,
-                      topology.size() * Ports::count(options.workers_per_node),
+                      topology.size() * Ports::count(options.shape.workers_per_node),
                       timing,
                       options.observe.tiles() ? run_clock(started, timing != nullptr) : RunClock{},
                       recorder.get(),
@@ -632,7 +634,7 @@ MachineResult run_machine(tracer::Database db, const MachineOptions& options) {
   check_options(options, db.header.page_size);
   const topology::Topology& topology = options.topology;
   const std::uint32_t cache_pages = cache_pages_for(options, db.header);
-  const PagePlacement placement(options.distribution, static_cast<int>(topology.size()), db.header.page_count);
+  const PagePlacement placement(options.shape.distribution, static_cast<int>(topology.size()), db.header.page_count);
   auto nodes = distribute(db, placement, cache_pages);
   return execute(db.header, topology, placement, cache_pages, nodes, options, Share{}).result;
 }
@@ -685,7 +687,7 @@ tracer::DatabaseHeader receive_setup(const MachineOptions& options, const RankPl
   if (r.get<Setup>() != Setup::ok) throw RankFailure(0, r.get_string());
   tracer::DatabaseHeader header = get_header(r);
   const auto cache_pages = r.get<std::uint32_t>();
-  const PagePlacement placement(options.distribution, static_cast<int>(plan.nodes()), header.page_count);
+  const PagePlacement placement(options.shape.distribution, static_cast<int>(plan.nodes()), header.page_count);
   for (NodeId n = plan.first(rank); n < plan.first(rank) + plan.count(rank); ++n) {
     const Incoming share = transport.receive(Tag::setup, 0);
     const std::uint32_t own = placement.own_count(static_cast<int>(n));
@@ -784,7 +786,8 @@ std::optional<MachineResult> run_machine_rank(std::optional<tracer::Database> db
   if (rank == 0) {
     try {
       cache_pages = cache_pages_for(options, db->header);
-      const PagePlacement placement(options.distribution, static_cast<int>(topology.size()), db->header.page_count);
+      const PagePlacement placement(options.shape.distribution, static_cast<int>(topology.size()),
+                                    db->header.page_count);
       send_setup(*db, plan, placement, cache_pages, transport, nodes);
     } catch (const std::exception& e) {
       abandon_machine(transport, e.what());
@@ -795,7 +798,7 @@ std::optional<MachineResult> run_machine_rank(std::optional<tracer::Database> db
     header = receive_setup(options, plan, rank, transport, nodes);
     cache_pages = cache_pages_for(options, header);
   }
-  const PagePlacement placement(options.distribution, static_cast<int>(topology.size()), header.page_count);
+  const PagePlacement placement(options.shape.distribution, static_cast<int>(topology.size()), header.page_count);
   Executed executed =
       execute(header, topology, placement, cache_pages, nodes, options, Share{&plan, &transport, rank});
   MachineReport& report = executed.result.report;

@@ -70,31 +70,46 @@ struct Observation {
   bool tiles() const { return record_tiles || record; }  // the tiles' times are taken
 };
 
+// The OS threads that carry a run, and how the network crosses between
+// them. A run takes at most one thread per node; virtual time always takes
+// one (timing), and then neither relays nor in-place routing apply.
+struct Threads {
+  unsigned count = 0;            // 0: thread_count()'s choice; never more than the nodes
+  unsigned cpus = 0;             // the CPUs count = 0 may use; 0: the host's
+  bool relay_between = true;     // links between threads through relays (NetworkOptions::relay_between_threads)
+  bool forward_in_place = true;  // routers of one thread route in place (NetworkOptions); real time only
+  bool shared_cores = false;     // other processes share the cores (csp::RuntimeOptions::shared_cores)
+};
+
+// The machine's shape beside its topology: the pixel computers on each node,
+// which node owns each page, and the packets each network queue holds. The
+// buffer bounds the prefetch (max_prefetch), so that the network cannot
+// deadlock (docs/architecture.md).
+struct Shape {
+  int workers_per_node = 1;                          // 1..max_workers_per_node
+  Distribution distribution = Distribution::modulo;  // page -> owner
+  std::size_t buffer_capacity = 4;                   // packets per network queue
+};
+
 struct MachineOptions {
   topology::Topology topology = topology::Topology::hypercube(4);  // 16 nodes; topology::parse_topology reads a spec
-  unsigned threads = 0;                // 0: thread_count()'s choice; never more than the nodes
-  unsigned cpus = 0;                   // the CPUs threads = 0 may use; 0: the host's
-  bool relay_between_threads = true;   // links between threads through relays (NetworkOptions)
-  bool forward_in_place = true;        // routers of one thread route in place (NetworkOptions); real time only
-  bool shared_cores = false;           // other processes share the cores (csp::RuntimeOptions::shared_cores)
+  Shape shape;
+  Threads threads;
   CacheSize cache;
   Farming farming;
-  int workers_per_node = 1;            // 1..max_workers_per_node
-  Distribution distribution = Distribution::modulo;
   Observation observe;
-  std::size_t buffer_capacity = 4;     // packets per network queue
   tracer::TraceOptions trace;
   std::optional<CostModel> timing;     // virtual time under this model (the run takes one thread)
   // For tests: the one thread's ready processes run in an order drawn from
   // this seed (csp::SeededScheduler), so one seed replays one schedule, and
   // pixel computers offer the thread every few pixels so that the draws cut
-  // tiles too. Needs threads = 1; not with timing. A split run draws per rank
-  // (csp::seed_of_stream(seed, rank)), but the wire's timing still varies.
+  // tiles too. Needs threads.count = 1; not with timing. A split run draws per
+  // rank (csp::seed_of_stream(seed, rank)), but the wire's timing still varies.
   std::optional<std::uint64_t> schedule_seed;
   Progress progress;                   // called by the collector (on its thread): at 0 as it starts, then per result
 };
 
-// The OS threads that carry `nodes` nodes of a run: `threads` when given,
+// The OS threads that carry `nodes` nodes of a run: threads.count when given,
 // else the CPUs, but no more than one thread for every
 // min_pixel_computers_per_thread pixel computers (nodes x workers), so that
 // a pixel computer waiting for a page leaves its thread another to run;
@@ -112,7 +127,7 @@ constexpr int max_workers_per_node = 64;
 // reply must fit the network's delivery buffer (docs/architecture.md, "Why
 // the network cannot deadlock").
 inline std::uint16_t max_prefetch(const MachineOptions& options) {
-  return static_cast<std::uint16_t>(options.buffer_capacity - 1);
+  return static_cast<std::uint16_t>(options.shape.buffer_capacity - 1);
 }
 
 struct MachineReport {
@@ -142,7 +157,7 @@ struct MachineReport {
   NetworkStats network;
   std::vector<RankReport> ranks;  // empty unless the machine ran over several processes
   std::size_t cut_links = 0;      // links whose ends ran in different processes
-  std::shared_ptr<const Recording> recording;  // with MachineOptions::record; null otherwise
+  std::shared_ptr<const Recording> recording;  // with Observation::record; null otherwise
 
   SvmStats svm() const;
   ServerCounters served() const;

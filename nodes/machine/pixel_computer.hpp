@@ -1,6 +1,6 @@
 // A pixel computer: one fiber that asks the farmer for work, traces it
 // through its node's shared virtual memory and sends the colours back. A
-// processor runs one or more (MachineOptions::workers_per_node), so page
+// processor runs one or more (Shape::workers_per_node), so page
 // waits of one overlap with tracing by another.
 //
 // It reads only its own local port (Ports::first_worker + w): the farmer's

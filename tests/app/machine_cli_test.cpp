@@ -524,7 +524,7 @@ TEST(MachineOptions, DefaultIsASixteenNodeHypercubeWithTheDefaultCache) {
   EXPECT_FALSE(o.machine.cache.kb);
   EXPECT_EQ(o.machine.farming.schedule, nodes::Schedule::affinity);
   EXPECT_EQ(o.machine.farming.pixel_order, nodes::PixelOrder::hilbert);
-  EXPECT_EQ(o.machine.distribution, nodes::Distribution::modulo);
+  EXPECT_EQ(o.machine.shape.distribution, nodes::Distribution::modulo);
 }
 
 TEST(MachineOptions, AFullSpecNeedsNoNodeCount) {
@@ -545,10 +545,10 @@ TEST(MachineOptions, ValuesReachTheMachine) {
   EXPECT_EQ(parse({"--schedule", "affinity"}).machine.farming.schedule, nodes::Schedule::affinity);
   EXPECT_EQ(parse({"--pixel-order", "scanline"}).machine.farming.pixel_order, nodes::PixelOrder::scanline);
   EXPECT_EQ(parse({"--schedule", "dynamic"}).machine.farming.schedule, nodes::Schedule::dynamic);
-  EXPECT_EQ(o.machine.workers_per_node, 3);
-  EXPECT_EQ(o.machine.distribution, nodes::Distribution::block);
+  EXPECT_EQ(o.machine.shape.workers_per_node, 3);
+  EXPECT_EQ(o.machine.shape.distribution, nodes::Distribution::block);
   EXPECT_EQ(o.machine.observe.trace_routes, 5u);
-  EXPECT_EQ(o.machine.threads, 2u);
+  EXPECT_EQ(o.machine.threads.count, 2u);
   EXPECT_EQ(o.machine.farming.prefetch, 2);
   EXPECT_TRUE(o.compare_serial);
 }

@@ -25,7 +25,7 @@ nodes::MachineResult small_run(bool corners, bool record_tiles = true) {
   scene.camera.height = 10;
   nodes::MachineOptions options;
   options.topology = topology::parse_topology("mesh:2x2");
-  options.threads = 1;
+  options.threads.count = 1;
   options.trace.spd_procedure = corners;
   options.timing = nodes::ipsc2_profile();
   options.observe.record_tiles = record_tiles;

@@ -111,7 +111,7 @@ TEST(Options, TheMachinesBoundsAreCheckedByTheMachine) {
   EXPECT_EQ(error_of({"--prefetch", "4"}).rfind("--prefetch: must be at most 3, got 4", 0), 0u);
   const Options o = parse({"--grain", "1048576", "--workers-per-node", "64", "--prefetch", "3"});
   EXPECT_EQ(o.machine.farming.grain, nodes::max_grain);
-  EXPECT_EQ(o.machine.workers_per_node, nodes::max_workers_per_node);
+  EXPECT_EQ(o.machine.shape.workers_per_node, nodes::max_workers_per_node);
   EXPECT_EQ(o.machine.farming.prefetch, 3);
 }
 
@@ -128,7 +128,7 @@ TEST(Options, MachineOptionsWithSingleAreErrors) {
   const Options o = parse({"--single", "--width", "8", "--shadow-rays", "all"});
   EXPECT_TRUE(o.single);
   // --threads is the one machine option the single-process renderer takes.
-  EXPECT_EQ(parse({"--single", "--threads", "3"}).machine.threads, 3u);
+  EXPECT_EQ(parse({"--single", "--threads", "3"}).machine.threads.count, 3u);
 }
 
 TEST(Options, HelpAndVersionAreActions) {

@@ -70,17 +70,17 @@ struct Case {
 nodes::MachineResult run_case(const Case& c) {
   MachineOptions options;
   options.topology = topology::parse_topology(c.topology, c.nodes);
-  options.threads = c.threads;
+  options.threads.count = c.threads;
   auto db = make_db(c.scene, c.page_size, c.size);
   options.cache.pages = c.cache_pages ? c.cache_pages : db.header.page_count;
   options.farming.grain = c.grain;
   options.farming.schedule = c.schedule;
-  options.workers_per_node = c.workers;
+  options.shape.workers_per_node = c.workers;
   options.farming.prefetch = c.prefetch;
   options.farming.pixel_order = c.order;
   options.trace.spd_procedure = c.spd;
   options.observe.record_tiles = c.record_tiles;
-  options.forward_in_place = c.forward_in_place;
+  options.threads.forward_in_place = c.forward_in_place;
   return nodes::run_machine(std::move(db), options);
 }
 
@@ -170,8 +170,8 @@ TEST(Machine, RelaysCarryEveryPacketBetweenThreadsOnce) {
 
   MachineOptions options;
   options.topology = topology::parse_topology(c.topology, c.nodes);
-  options.threads = 2;
-  options.relay_between_threads = false;
+  options.threads.count = 2;
+  options.threads.relay_between = false;
   auto db = make_db(c.scene, c.page_size, c.size);
   options.cache.pages = c.cache_pages;
   options.farming.grain = c.grain;
@@ -277,7 +277,7 @@ TEST(Machine, EveryPixelIsComputedExactlyOnce) {
 TEST(Machine, ProgressStartsAtZeroAndEndsAtTheFrame) {
   MachineOptions options;
   options.topology = topology::parse_topology("ring", 4);
-  options.threads = 2;
+  options.threads.count = 2;
   auto db = make_db("teapot:2", 1024, 16);
   options.cache.pages = db.header.page_count;
   std::vector<std::uint64_t> seen;
@@ -367,7 +367,7 @@ TEST(Machine, ResidentSceneBytesStayWithinOwnShareAndCache) {
 TEST(Machine, LargeSceneOn64NodesKeepsASmallFractionPerProcessor) {
   MachineOptions options;
   options.topology = topology::parse_topology("hypercube", 64);
-  options.threads = 1;
+  options.threads.count = 1;
   options.cache.pages = 64;
   auto db = make_db("tetra:7", 1024, 16);
   const std::uint64_t database_bytes = db.header.bytes();
@@ -419,7 +419,7 @@ TEST(Machine, DefaultCacheIsAnEighthOfTheDatabaseButNeverTooSmallForARay) {
   ASSERT_LT(pages, 16u);
   MachineOptions options;
   options.topology = topology::parse_topology("hypercube", 16);
-  options.threads = 1;
+  options.threads.count = 1;
   const auto result = nodes::run_machine(std::move(db), options);
   for (const auto& node : result.report.per_node) {
     EXPECT_EQ(node.cache_capacity + node.own_bytes / 1024, pages);  // every page it does not own
@@ -433,29 +433,29 @@ TEST(Machine, DefaultCacheIsAnEighthOfTheDatabaseButNeverTooSmallForARay) {
 // is taken as it is, at most one thread a node.
 TEST(Machine, DefaultThreadsLeaveEachThreadTwoPixelComputers) {
   MachineOptions o;
-  o.cpus = 16;
+  o.threads.cpus = 16;
   EXPECT_EQ(nodes::thread_count(o, 16), 8u);
   EXPECT_EQ(nodes::thread_count(o, 64), 16u);
   EXPECT_EQ(nodes::thread_count(o, 256), 16u);
   EXPECT_EQ(nodes::thread_count(o, 5), 2u);
   EXPECT_EQ(nodes::thread_count(o, 2), 1u);
   EXPECT_EQ(nodes::thread_count(o, 1), 1u);
-  o.workers_per_node = 4;
+  o.shape.workers_per_node = 4;
   EXPECT_EQ(nodes::thread_count(o, 16), 16u);
   EXPECT_EQ(nodes::thread_count(o, 2), 2u);
-  o.cpus = 2;
-  o.workers_per_node = 1;
+  o.threads.cpus = 2;
+  o.shape.workers_per_node = 1;
   EXPECT_EQ(nodes::thread_count(o, 16), 2u);
   EXPECT_EQ(nodes::thread_count(o, 3), 1u);
-  o.threads = 16;
-  o.cpus = 0;
+  o.threads.count = 16;
+  o.threads.cpus = 0;
   EXPECT_EQ(nodes::thread_count(o, 16), 16u);
   EXPECT_EQ(nodes::thread_count(o, 4), 4u);
 
   // And a run takes what the rule says.
   MachineOptions run;
   run.topology = topology::parse_topology("hypercube", 4);
-  run.cpus = 4;
+  run.threads.cpus = 4;
   EXPECT_EQ(nodes::run_machine(make_db("balls:1", 1024, 16), run).report.threads, 2u);
 }
 
@@ -486,9 +486,9 @@ TEST(Machine, BadOptionsFailWithOneLineNamingTheField) {
   tiny_kb.cache.kb = 0;
   expect_error(c, tiny_kb, "cache_kb");
   MachineOptions workers;
-  workers.workers_per_node = 0;
+  workers.shape.workers_per_node = 0;
   expect_error(c, workers, "workers_per_node");
-  workers.workers_per_node = nodes::max_workers_per_node + 1;
+  workers.shape.workers_per_node = nodes::max_workers_per_node + 1;
   expect_error(c, workers, "workers_per_node: must be at most 64, got 65");
   MachineOptions grain;
   grain.farming.grain = 0;

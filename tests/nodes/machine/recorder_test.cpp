@@ -27,8 +27,8 @@ RecordedRun recorded_run(const std::string& spec, std::size_t nodes, bool virtua
                          unsigned threads = 1, int workers = 1) {
   nodes::MachineOptions options;
   options.topology = topology::parse_topology(spec, nodes);
-  options.threads = threads;
-  options.workers_per_node = workers;
+  options.threads.count = threads;
+  options.shape.workers_per_node = workers;
   options.cache.pages = 8;
   options.observe.record = true;
   options.observe.record_packets = max_packets;
@@ -186,7 +186,7 @@ TEST(Recorder, ABudgetOfNoneCountsEveryPacket) {
 TEST(Recorder, AnUnrecordedRunHasNoRecording) {
   nodes::MachineOptions options;
   options.topology = topology::parse_topology("hypercube", 4);
-  options.threads = 1;
+  options.threads.count = 1;
   const auto result = nodes::run_machine(test::make_db("teapot:2", 1024, 16), options);
   EXPECT_EQ(result.report.recording, nullptr);
 }

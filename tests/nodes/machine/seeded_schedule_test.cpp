@@ -64,13 +64,13 @@ std::string describe(const Config& c) {
 MachineOptions options_for(const Config& c, std::optional<std::uint64_t> seed) {
   MachineOptions o;
   o.topology = topology::parse_topology(c.topology, c.nodes);
-  o.threads = 1;
+  o.threads.count = 1;
   o.cache.pages = c.cache_pages;
   o.farming.schedule = c.schedule;
-  o.workers_per_node = c.workers;
+  o.shape.workers_per_node = c.workers;
   o.farming.prefetch = c.prefetch;
   o.farming.grain = c.grain;
-  o.buffer_capacity = c.buffer_capacity;
+  o.shape.buffer_capacity = c.buffer_capacity;
   o.farming.pixel_order = c.order;
   o.schedule_seed = seed;
   return o;
@@ -232,7 +232,7 @@ TEST(SeededSchedules, ASeedReplaysItsSchedule) {
 TEST(SeededSchedules, ASeedIsRefusedWithVirtualTimeOrSeveralThreads) {
   const Config c{"ring", 3, 2, Schedule::dynamic, 1, 1, 4};
   MachineOptions options = options_for(c, 1);
-  options.threads = 2;
+  options.threads.count = 2;
   try {
     nodes::run_machine(database(c), options);
     ADD_FAILURE() << "a seed on two threads was accepted";
@@ -240,7 +240,7 @@ TEST(SeededSchedules, ASeedIsRefusedWithVirtualTimeOrSeveralThreads) {
     EXPECT_EQ(e.field(), "schedule_seed");
     EXPECT_NE(std::string(e.what()).find("threads = 1"), std::string::npos) << e.what();
   }
-  options.threads = 1;
+  options.threads.count = 1;
   options.timing = nodes::CostModel{};
   try {
     nodes::run_machine(database(c), options);

@@ -92,11 +92,11 @@ std::string describe(const Case& c) {
 MachineOptions options_for(const Case& c, const tracer::Database& db) {
   MachineOptions o;
   o.topology = topology::parse_topology(c.topology);
-  o.threads = c.threads;
+  o.threads.count = c.threads;
   o.cache.pages = c.cache_pages ? c.cache_pages : db.header.page_count;
   o.farming.schedule = c.schedule;
   o.farming.grain = 4;
-  o.workers_per_node = c.workers;
+  o.shape.workers_per_node = c.workers;
   return o;
 }
 

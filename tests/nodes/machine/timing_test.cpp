@@ -101,10 +101,10 @@ TEST(Timing, MessageSoftwareCostsBothProcessorsTwoMessagesPerPageRequest) {
 nodes::MachineResult run_timed(const std::string& topology, std::size_t n, unsigned threads,
                                const CostModel& model, bool record_tiles = false, int workers_per_node = 1) {
   nodes::MachineOptions options;
-  options.workers_per_node = workers_per_node;
+  options.shape.workers_per_node = workers_per_node;
   options.observe.record_tiles = record_tiles;
   options.topology = topology::parse_topology(topology, n);
-  options.threads = threads;
+  options.threads.count = threads;
   options.cache.pages = 4;
   options.timing = model;
   return nodes::run_machine(make_db("teapot:2", 16), options);
