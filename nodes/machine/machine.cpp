@@ -36,6 +36,7 @@ struct NodeState {
   std::vector<std::unique_ptr<Outbox>> worker_out;
   std::vector<std::unique_ptr<WorkerPort>> worker_in;
   std::vector<WorkerCounters> work;
+  std::unique_ptr<NodeObserver> observer;  // null unless virtual time or the recorder watches
   std::unique_ptr<Mailbox> mailbox;
 };
 
@@ -144,19 +145,36 @@ csp::In<Packet> drained_port(const Wiring& w, NodeId n, std::uint16_t port, std:
   return mailbox->reader();
 }
 
-// The miss path with each wait for a page logged on the node while the
-// recorder's budget lasts, and counted after.
-PageFetch recording_fetch(Recorder& recorder, NodeId n, int worker, PageFetch inner) {
-  return [&recorder, n, worker, inner = std::move(inner)](std::uint32_t page) {
-    if (!recorder.open()) {
-      ++recorder.log(n).unrecorded_fetches;
-      return inner(page);
-    }
-    const double start = recorder.now();
-    auto bytes = inner(page);
-    recorder.log(n).fetches.push_back({start, recorder.now(), page, static_cast<std::uint16_t>(worker)});
-    return bytes;
-  };
+// Who watches node n's pixel computers: virtual time's charges, then the
+// recorder, so that a recorded wait starts as its request leaves, after the
+// work before it is charged; null when neither watches.
+std::unique_ptr<NodeObserver> node_observer(const Wiring& w, NodeId n, const std::vector<WorkerCounters>& work) {
+  auto observers = std::make_unique<ObserverList>();
+  if (w.timing) {
+    std::vector<const tracer::RayStats*> rays;
+    for (const WorkerCounters& counters : work) rays.push_back(&counters.rays);
+    observers->add(w.timing->charges(static_cast<int>(n), rays));
+  }
+  if (w.recorder) observers->add(std::make_unique<RecordingObserver>(*w.recorder, n, static_cast<int>(work.size())));
+  if (observers->empty()) return nullptr;
+  return observers;
+}
+
+// Whether pixel computers run at low priority, yielding every few pixels.
+// On the one thread of a whole machine nobody waits across threads or
+// processes, and first-in first-out order lets a router take more packets
+// per wake-up; under virtual time the scheduler orders by clock. A split
+// machine's bridge polls the wire and needs the thread often.
+bool prioritised(const Wiring& w) { return !w.timing && (w.runtime.threads() > 1 || w.split); }
+
+// How pixel computers pace their work. Under a schedule seed they yield
+// every few pixels whatever their priority, so that the seeded draws also
+// interleave them mid-tile.
+WorkerPacing worker_pacing(const Wiring& w, NodeObserver* observer) {
+  const std::uint32_t timeslice = w.options.schedule_seed ? seeded_timeslice_items
+                                  : prioritised(w)        ? timeslice_items
+                                                          : 0;
+  return {w.options.farming.prefetch, timeslice, observer, w.tile_clock};
 }
 
 void spawn_node(const Wiring& w, NodeId n, NodeState& node) {
@@ -172,49 +190,19 @@ void spawn_node(const Wiring& w, NodeId n, NodeState& node) {
   w.net.receive_in_place(n, Ports::page_server, *node.server);
   w.runtime.spawn(name + " page server", thread, [server = node.server.get()] { server->run(); });
   node.work.resize(static_cast<std::size_t>(k));
+  node.observer = node_observer(w, n, node.work);
+  const TraceWork work{w.header, w.options.trace, w.grid};
+  const WorkerPacing pacing = worker_pacing(w, node.observer.get());
   for (int i = 0; i < k; ++i) {
     const auto port = static_cast<std::uint16_t>(Ports::first_worker + i);
-    node.worker_out.push_back(std::make_unique<Outbox>(w.outbox(n, port)));
-    node.worker_in.push_back(std::make_unique<WorkerPort>(w.net.port(n, port)));
-    Outbox& out = *node.worker_out.back();
-    WorkerPort& in = *node.worker_in.back();
-    auto& counters = node.work[static_cast<std::size_t>(i)];
-    PageFetch fetch = make_page_fetch(w.placement, port, in, out);
-    // Inside the charge: the wait starts as the request leaves.
-    if (w.recorder) fetch = recording_fetch(*w.recorder, n, i, std::move(fetch));
-    std::function<void()> charge;
-    if (w.timing) {
-      ComputeMeter& meter = w.timing->add_meter(static_cast<int>(n), counters.rays);
-      fetch = MachineTiming::charging_fetch(meter, std::move(fetch));
-      charge = [&meter] { meter.charge(); };
-    }
-    SvmSource& source = node.svm->add_worker(std::move(fetch));
-    // After each tile (its work charged): the page calls the cache and the
-    // own pages have answered so far.
-    if (w.recorder)
-      charge = [charge, &source, recorder = w.recorder, n, worker = static_cast<std::uint16_t>(i)] {
-        if (charge) charge();
-        const SvmStats s = source.stats();
-        recorder->log(n).hits.push_back({recorder->now(), s.own_hits + s.cache_hits, worker});
-      };
-    // On the one thread of a whole machine nobody waits across threads or
-    // processes, and first-in first-out order lets a router take more
-    // packets per wake-up; under virtual time the scheduler orders by clock.
-    // A split machine's bridge polls the wire and needs the thread often.
-    // Under a schedule seed they yield every few pixels whatever their
-    // priority, so that the seeded draws also interleave them mid-tile.
-    const bool prioritised = !w.timing && (w.runtime.threads() > 1 || w.split);
-    const std::uint32_t timeslice = w.options.schedule_seed ? seeded_timeslice_items
-                                    : prioritised           ? timeslice_items
-                                                            : 0;
+    Outbox& out = *node.worker_out.emplace_back(std::make_unique<Outbox>(w.outbox(n, port)));
+    WorkerPort& in = *node.worker_in.emplace_back(std::make_unique<WorkerPort>(w.net.port(n, port)));
+    SvmSource& source = node.svm->add_worker(make_page_fetch(w.placement, port, in, out, node.observer.get()));
+    const WorkerLinks links{port, source, in, out, node.work[static_cast<std::size_t>(i)]};
     w.runtime.spawn(
         name + " pixel computer " + std::to_string(i), thread,
-        [&w, port, &source, &in, &out, &counters, charge, timeslice] {
-          PixelComputer(port, w.options.farming.prefetch, source, w.header, w.options.trace, w.grid, in, out,
-                        counters, charge, timeslice, w.tile_clock)
-              .run();
-        },
-        prioritised ? csp::Priority::low : csp::Priority::high);
+        [work, links, pacing] { PixelComputer(work, links, pacing).run(); },
+        prioritised(w) ? csp::Priority::low : csp::Priority::high);
   }
 }
 

@@ -7,7 +7,8 @@
 // work and stop answers, P + 1 always owed to it (P = prefetch), and the
 // page_reply to each of its misses (make_page_fetch); answers that arrive
 // while it waits for a page are kept, in order, for later. It sends a result
-// after each tile and worker_done once every answer is in, then ends. On
+// after each tile and worker_done once every answer is in, then ends; its
+// node's observer (node_observer.hpp) hears of each miss and each tile. On
 // several threads it runs at low priority and yields every `timeslice`
 // items. The protocol and why the port drains: docs/architecture.md ("The
 // path of one pixel", "The path of one page request", "Messages", "Why the
@@ -22,6 +23,7 @@
 
 #include "csp/csp.hpp"
 #include "nodes/machine/messages.hpp"
+#include "nodes/machine/node_observer.hpp"
 #include "nodes/machine/pixel_order.hpp"
 #include "nodes/machine/svm.hpp"
 #include "tracer/render.hpp"
@@ -74,32 +76,53 @@ class WorkerPort {
   std::deque<Packet> answers_;  // arrived while waiting for a page
 };
 
+// What a pixel computer traces: the frame's items (grid) of the scene whose
+// header this is, under these options. The header outlives the process.
+struct TraceWork {
+  const tracer::DatabaseHeader& header;
+  tracer::TraceOptions options;
+  ItemGrid grid;
+};
+
+// Where a pixel computer stands on its node: its port (Ports::first_worker +
+// its index), its view of the node's memory, the port it reads, the outbox
+// it sends on and the counters it fills. All outlive the process.
+struct WorkerLinks {
+  std::uint16_t port;
+  SvmSource& source;
+  WorkerPort& in;
+  Outbox& out;
+  WorkerCounters& counters;
+};
+
+// How a pixel computer paces its work, and who watches it.
+struct WorkerPacing {
+  std::uint16_t prefetch = 0;        // tiles asked for beyond the one traced (Farming::prefetch)
+  std::uint32_t timeslice = 0;       // items traced between two csp::yield()s; 0: never yield
+  NodeObserver* observer = nullptr;  // told of each tile before its result is sent; null: nobody
+  RunClock clock;                    // set: record a TileSpan per tile
+};
+
 class PixelComputer {
  public:
-  PixelComputer(std::uint16_t port, std::uint16_t prefetch, SvmSource& source, const tracer::DatabaseHeader& header,
-                tracer::TraceOptions options, ItemGrid grid, WorkerPort& in, Outbox& out, WorkerCounters& counters,
-                std::function<void()> after_tile = {}, std::uint32_t timeslice = 0, RunClock clock = {});
+  PixelComputer(const TraceWork& work, const WorkerLinks& links, WorkerPacing pacing = {});
   void run();
 
  private:
   void compute(Tile tile);
+  int worker() const { return links_.port - Ports::first_worker; }
 
-  std::uint16_t port_;
-  std::uint16_t prefetch_;
-  SvmSource& source_;
+  WorkerLinks links_;
+  WorkerPacing pacing_;
   tracer::Tracer tracer_;
   ItemGrid grid_;
-  WorkerPort& in_;
-  Outbox& out_;
-  WorkerCounters& counters_;
   std::vector<tracer::Color> colors_;
-  std::function<void()> after_tile_;  // before the result is sent: virtual time charges the work here
-  std::uint32_t timeslice_;           // items traced between two csp::yield()s; 0: never yield
-  RunClock clock_;                    // set: record a TileSpan per tile
 };
 
 // The miss path of a worker's SvmSource: page_request to the owner, then
-// wait on the worker's port for the page_reply.
-PageFetch make_page_fetch(const PagePlacement& placement, std::uint16_t port, WorkerPort& in, Outbox& out);
+// wait on the worker's port for the page_reply; the node's observer, if
+// any, is told as the request leaves and as the page arrives.
+PageFetch make_page_fetch(const PagePlacement& placement, std::uint16_t port, WorkerPort& in, Outbox& out,
+                          NodeObserver* observer = nullptr);
 
 }  // namespace nodes

@@ -17,6 +17,30 @@ Recorder::Recorder(std::size_t nodes, std::uint64_t max_packets, bool virtual_ti
   for (std::size_t n = 0; n < nodes; ++n) logs_.push_back(std::make_unique<NodeLog>());
 }
 
+RecordingObserver::RecordingObserver(Recorder& recorder, NodeId node, int workers)
+    : recorder_(recorder), node_(node), waiting_(static_cast<std::size_t>(workers)) {}
+
+void RecordingObserver::fetch_started(int worker, std::uint32_t /*page*/) {
+  std::optional<double>& waiting = waiting_.at(static_cast<std::size_t>(worker));
+  waiting.reset();
+  if (recorder_.open())
+    waiting = recorder_.now();
+  else
+    ++recorder_.log(node_).unrecorded_fetches;
+}
+
+void RecordingObserver::fetch_ended(int worker, std::uint32_t page) {
+  std::optional<double>& waiting = waiting_.at(static_cast<std::size_t>(worker));
+  if (!waiting) return;
+  recorder_.log(node_).fetches.push_back({*waiting, recorder_.now(), page, static_cast<std::uint16_t>(worker)});
+  waiting.reset();
+}
+
+void RecordingObserver::tile_done(int worker, const SvmStats& memory) {
+  recorder_.log(node_).hits.push_back(
+      {recorder_.now(), memory.own_hits + memory.cache_hits, static_cast<std::uint16_t>(worker)});
+}
+
 std::uint64_t Recording::recorded_hops() const {
   std::uint64_t hops = 0;
   for (const PacketTrace& p : packets) hops += p.hops();

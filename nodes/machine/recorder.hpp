@@ -19,9 +19,11 @@
 #include <chrono>
 #include <cstdint>
 #include <memory>
+#include <optional>
 #include <utility>
 #include <vector>
 
+#include "nodes/machine/node_observer.hpp"
 #include "nodes/machine/pixel_computer.hpp"
 #include "nodes/net/packet.hpp"
 #include "nodes/net/route_log.hpp"
@@ -77,6 +79,23 @@ class Recorder final : public RouteRecorder {
 
  private:
   std::vector<std::unique_ptr<NodeLog>> logs_;
+};
+
+// The recorder's observer of one node's pixel computers: each wait for a
+// page logged while the budget lasts (Recorder::open() as the request
+// leaves), only counted after; and after each tile, what the worker's page
+// calls have found at hand so far (a HitSample).
+class RecordingObserver final : public NodeObserver {
+ public:
+  RecordingObserver(Recorder& recorder, NodeId node, int workers);
+  void fetch_started(int worker, std::uint32_t page) override;
+  void fetch_ended(int worker, std::uint32_t page) override;
+  void tile_done(int worker, const SvmStats& memory) override;
+
+ private:
+  Recorder& recorder_;
+  NodeId node_;
+  std::vector<std::optional<double>> waiting_;  // per worker: when its recorded wait began; none: not recorded
 };
 
 // One recorded packet, merged from the logs of the nodes it crossed.

@@ -297,11 +297,10 @@ ComputeMeter& MachineTiming::add_meter(int node, const tracer::RayStats& rays) {
   return *meters_.back();
 }
 
-PageFetch MachineTiming::charging_fetch(ComputeMeter& meter, PageFetch fetch) {
-  return [&meter, fetch = std::move(fetch)](std::uint32_t page) {
-    meter.charge_page_request();
-    return fetch(page);
-  };
+std::unique_ptr<ChargingObserver> MachineTiming::charges(int node, const std::vector<const tracer::RayStats*>& workers) {
+  std::vector<ComputeMeter*> meters;
+  for (const tracer::RayStats* rays : workers) meters.push_back(&add_meter(node, *rays));
+  return std::make_unique<ChargingObserver>(std::move(meters));
 }
 
 std::function<void()> MachineTiming::serve_hook(int node) {

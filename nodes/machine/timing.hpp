@@ -18,10 +18,12 @@
 #include <functional>
 #include <memory>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "csp/runtime.hpp"
 #include "csp/virtual_time.hpp"
+#include "nodes/machine/node_observer.hpp"
 #include "nodes/machine/svm.hpp"
 #include "nodes/net/link.hpp"
 #include "tracer/stats.hpp"
@@ -107,6 +109,20 @@ class ComputeMeter {
   std::int64_t charged_ps_ = 0;     // what the clock has received: rounding never drifts
 };
 
+// Virtual time's observer of one node: each pixel computer's work charged
+// on its own meter before each of its page requests leaves and at the end
+// of each of its tiles.
+class ChargingObserver final : public NodeObserver {
+ public:
+  explicit ChargingObserver(std::vector<ComputeMeter*> meters) : meters_(std::move(meters)) {}
+  void fetch_started(int worker, std::uint32_t /*page*/) override { meter(worker).charge_page_request(); }
+  void tile_done(int worker, const SvmStats& /*memory*/) override { meter(worker).charge(); }
+
+ private:
+  ComputeMeter& meter(int worker) { return *meters_.at(static_cast<std::size_t>(worker)); }
+  std::vector<ComputeMeter*> meters_;  // per worker, in order
+};
+
 class MachineTiming {
  public:
   MachineTiming(CostModel model, int nodes);
@@ -116,8 +132,9 @@ class MachineTiming {
   const CostModel& model() const { return model_; }
 
   ComputeMeter& add_meter(int node, const tracer::RayStats& rays);
-  // fetch, but first charging the work done so far (the request leaves then).
-  static PageFetch charging_fetch(ComputeMeter& meter, PageFetch fetch);
+  // The observer that charges node's pixel computers, a meter for each
+  // (add_meter), given their ray counters in worker order.
+  std::unique_ptr<ChargingObserver> charges(int node, const std::vector<const tracer::RayStats*>& workers);
   // For node n's page server, before each reply.
   std::function<void()> serve_hook(int node);
 

@@ -59,8 +59,8 @@ double one_page_request(const CostModel& model) {
     nodes::Outbox out(net.injector(0, Ports::first_worker), 1, 4);
     const tracer::RayStats no_work;
     nodes::WorkerPort port(net.port(0, Ports::first_worker));
-    const auto fetch = nodes::MachineTiming::charging_fetch(
-        timing.add_meter(0, no_work), nodes::make_page_fetch(placement, Ports::first_worker, port, out));
+    const auto charges = timing.charges(0, {&no_work});
+    const auto fetch = nodes::make_page_fetch(placement, Ports::first_worker, port, out, charges.get());
     const auto reply = fetch(1);
     arrived = double(csp::this_process::now().count()) * 1e-12;
     EXPECT_EQ(nodes::page_reply_id(reply), 1u);
