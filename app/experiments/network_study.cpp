@@ -116,11 +116,11 @@ T whole_in(std::int64_t v, std::int64_t low, std::int64_t high, const char* opti
 }
 
 void check_network(NetworkStudyOptions& o, const RawNetwork& raw) {
-  o.topologies = split(raw.topologies);
-  if (o.topologies.empty()) throw UsageError("--topology: empty list");
-  for (auto t = o.topologies.begin(); t != o.topologies.end(); ++t) {
+  const std::vector<std::string> specs = split(raw.topologies);
+  if (specs.empty()) throw UsageError("--topology: empty list");
+  for (auto t = specs.begin(); t != specs.end(); ++t) {
     if (t->empty()) throw UsageError("--topology: an empty item in '" + raw.topologies + "'");
-    if (std::find(o.topologies.begin(), t, *t) != t) throw UsageError("--topology: " + *t + " is listed twice");
+    if (std::find(specs.begin(), t, *t) != t) throw UsageError("--topology: " + *t + " is listed twice");
   }
   o.patterns.clear();
   for (const std::string& name : split(raw.patterns)) {
@@ -133,13 +133,14 @@ void check_network(NetworkStudyOptions& o, const RawNetwork& raw) {
       throw UsageError("--pattern: " + name + " is listed twice");
   }
   if (o.patterns.empty()) throw UsageError("--pattern: empty list");
-  for (const std::string& spec : o.topologies) {
-    topology::Topology t = topology::Topology::ring(2);
+  o.topologies.clear();
+  for (const std::string& spec : specs) {
     try {
-      t = topology::parse_topology(spec);
+      o.topologies.push_back(topology::parse_topology(spec));
     } catch (const std::invalid_argument& e) {
       throw UsageError(std::string("--topology: ") + e.what());
     }
+    const topology::Topology& t = o.topologies.back();
     for (const nodes::TrafficPattern p : o.patterns)
       if (const std::string why = nodes::pattern_unfit(p, t); !why.empty()) throw UsageError("--pattern: " + why);
   }
@@ -255,8 +256,7 @@ double pattern_distance(const topology::Topology& t, nodes::TrafficPattern p) {
 // the render pattern's traffic recorded once a topology.
 void plan_points(const NetworkStudyOptions& o, NetworkTable& table, std::ostream* progress) {
   const double message = nodes::zero_load_latency(o.study.link, o.study.payload_bytes, 0);
-  for (const std::string& spec : o.topologies) {
-    const topology::Topology t = topology::parse_topology(spec);
+  for (const topology::Topology& t : o.topologies) {
     table.costs.push_back(topology_cost(t));
     for (const nodes::TrafficPattern p : o.patterns) {
       std::shared_ptr<const nodes::RecordedTraffic> recorded;
@@ -292,7 +292,7 @@ void run_points(const NetworkStudyOptions& o, std::vector<NetworkPoint>& points,
         const auto start = std::chrono::steady_clock::now();
         nodes::LoadStudyOptions study = o.study;
         study.recorded = p.recorded;
-        p.result = nodes::run_load(topology::parse_topology(p.topology), p.pattern, p.load * p.bound, study);
+        p.result = nodes::run_load(study_topology(o, p.topology), p.pattern, p.load * p.bound, study);
         p.wall_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
         p.saturated = p.result.accepted < 0.95 * p.result.offered || p.result.mean_latency > 10 * p.zero_load;
       } catch (...) {
@@ -313,6 +313,12 @@ void run_points(const NetworkStudyOptions& o, std::vector<NetworkPoint>& points,
 }
 
 }  // namespace
+
+const topology::Topology& study_topology(const NetworkStudyOptions& o, const std::string& spec) {
+  for (const topology::Topology& t : o.topologies)
+    if (t.spec() == spec) return t;
+  throw std::logic_error("network study: no topology " + spec + " in the options");
+}
 
 nodes::RecordedTraffic record_render_traffic(const NetworkStudyOptions& o, const topology::Topology& t) {
   if (!o.render_scene) throw std::logic_error("record_render_traffic: no scene read");
@@ -416,10 +422,11 @@ std::vector<viz::LinePlot> network_plots(const NetworkTable& t) {
     viz::LinePlot accepted{.title = std::string(nodes::pattern_name(pattern)) + " traffic: throughput",
                            .x_label = "offered load (fraction of the bound)",
                            .y_label = "accepted / bound"};
-    for (const std::string& spec : t.options.topologies) {
+    for (const topology::Topology& network : t.options.topologies) {
+      const std::string spec = network.spec();
       viz::Series l{.name = spec}, a{.name = spec};
       for (const NetworkPoint& p : t.points) {
-        if (p.pattern != pattern || p.topology != topology::parse_topology(spec).spec()) continue;
+        if (p.pattern != pattern || p.topology != spec) continue;
         l.points.push_back({p.load, p.result.mean_latency * 1e6});
         a.points.push_back({p.load, p.result.accepted / p.bound});
       }
@@ -440,7 +447,7 @@ viz::Table cost_table(const NetworkTable& t) {
   for (const TopologyCost& c : t.costs)
     table.rows.push_back({c.spec, std::to_string(c.nodes), std::to_string(c.links), std::to_string(c.degree),
                           std::to_string(c.diameter), fixed(c.average_distance, 3), std::to_string(c.bisection),
-                          fixed(1.0 / (message * nodes::max_channel_load(topology::parse_topology(c.spec),
+                          fixed(1.0 / (message * nodes::max_channel_load(study_topology(t.options, c.spec),
                                                                          nodes::TrafficPattern::uniform, 0)),
                                 1)});
   return table;
@@ -469,7 +476,7 @@ std::vector<viz::MachineDrawing> link_pictures(const NetworkTable& t) {
       if (p.topology == c.spec && p.pattern == t.options.patterns.front() &&
           (!nearest || std::abs(p.load - t.options.links_at) < std::abs(nearest->load - t.options.links_at)))
         nearest = &p;
-    viz::MachineDrawing m = machine_shape(topology::parse_topology(c.spec));
+    viz::MachineDrawing m = machine_shape(study_topology(t.options, c.spec));
     m.title = c.spec + ": link traffic, " + nodes::pattern_name(nearest->pattern) + " traffic at load " +
               fixed(nearest->load, 2) + " of the bound";
     m.nodes.assign(c.nodes, viz::NodeWork{});

@@ -25,7 +25,9 @@
 namespace app {
 
 struct NetworkStudyOptions {
-  std::vector<std::string> topologies{"hypercube:6", "torus:8x8", "mesh:8x8", "ring:64", "complete:64"};
+  std::vector<topology::Topology> topologies{topology::Topology::hypercube(6), topology::Topology::torus(8, 8),
+                                             topology::Topology::mesh(8, 8), topology::Topology::ring(64),
+                                             topology::Topology::complete(64)};  // parsed once, from --topology
   std::vector<nodes::TrafficPattern> patterns{nodes::TrafficPattern::uniform};
   std::vector<double> loads{0.1, 0.2, 0.3, 0.4, 0.5, 0.6, 0.7, 0.8, 0.9, 1.0, 1.1, 1.2};
   nodes::CostModel model = nodes::ipsc2_profile();  // its hop and bandwidth make the link model
@@ -53,7 +55,7 @@ struct TopologyCost {
 TopologyCost topology_cost(const topology::Topology& t);
 
 struct NetworkPoint {
-  std::string topology;
+  std::string topology;  // canonical spec, one of the options' topologies (study_topology)
   nodes::TrafficPattern pattern = nodes::TrafficPattern::uniform;
   double load = 0;            // fraction of the bound
   double bound = 0;           // packets per node per second at load 1
@@ -77,6 +79,10 @@ NetworkStudyOptions parse_network_options(int argc, const char* const argv[]);
 std::string network_usage();
 OptionGroup network_option_group();
 std::string network_summary();
+
+// The topology of options.topologies that `spec` (canonical) names;
+// std::logic_error if none does.
+const topology::Topology& study_topology(const NetworkStudyOptions& options, const std::string& spec);
 
 NetworkTable run_network_study(const NetworkStudyOptions& options, std::ostream* progress);
 // The packets of a render of options.scene on `t`, in virtual time under
