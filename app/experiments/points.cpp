@@ -9,13 +9,12 @@
 #include <stdexcept>
 #include <thread>
 
-#include "topology/spec.hpp"
 
 namespace app {
 
 nodes::MachineOptions machine_options(const ExperimentSetup& setup) {
   nodes::MachineOptions options;
-  options.topology = topology::parse_topology(setup.topology, setup.nodes);
+  options.topology = setup.topology;
   options.cache.pages = setup.cache_pages;
   options.farming = setup.farming;
   options.timing = setup.model;
@@ -102,8 +101,7 @@ double fit_unit(const tracer::Database& db, const ExperimentSetup& setup, double
   // A small probe unit keeps the probe run well inside the virtual clock's range.
   constexpr double probe_unit = 1e-6;
   ExperimentSetup probe = setup;
-  probe.topology = "hypercube";
-  probe.nodes = 1;
+  probe.topology = topology::Topology::hypercube(0);
   probe.model.unit = probe_unit;
   ExperimentSetup messages_only = probe;
   messages_only.model.unit = 0.0;  // what remains is message time (work requests, results)

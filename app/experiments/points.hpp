@@ -17,6 +17,7 @@
 
 #include "nodes/machine/machine.hpp"
 #include "nodes/machine/timing.hpp"
+#include "topology/topology.hpp"
 #include "tracer/database.hpp"
 #include "tracer/render.hpp"
 
@@ -28,8 +29,7 @@ inline constexpr nodes::Farming paper_farming{
     .grain = 4, .prefetch = 0, .schedule = nodes::Schedule::dynamic, .pixel_order = nodes::PixelOrder::scanline};
 
 struct ExperimentSetup {
-  std::string topology = "hypercube";
-  std::size_t nodes = 1;
+  topology::Topology topology = topology::Topology::hypercube(0);  // one node
   std::optional<std::uint32_t> cache_pages;  // default: nodes::default_cache_pages
   nodes::Farming farming = paper_farming;
   nodes::CostModel model = nodes::ipsc2_profile();

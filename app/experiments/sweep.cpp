@@ -223,7 +223,6 @@ std::vector<ExperimentSetup> sweep_setups(const SweepOptions& o, const tracer::D
   setup.farming = o.farming;
   setup.model = o.model;
   setup.trace = o.trace;
-  setup.nodes = 1;
   if (o.fit_seconds > 0) setup.model.unit = fit_unit(db, setup, o.fit_seconds, o.jobs);
   if (!o.cache_pages.empty()) setup.cache_pages = o.cache_pages.front();
   std::vector<ExperimentSetup> setups{setup};
@@ -231,8 +230,7 @@ std::vector<ExperimentSetup> sweep_setups(const SweepOptions& o, const tracer::D
   for (const std::string& topology : o.topologies) {
     const std::size_t count = by_nodes ? o.nodes.size() : o.cache_pages.size();
     for (std::size_t i = 0; i < count; ++i) {
-      setup.topology = topology;
-      setup.nodes = by_nodes ? o.nodes[i] : o.nodes.front();
+      setup.topology = topology::parse_topology(topology, by_nodes ? o.nodes[i] : o.nodes.front());
       if (!by_nodes) setup.cache_pages = o.cache_pages[i];
       setups.push_back(setup);
     }

@@ -450,15 +450,15 @@ TEST(Sweep, SideBySideRunsReportTheFirstFailureInOrder) {
   scene.camera.width = scene.camera.height = 8;
   const tracer::Database db = tracer::build_database(scene, {});
   std::vector<app::ExperimentSetup> setups(6);
-  setups[2].nodes = 3;  // no hypercube has 3 nodes
-  setups[4].nodes = 5;
+  setups[2].cache_pages = 0;  // refused: a cache holds a page at least
+  setups[4].farming.prefetch = 1000;  // refused: more than a node can hold
   for (const unsigned jobs : {1u, 2u, 6u}) {
     std::vector<std::size_t> done;
     try {
       app::run_points(db, setups, jobs, [&](std::size_t i, const app::ExperimentPoint&) { done.push_back(i); });
       ADD_FAILURE() << "no failure with " << jobs << " jobs";
     } catch (const std::exception& e) {
-      EXPECT_NE(std::string(e.what()).find("not 3"), std::string::npos) << jobs << " jobs: " << e.what();
+      EXPECT_NE(std::string(e.what()).find("cache_pages"), std::string::npos) << jobs << " jobs: " << e.what();
     }
     EXPECT_EQ(done, (std::vector<std::size_t>{0, 1})) << jobs << " jobs";
   }
