@@ -198,7 +198,7 @@ TEST_F(Cli, RunningOutOfAddressSpaceAnywhereEndsInSuccessOrOneLine) {
     for (int limit_mb = 50; limit_mb <= 200; limit_mb += 10) {
       const std::string limit = "ulimit -v " + std::to_string(limit_mb * 1000);
       const std::string cmd = "cd '" + dir_.string() + "' && " + limit + " && exec timeout -s KILL 60 " +
-                              VMPRAY_BINARY + " teapot --threads 8 --width 64 --height 64 -q -o out.png" + timing +
+                              test::vmpray_binary() + " teapot --threads 8 --width 64 --height 64 -q -o out.png" + timing +
                               " >stdout.txt 2>stderr.txt </dev/null";
       const int status = std::system(cmd.c_str());
       const std::string err = test::read_file(dir_ / "stderr.txt");

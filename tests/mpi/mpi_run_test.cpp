@@ -44,7 +44,7 @@ class Mpirun : public test::ScratchTest {
   Outcome mpirun(int ranks, const Transport& via, const std::string& args, const std::string& input = "",
                  const std::string& launch = "") const {
     const std::string cmd = "cd '" + dir_.string() + "' && " + mpi_environment + " timeout -v -k 10 120 " + MPIEXEC +
-                            " -np " + std::to_string(ranks) + " " + via.mca + " " + launch + " " + VMPRAY_BINARY +
+                            " -np " + std::to_string(ranks) + " " + via.mca + " " + launch + " " + test::vmpray_binary() +
                             " " + args + " >stdout.txt 2>stderr.txt <" + (input.empty() ? "/dev/null" : input);
     const int status = std::system(cmd.c_str());
     return {WEXITSTATUS(status), read_file(dir_ / "stdout.txt"), read_file(dir_ / "stderr.txt")};
@@ -101,8 +101,8 @@ TEST_F(Mpirun, ImageIsByteIdenticalToOneProcessOverEveryRankCountAndTransport) {
 }
 
 TEST_F(Mpirun, ReadsTheSceneFromStandardInputAndFromGzipOnRankZero) {
-  const std::string balls = std::string(VMPRAY_SHARED_SCENES) + "/balls-s1.nff";
-  const std::string teapot = std::string(VMPRAY_SHARED_SCENES) + "/teapot-s7.nff.gz";
+  const std::string balls = test::shared_scenes() + "/balls-s1.nff";
+  const std::string teapot = test::shared_scenes() + "/teapot-s7.nff.gz";
   const std::string size = " --width 48 --height 48 -q --topology hypercube:3";
   ASSERT_EQ(run_vmpray("'" + balls + "'" + size + " -o one.png").exit_code, 0);
   Outcome split = mpirun(3, shared_memory, "-" + size + " -o split.png", balls);

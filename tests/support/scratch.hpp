@@ -20,6 +20,8 @@
 #include <sstream>
 #include <string>
 
+#include "tests/support/paths.hpp"
+
 namespace test {
 
 namespace fs = std::filesystem;
@@ -65,7 +67,6 @@ class ScratchTest : public ::testing::Test {
   }
   void TearDown() override { fs::remove_all(dir_); }
 
-#ifdef VMPRAY_BINARY
   // Runs `vmpray args` in dir_; stdout and stderr are captured in files there
   // (stdout goes to `stdout_to` instead when given: a shell redirection target).
   // `setup`, if given, is a shell command run first in the same shell, such
@@ -73,12 +74,11 @@ class ScratchTest : public ::testing::Test {
   Outcome run_vmpray(const std::string& args, const std::string& stdout_to = "stdout.txt",
                      const std::string& setup = "") const {
     const std::string cmd = "cd '" + dir_.string() + "' && " + (setup.empty() ? "" : setup + " && ") +
-                            VMPRAY_BINARY + " " + args + " >" + stdout_to + " 2>stderr.txt </dev/null";
+                            test::vmpray_binary() + " " + args + " >" + stdout_to + " 2>stderr.txt </dev/null";
     const int status = std::system(cmd.c_str());
     return {WEXITSTATUS(status), read_file(dir_ / "stdout.txt"),
             without_sanitizer_noise(read_file(dir_ / "stderr.txt"))};
   }
-#endif
 
   fs::path dir_;
 };

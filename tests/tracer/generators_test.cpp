@@ -10,6 +10,7 @@
 #include <stdexcept>
 
 #include "scene_stats.hpp"
+#include "tests/support/paths.hpp"
 #include "tracer/nff.hpp"
 
 namespace tracer {
@@ -34,7 +35,7 @@ void expect_close(const Vec3d& a, const Vec3d& b, const char* what) {
 
 TEST_P(GeneratorVsFile, MatchesCountsCameraAndBounds) {
   Scene generated = generate_scene(GetParam().spec);
-  Scene file = load_nff_file(std::string(VMPRAY_SHARED_SCENES) + "/" + GetParam().file);
+  Scene file = load_nff_file(test::shared_scenes() + "/" + GetParam().file);
   auto g = scene_stats(generated), f = scene_stats(file);
   EXPECT_EQ(g.polygons, f.polygons);
   EXPECT_EQ(g.patches, f.patches);
@@ -76,7 +77,7 @@ INSTANTIATE_TEST_SUITE_P(
 TEST(Generators, MountMatchesReferenceVertexForVertex) {
   // The fractal depends on SPD's hash and Gaussian generator: compare heights.
   Scene generated = generate_scene("mount:1");
-  Scene file = load_nff_file(std::string(VMPRAY_SHARED_SCENES) + "/mount-s1.nff");
+  Scene file = load_nff_file(test::shared_scenes() + "/mount-s1.nff");
   ASSERT_EQ(generated.objects.size(), file.objects.size());
   for (std::size_t i = 0; i < file.objects.size(); ++i) {
     auto* fp = std::get_if<Polygon>(&file.objects[i].shape);

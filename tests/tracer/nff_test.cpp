@@ -18,6 +18,7 @@
 #include <vector>
 
 #include "scene_stats.hpp"
+#include "tests/support/paths.hpp"
 
 namespace tracer {
 namespace {
@@ -36,7 +37,7 @@ class NffReference : public ::testing::TestWithParam<ReferenceFile> {};
 
 TEST_P(NffReference, ParsesWithExpectedCountsAndBounds) {
   const ReferenceFile& ref = GetParam();
-  Scene scene = load_nff_file(std::string(VMPRAY_SHARED_SCENES) + "/" + ref.name);
+  Scene scene = load_nff_file(test::shared_scenes() + "/" + ref.name);
   auto s = scene_stats(scene);
   EXPECT_EQ(s.polygons, ref.polygons);
   EXPECT_EQ(s.patches, ref.patches);
