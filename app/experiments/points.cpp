@@ -9,7 +9,6 @@
 #include <stdexcept>
 #include <thread>
 
-
 namespace app {
 
 nodes::MachineOptions machine_options(const ExperimentSetup& setup) {
