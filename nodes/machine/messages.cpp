@@ -11,12 +11,15 @@ namespace nodes {
 
 namespace {
 
+// Written straight into the packet's payload: one that fits in a packet
+// takes no allocation.
 template <class T>
-std::vector<std::byte> encode(const T& message, std::size_t bytes) {
-  WireWriter w;
-  w.reserve(bytes);
+Payload encode(const T& message, std::size_t bytes) {
+  Payload payload;
+  payload.reserve(bytes);
+  BasicWireWriter<Payload&> w(payload);
   put_fields(w, message);
-  return w.take();
+  return payload;
 }
 
 template <class T>
@@ -55,7 +58,7 @@ tracer::Color ResultView::color(std::uint32_t i) const {
   return c;
 }
 
-Packet make_packet(NodeId destination, std::uint16_t port, MessageKind kind, std::vector<std::byte> payload) {
+Packet make_packet(NodeId destination, std::uint16_t port, MessageKind kind, Payload payload) {
   Packet p;
   p.destination = destination;
   p.port = port;
@@ -64,7 +67,7 @@ Packet make_packet(NodeId destination, std::uint16_t port, MessageKind kind, std
   return p;
 }
 
-std::vector<std::byte> encode_work_request(WorkRequest request) {
+Payload encode_work_request(WorkRequest request) {
   return encode(request, work_request_bytes);
 }
 
@@ -72,11 +75,11 @@ WorkRequest decode_work_request(std::span<const std::byte> payload) {
   return decode<WorkRequest>(payload, "work_request");
 }
 
-std::vector<std::byte> encode_tile(Tile tile) { return encode(tile, tile_bytes); }
+Payload encode_tile(Tile tile) { return encode(tile, tile_bytes); }
 
 Tile decode_tile(std::span<const std::byte> payload) { return decode<Tile>(payload, "work"); }
 
-std::vector<std::byte> encode_result(std::uint16_t reply_port, Tile tile, std::span<const tracer::Color> colors) {
+Payload encode_result(std::uint16_t reply_port, Tile tile, std::span<const tracer::Color> colors) {
   if (colors.size() != tile.count) throw std::logic_error("result: colour count differs from tile size");
   // A Color is exactly its three floats (see color_bytes), so the run goes as one block.
   const ResultView result{reply_port, tile, std::as_bytes(colors)};
@@ -90,7 +93,7 @@ ResultView decode_result(std::span<const std::byte> payload) {
   return result;
 }
 
-std::vector<std::byte> encode_page_request(PageRequest request) {
+Payload encode_page_request(PageRequest request) {
   return encode(request, page_request_bytes);
 }
 
@@ -98,7 +101,7 @@ PageRequest decode_page_request(std::span<const std::byte> payload) {
   return decode<PageRequest>(payload, "page_request");
 }
 
-std::vector<std::byte> encode_page_reply(std::uint32_t page, std::span<const std::byte> bytes) {
+Payload encode_page_reply(std::uint32_t page, std::span<const std::byte> bytes) {
   return encode(PageReplyView{page, bytes}, page_id_bytes + bytes.size());
 }
 

@@ -118,20 +118,20 @@ void wire_fields(V& v, WireView<PageReplyView> auto& reply) {
   v(wire_rest(reply.bytes));
 }
 
-std::vector<std::byte> encode_work_request(WorkRequest request);
+Payload encode_work_request(WorkRequest request);
 WorkRequest decode_work_request(std::span<const std::byte> payload);
 
-std::vector<std::byte> encode_tile(Tile tile);
+Payload encode_tile(Tile tile);
 Tile decode_tile(std::span<const std::byte> payload);
 
-std::vector<std::byte> encode_result(std::uint16_t reply_port, Tile tile, std::span<const tracer::Color> colors);
+Payload encode_result(std::uint16_t reply_port, Tile tile, std::span<const tracer::Color> colors);
 ResultView decode_result(std::span<const std::byte> payload);
 
-std::vector<std::byte> encode_page_request(PageRequest request);
+Payload encode_page_request(PageRequest request);
 PageRequest decode_page_request(std::span<const std::byte> payload);
 
 // A packet to (destination, port); the network stamps the source.
-Packet make_packet(NodeId destination, std::uint16_t port, MessageKind kind, std::vector<std::byte> payload = {});
+Packet make_packet(NodeId destination, std::uint16_t port, MessageKind kind, Payload payload = {});
 
 // A process's injection end that numbers its packets: ids interleave over
 // all sending processes (first id = the process's index, step = their
@@ -154,7 +154,7 @@ class Outbox {
   std::uint64_t step_;
 };
 
-std::vector<std::byte> encode_page_reply(std::uint32_t page, std::span<const std::byte> bytes);
+Payload encode_page_reply(std::uint32_t page, std::span<const std::byte> bytes);
 std::uint32_t page_reply_id(std::span<const std::byte> payload);
 std::span<const std::byte> page_reply_bytes(std::span<const std::byte> payload);
 

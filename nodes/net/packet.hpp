@@ -10,7 +10,9 @@
 // the network runs (a page of the scene); inside one process the packet
 // points at them rather than copying them, but in every count and delay
 // they are bytes carried (bytes()), and across processes the bridge sends
-// them as payload.
+// them as payload. A payload of up to inline_payload bytes (every message
+// of the machine but a result) lies inside the packet: it takes no
+// allocation, and crosses a thread in the packet's own cache lines.
 #pragma once
 
 #include <cstddef>
@@ -18,11 +20,20 @@
 #include <span>
 #include <vector>
 
+#include <boost/container/small_vector.hpp>
+
 #include "topology/topology.hpp"
 
 namespace nodes {
 
 using topology::NodeId;
+
+inline constexpr std::size_t inline_payload = 16;
+class Payload : public boost::container::small_vector<std::byte, inline_payload> {
+ public:
+  using small_vector::small_vector;
+  operator std::span<const std::byte>() const { return {data(), size()}; }
+};
 
 struct Packet {
   NodeId source = 0;       // set by the network at injection
@@ -33,7 +44,7 @@ struct Packet {
   bool traced = false;     // record the route (or the network decides: trace_routes)
   bool recorded = false;   // its hops go into the run's Recorder (set at injection)
   std::uint64_t id = 0;    // application-defined sequence number
-  std::vector<std::byte> payload;
+  Payload payload;
   std::span<const std::byte> shared;  // follows the payload; read-only
   std::vector<NodeId> route;  // visited nodes, for traced packets only
 

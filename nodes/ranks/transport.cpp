@@ -93,18 +93,6 @@ int LocalTransportGroup::size() const { return static_cast<int>(endpoints_.size(
 
 // ---- wire encoding ----
 
-void WireWriter::put_string(const std::string& s) {
-  put<std::uint64_t>(s.size());
-  append(s.data(), s.size());
-}
-
-void WireWriter::append(const void* data, std::size_t n) {
-  if (n == 0) return;
-  const std::size_t at = bytes_.size();
-  bytes_.resize(at + n);
-  std::memcpy(bytes_.data() + at, data, n);
-}
-
 std::string WireReader::get_string() {
   const auto n = get<std::uint64_t>();
   if (n > bytes_.size() - at_) fail();

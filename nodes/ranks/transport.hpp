@@ -86,9 +86,15 @@ class LocalTransportGroup {
 // sequences with a 64-bit count before them. Reader throws
 // std::runtime_error on a message shorter than what is read from it.
 // Structured values are written and read by their field lists
-// (wire_fields.hpp).
-class WireWriter {
+// (wire_fields.hpp). A writer appends to its Buffer, which has size,
+// resize and data: its own Bytes between ranks, or (Buffer a reference) a
+// packet's payload in place (messages.cpp).
+template <class Buffer>
+class BasicWireWriter {
  public:
+  BasicWireWriter() = default;
+  explicit BasicWireWriter(Buffer into) : bytes_(into) {}
+
   template <class T>
   void put(const T& value) {
     static_assert(std::is_trivially_copyable_v<T>);
@@ -106,17 +112,26 @@ class WireWriter {
     append(first.data(), first.size());
     append(second.data(), second.size());
   }
-  void put_string(const std::string& s);
+  void put_string(const std::string& s) {
+    put<std::uint64_t>(s.size());
+    append(s.data(), s.size());
+  }
   // Bytes with no count: the end of a message, read back by take_rest().
   void put_raw(std::span<const std::byte> bytes) { append(bytes.data(), bytes.size()); }
   void reserve(std::size_t n) { bytes_.reserve(n); }
-  Bytes take() { return std::move(bytes_); }
+  Buffer take() { return std::move(bytes_); }
   std::size_t size() const { return bytes_.size(); }
 
  private:
-  void append(const void* data, std::size_t n);
-  Bytes bytes_;
+  void append(const void* data, std::size_t n) {
+    if (n == 0) return;
+    const std::size_t at = bytes_.size();
+    bytes_.resize(at + n);
+    std::memcpy(bytes_.data() + at, data, n);
+  }
+  Buffer bytes_;
 };
+using WireWriter = BasicWireWriter<Bytes>;
 
 class WireReader {
  public:
@@ -140,6 +155,11 @@ class WireReader {
     return values;
   }
   std::string get_string();
+  // A count, then that many bytes, viewed in place.
+  std::span<const std::byte> get_counted_bytes() {
+    const auto n = get<std::uint64_t>();
+    return {take(static_cast<std::size_t>(n)), static_cast<std::size_t>(n)};
+  }
   // All that is left, as a view into the message.
   std::span<const std::byte> take_rest() { return bytes_.subspan(std::exchange(at_, bytes_.size())); }
   // Throws unless at least n bytes are left.

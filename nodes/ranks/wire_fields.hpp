@@ -1,7 +1,7 @@
 // Wire formats named once for both directions. A format is a field list in
 // namespace nodes, in wire order: a function template wire_fields(v, x) that
 // passes each field of x to v (an example at WireView below). put_fields()
-// writes a value with it (FieldWriter, over a const value) and get_fields()
+// writes a value with it (BasicFieldWriter, over a const value) and get_fields()
 // reads one back (FieldReader), so the two directions cannot disagree and a
 // field added to the list travels both ways. How each kind of field travels
 // is listed below; reading throws std::runtime_error (WireReader) where a
@@ -51,7 +51,8 @@ concept WireCodec = requires(const T& codec, WireWriter& w) { codec.put_to(w); }
 template <class Wire, class Field>
 struct WireAs {
   Field& field;
-  void put_to(WireWriter& w) const { w.put(static_cast<Wire>(field)); }
+  template <class Writer>
+  void put_to(Writer& w) const { w.put(static_cast<Wire>(field)); }
   void get_from(WireReader& r) { field = static_cast<std::remove_const_t<Field>>(r.get<Wire>()); }
 };
 
@@ -59,9 +60,11 @@ template <class Bytes, class More>
 struct WireJoined {
   Bytes& first;
   More& second;
-  void put_to(WireWriter& w) const { w.put_joined(first, second); }
+  template <class Writer>
+  void put_to(Writer& w) const { w.put_joined(first, second); }
   void get_from(WireReader& r) {
-    first = r.get_vector<std::byte>();
+    const std::span<const std::byte> bytes = r.get_counted_bytes();
+    first.assign(bytes.begin(), bytes.end());
     second = {};
   }
 };
@@ -69,7 +72,8 @@ struct WireJoined {
 template <class Span>
 struct WireRest {
   Span& bytes;
-  void put_to(WireWriter& w) const { w.put_raw(bytes); }
+  template <class Writer>
+  void put_to(Writer& w) const { w.put_raw(bytes); }
   void get_from(WireReader& r) { bytes = r.take_rest(); }
 };
 
@@ -98,18 +102,19 @@ template <class T, class A>
 inline constexpr bool is_vector<std::vector<T, A>> = true;
 }  // namespace wire_detail
 
-class FieldWriter {
+template <class Writer>
+class BasicFieldWriter {
  public:
-  explicit FieldWriter(WireWriter& w) : w_(w) {}
+  explicit BasicFieldWriter(Writer& w) : w_(w) {}
 
   template <class T>
   void operator()(const T& x) {
     if constexpr (WireCodec<T>) {
       x.put_to(w_);
-    } else if constexpr (HasWireFields<const T, FieldWriter>) {
+    } else if constexpr (HasWireFields<const T, BasicFieldWriter>) {
       wire_fields(*this, x);
     } else if constexpr (std::is_same_v<T, bool>) {
-      w_.put<std::uint8_t>(x ? 1 : 0);
+      w_.template put<std::uint8_t>(x ? 1 : 0);
     } else if constexpr (std::is_same_v<T, std::string>) {
       w_.put_string(x);
     } else if constexpr (wire_detail::is_vector<T>) {
@@ -126,16 +131,17 @@ class FieldWriter {
   template <class T>
   void put_sequence(const std::vector<T>& xs) {
     static_assert(!std::is_same_v<T, bool>, "std::vector<bool> has no bytes to send");
-    if constexpr (std::is_trivially_copyable_v<T> && !HasWireFields<const T, FieldWriter>) {
+    if constexpr (std::is_trivially_copyable_v<T> && !HasWireFields<const T, BasicFieldWriter>) {
       w_.put_vector(xs);
     } else {
-      w_.put<std::uint64_t>(xs.size());
+      w_.template put<std::uint64_t>(xs.size());
       for (const T& x : xs) (*this)(x);
     }
   }
 
-  WireWriter& w_;
+  Writer& w_;
 };
+using FieldWriter = BasicFieldWriter<WireWriter>;
 
 class FieldReader {
  public:
@@ -182,9 +188,9 @@ class FieldReader {
   WireReader& r_;
 };
 
-template <class T>
-void put_fields(WireWriter& w, const T& x) {
-  FieldWriter v(w);
+template <class Buffer, class T>
+void put_fields(BasicWireWriter<Buffer>& w, const T& x) {
+  BasicFieldWriter<BasicWireWriter<Buffer>> v(w);
   v(x);
 }
 

@@ -74,7 +74,8 @@ TEST(BridgeWire, TracedSharedPageReplyRoundTrips) {
   for (std::size_t i = 0; i < page.size(); ++i) page[i] = static_cast<std::byte>(200 - i);
   const Packet p = traced_reply(page);
   const Bytes bytes = put_packet(p);
-  const Bytes payload = nodes::encode_page_reply(0x00abcdef, page);  // the id, then the page
+  const nodes::Payload encoded = nodes::encode_page_reply(0x00abcdef, page);  // the id, then the page
+  const Bytes payload(encoded.begin(), encoded.end());
   const Bytes head = raw(p.source, p.destination, p.kind, p.port, p.hops, std::uint8_t{1}, std::uint8_t{1}, p.id);
   EXPECT_EQ(head.size(), 4 + 4 + 1 + 2 + 2 + 1 + 1 + 8u);
   EXPECT_EQ(bytes.size(), head.size() + 8 + payload.size() + 8 + 3 * 4);
@@ -92,7 +93,7 @@ TEST(BridgeWire, TracedSharedPageReplyRoundTrips) {
   EXPECT_TRUE(back.traced);
   EXPECT_TRUE(back.recorded);  // travels: the other rank's routers log its hops
   EXPECT_EQ(back.id, p.id);
-  EXPECT_EQ(back.payload, payload);
+  EXPECT_EQ(back.payload, encoded);
   EXPECT_TRUE(back.shared.empty());
   EXPECT_EQ(back.bytes(), p.bytes());
   EXPECT_EQ(back.route, p.route);

@@ -25,7 +25,7 @@ constexpr std::uint16_t worker_port = Ports::first_worker;
 MessageKind kind_of(const Packet& p) { return static_cast<MessageKind>(p.kind); }
 
 // A packet as the network delivers it: from node 0, to the farmer.
-Packet from_worker(MessageKind kind, std::vector<std::byte> payload = {}) {
+Packet from_worker(MessageKind kind, nodes::Payload payload = {}) {
   Packet p = nodes::make_packet(0, Ports::farmer, kind, std::move(payload));
   p.source = 0;
   return p;
