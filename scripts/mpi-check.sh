@@ -30,18 +30,25 @@ done
 # sleep: its CPU time (user + system, its start, its pages and its pixels
 # included) at most a third of its wall time (a rank that spun while
 # waiting would use about as much CPU as wall time).
-timeout -k 10 300 mpirun -np 2 --oversubscribe --mca btl self,vader \
+# The run's whole output is kept, and shown if it fails or lacks a time.
+if ! timeout -k 10 300 mpirun -np 2 --oversubscribe --mca btl self,vader \
   sh -c 'exec /usr/bin/time -f "rank $OMPI_COMM_WORLD_RANK: %e s wall, %U s user, %S s system" "$0" "$@"' \
-  "$vmpray" tetra10 --width 16 --height 16 --topology hypercube:1 -q -o tetra.png 2>&1 | grep '^rank' | tee times.txt
-python3 - times.txt <<'CHECK'
+  "$vmpray" tetra10 --width 16 --height 16 --topology hypercube:1 -q -o tetra.png >waiting.txt 2>&1; then
+  cat waiting.txt >&2
+  echo "mpi-check: the run of a waiting rank failed (its output above)" >&2
+  exit 1
+fi
+grep '^rank' waiting.txt || true
+python3 - waiting.txt <<'CHECK'
 import re, sys
 ranks = {}
-for line in open(sys.argv[1]):
+text = open(sys.argv[1]).read()
+for line in text.splitlines():
     m = re.match(r"rank (\d+): ([\d.]+) s wall, ([\d.]+) s user, ([\d.]+) s system", line)
     if m:
         ranks[int(m[1])] = (float(m[2]), float(m[3]) + float(m[4]))
 if set(ranks) != {0, 1}:
-    sys.exit("mpi-check: expected the times of ranks 0 and 1, got " + repr(sorted(ranks)))
+    sys.exit(text + "mpi-check: expected the times of ranks 0 and 1, got " + repr(sorted(ranks)))
 (wall0, cpu0), (wall1, cpu1) = ranks[0], ranks[1]
 if cpu1 > wall1 / 3:
     sys.exit(f"mpi-check: the waiting rank used {cpu1:.2f} s of CPU in {wall1:.2f} s, rank 0 {cpu0:.2f} s: it did not sleep")
