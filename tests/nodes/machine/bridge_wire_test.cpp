@@ -75,7 +75,7 @@ TEST(BridgeWire, TracedSharedPageReplyRoundTrips) {
   const Packet p = traced_reply(page);
   const Bytes bytes = put_packet(p);
   const nodes::Payload encoded = nodes::encode_page_reply(0x00abcdef, page);  // the id, then the page
-  const Bytes payload(encoded.begin(), encoded.end());
+  const Bytes payload = wire_test::bytes_of(encoded);
   const Bytes head = raw(p.source, p.destination, p.kind, p.port, p.hops, std::uint8_t{1}, std::uint8_t{1}, p.id);
   EXPECT_EQ(head.size(), 4 + 4 + 1 + 2 + 2 + 1 + 1 + 8u);
   EXPECT_EQ(bytes.size(), head.size() + 8 + payload.size() + 8 + 3 * 4);

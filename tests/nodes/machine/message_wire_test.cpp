@@ -18,12 +18,10 @@ namespace {
 
 using nodes::Bytes;
 using nodes::Tile;
+using wire_test::bytes_of;
 using wire_test::expect_prefixes_refused;
 using wire_test::joined;
 using wire_test::raw;
-
-// A payload as the plain bytes the expectations are written in.
-Bytes bytes_of(const nodes::Payload& payload) { return Bytes(payload.begin(), payload.end()); }
 
 TEST(MessageWire, WorkRequestRoundTrips) {
   const nodes::WorkRequest request{0x1234, 0x0506};

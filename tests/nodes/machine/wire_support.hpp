@@ -14,6 +14,7 @@
 #include <stdexcept>
 #include <type_traits>
 
+#include "nodes/net/packet.hpp"
 #include "nodes/ranks/transport.hpp"
 
 namespace wire_test {
@@ -50,6 +51,9 @@ inline void overwrite(nodes::Bytes& bytes, std::size_t at, const nodes::Bytes& w
   if (at + with.size() > bytes.size()) throw std::logic_error("overwrite: beyond the message");
   std::memcpy(bytes.data() + at, with.data(), with.size());
 }
+
+// A packet's payload as the plain bytes the expectations are written in.
+inline nodes::Bytes bytes_of(const nodes::Payload& payload) { return nodes::Bytes(payload.begin(), payload.end()); }
 
 inline nodes::Bytes joined(nodes::Bytes first, std::span<const std::byte> second) {
   first.insert(first.end(), second.begin(), second.end());
