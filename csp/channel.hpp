@@ -99,6 +99,43 @@ class ChannelState final : public ChannelBase {
     return take_locked();
   }
 
+  // Up to `most` values without waiting, in order, under one lock: each is
+  // handed to take(T&), which moves it out, and its slot then refilled from
+  // the first parked writer. The room freed is rung once, at the end.
+  template <class F>
+  std::size_t try_read_each(std::size_t most, F&& take) {
+    ChannelLock lk(lock_);
+    check_poison("In::try_read_each");
+    std::size_t n = 0;
+    bool freed = false;
+    for (; n < most; ++n) {
+      if (count_ > 0) {
+        take(*ring_[head_]);
+        ring_[head_].reset();
+        if (++head_ == ring_.size()) head_ = 0;
+        --count_;
+        if (Record* r = claim_front_locked(writers_)) {
+          push_locked(std::move(*static_cast<T*>(r->slot)));
+          complete(*r->waiter, WaitState::data, r->guard);
+        } else {
+          freed = true;
+        }
+      } else if (Record* r = claim_front_locked(writers_)) {
+        take(*static_cast<T*>(r->slot));
+        complete(*r->waiter, WaitState::data, r->guard);
+      } else {
+        break;
+      }
+    }
+    if (n == 0) return 0;
+    publish_hints_locked();
+    if (freed && count_ < capacity_) {
+      if (Record* alt = claim_front_locked(room_waiters_)) complete(*alt->waiter, WaitState::data, alt->guard);
+      room_bell_.ring();
+    }
+    return n;
+  }
+
   std::optional<T> read_until(Clock::time_point deadline) {
     ChannelLock lk(lock_);
     check_poison("In::read_for");
@@ -324,6 +361,12 @@ class In : private detail::ChannelEnd<T> {
   In() = default;  // unbound: assign an end from a Channel before use; moving one leaves it unbound
   T read() { return state_->read(); }
   std::optional<T> try_read() { return state_->try_read(); }
+  // Up to `most` values without waiting, each passed to take(T&) to be
+  // moved out; returns how many. One lock for them all.
+  template <class F>
+  std::size_t try_read_each(std::size_t most, F&& take) {
+    return state_->try_read_each(most, std::forward<F>(take));
+  }
   std::optional<T> read_for(std::chrono::steady_clock::duration d) {
     return state_->read_until(detail::deadline_after(std::chrono::steady_clock::now(), d));
   }

@@ -44,17 +44,30 @@ class ThreadRelays::Ring {
 
   explicit Ring(std::size_t capacity) : slots_(std::max<std::size_t>(capacity, 1)) {}
 
-  // The credits bound what can be in a ring, so a full ring is a broken
-  // invariant, never back-pressure.
-  void push(Entry&& e) {
-    if (tail_ - head_seen_ == slots_.size()) {
-      head_seen_ = head_.load(std::memory_order_acquire);
-      if (tail_ - head_seen_ == slots_.size()) throw std::logic_error("thread relay: ring full");
-    }
-    slots_[tail_slot_] = std::move(e);
-    tail_slot_ = next(tail_slot_);
-    tail_published_.store(++tail_, std::memory_order_release);
+  // Room for `n` more entries. The credits bound what can be in a ring, so
+  // a full ring is a broken invariant, never back-pressure.
+  void reserve(std::size_t n) {
+    if (tail_ - head_seen_ + n <= slots_.size()) return;
+    head_seen_ = head_.load(std::memory_order_acquire);
+    if (tail_ - head_seen_ + n > slots_.size()) throw std::logic_error("thread relay: ring full");
   }
+  // After reserve(): moves the packet in, unpublished until publish().
+  void put(std::uint32_t link, Packet& packet) {
+    Entry& e = slots_[tail_slot_];
+    e.link = link;
+    e.credits = 0;
+    e.packet = std::move(packet);
+    tail_slot_ = next(tail_slot_);
+    ++tail_;
+  }
+  void put_credits(std::uint32_t link, std::uint32_t credits) {
+    Entry& e = slots_[tail_slot_];
+    e.link = link;
+    e.credits = credits;
+    tail_slot_ = next(tail_slot_);
+    ++tail_;
+  }
+  void publish() { tail_published_.store(tail_, std::memory_order_release); }
 
   // Takes every entry published so far; the head is published once.
   template <class F>
@@ -224,14 +237,14 @@ class ThreadRelays::Relay {
   void send(Outgoing& o) {
     Link& l = relays_.links_[o.link];
     Ring& ring = relays_.ring(thread_, l.to_thread);
-    while (o.credits > 0) {
-      std::optional<Packet> p = l.queue.try_read();
-      if (!p) break;
-      ring.push(Ring::Entry{static_cast<std::uint32_t>(o.link), 0, std::move(*p)});
-      ++relays_.counters_[thread_].packets_sent;
-      --o.credits;
-      touched_[l.to_thread] = true;
-    }
+    ring.reserve(o.credits);
+    const auto link = static_cast<std::uint32_t>(o.link);
+    const std::size_t n = l.queue.try_read_each(o.credits, [&](Packet& p) { ring.put(link, p); });
+    if (n == 0) return;
+    ring.publish();
+    relays_.counters_[thread_].packets_sent += n;
+    o.credits -= n;
+    touched_[l.to_thread] = true;
     if (o.credits == 0) alt_.enable(o.guard, false);
   }
 
@@ -254,7 +267,10 @@ class ThreadRelays::Relay {
     for (Incoming& i : incoming_) {
       if (i.owed == 0 || 2 * i.owed < relays_.capacity_) continue;
       const Link& l = relays_.links_[i.link];
-      relays_.ring(thread_, l.from_thread).push(Ring::Entry{static_cast<std::uint32_t>(i.link), i.owed, {}});
+      Ring& ring = relays_.ring(thread_, l.from_thread);
+      ring.reserve(1);
+      ring.put_credits(static_cast<std::uint32_t>(i.link), i.owed);
+      ring.publish();
       i.owed = 0;
       touched_[l.from_thread] = true;
     }

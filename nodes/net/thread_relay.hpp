@@ -27,8 +27,10 @@ namespace nodes {
 
 class Router;
 
-// What one thread's relay carried; read after the run.
-struct RelayCounters {
+// What one thread's relay carried; read after the run. A cache line of
+// its own: each relay counts every packet, and counters of two threads in
+// one line would send it between their cores at every count.
+struct alignas(64) RelayCounters {
   std::uint64_t packets_sent = 0;      // packets this thread's relay put in rings
   std::uint64_t packets_received = 0;  // packets it took from rings
   std::uint64_t wakes = 0;             // times it woke to work

@@ -7,6 +7,7 @@
 #include <optional>
 #include <stdexcept>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "csp/csp.hpp"
@@ -118,6 +119,84 @@ TEST(Channel, TryOperationsNeverBlock) {
   csp::Channel<int> rendezvous("r");
   int x = 1;
   EXPECT_FALSE(rendezvous.writer().try_write(x));
+}
+
+// try_read_each takes at most `most` values, in order, under one call;
+// none from an empty channel; poison throws.
+TEST(Channel, TryReadEachTakesAtMostWhatIsAskedInOrder) {
+  csp::Channel<std::unique_ptr<int>> c("c", 5);
+  auto in = c.reader();
+  auto out = c.writer();
+  std::vector<int> got;
+  const auto take = [&got](std::unique_ptr<int>& v) { got.push_back(*std::exchange(v, nullptr)); };
+  EXPECT_EQ(in.try_read_each(3, take), 0u);
+  for (int i = 0; i < 5; ++i) {
+    auto v = std::make_unique<int>(i);
+    ASSERT_TRUE(out.try_write(v));
+  }
+  EXPECT_EQ(in.try_read_each(3, take), 3u);
+  EXPECT_EQ(got, (std::vector<int>{0, 1, 2}));
+  // Room again for three, behind the two left: the ring wraps.
+  for (int i = 5; i < 8; ++i) {
+    auto v = std::make_unique<int>(i);
+    ASSERT_TRUE(out.try_write(v));
+  }
+  auto refused = std::make_unique<int>(99);
+  EXPECT_FALSE(out.try_write(refused));
+  EXPECT_EQ(in.try_read_each(10, take), 5u);
+  EXPECT_EQ(got, (std::vector<int>{0, 1, 2, 3, 4, 5, 6, 7}));
+  EXPECT_EQ(in.try_read_each(0, take), 0u);
+  c.poison();
+  EXPECT_THROW(in.try_read_each(1, take), csp::Poisoned);
+}
+
+// A writer parked on a full buffer refills the slot a batch read frees, and
+// goes on; a rendezvous writer's value is taken straight from it.
+TEST(Channel, TryReadEachTakesFromParkedWriters) {
+  for (std::size_t capacity : {0u, 2u}) {
+    csp::Channel<int> c("c", capacity);
+    std::vector<int> got;
+    bool written = false;
+    csp::Runtime rt(1);
+    rt.spawn("writer", 0, [out = c.writer(), &written, capacity]() mutable {
+      for (int i = 0; i <= static_cast<int>(capacity); ++i) out.write(i);
+      written = true;
+    });
+    rt.spawn("reader", 0, [in = c.reader(), &got, &written, capacity]() mutable {
+      for (int i = 0; i < 10; ++i) csp::yield();  // the writer is parked, its last value in hand
+      ASSERT_FALSE(written);
+      const auto take = [&got](int& v) { got.push_back(v); };
+      EXPECT_EQ(in.try_read_each(100, take), capacity + 1) << "capacity " << capacity;
+      for (int i = 0; i < 10 && !written; ++i) csp::yield();
+      EXPECT_TRUE(written);
+    });
+    rt.run();
+    std::vector<int> want;
+    for (int i = 0; i <= static_cast<int>(capacity); ++i) want.push_back(i);
+    EXPECT_EQ(got, want) << "capacity " << capacity;
+  }
+}
+
+// The room a batch read frees fires an ALT waiting for room.
+TEST(Channel, TryReadEachFiresAWaitForRoom) {
+  csp::Channel<int> c("c", 2);
+  bool room = false;
+  csp::Runtime rt(1);
+  rt.spawn("writer", 0, [out = c.writer(), &room]() mutable {
+    for (int i = 0; i < 2; ++i) out.write(i);
+    csp::Alt alt;
+    alt.add_room(out);
+    alt.select();
+    room = true;
+  });
+  rt.spawn("reader", 0, [in = c.reader(), &room]() mutable {
+    for (int i = 0; i < 10; ++i) csp::yield();
+    ASSERT_FALSE(room);
+    EXPECT_EQ(in.try_read_each(1, [](int& v) { EXPECT_EQ(v, 0); }), 1u);
+    for (int i = 0; i < 10 && !room; ++i) csp::yield();
+    EXPECT_TRUE(room);
+  });
+  rt.run();
 }
 
 TEST(Channel, ReadForTimesOutWithoutWriter) {
