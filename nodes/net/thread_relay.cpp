@@ -224,7 +224,7 @@ class ThreadRelays::Relay {
         Incoming& i = incoming_[in_index_[e.link]];
         ++relays_.counters_[thread_].packets_received;
         if (i.staged.empty() && relays_.links_[i.link].deliver(e.packet)) {
-          ++i.owed;
+          owe(i);
           return;
         }
         if (i.staged.empty()) alt_.enable(i.guard, true);
@@ -248,12 +248,20 @@ class ThreadRelays::Relay {
     if (o.credits == 0) alt_.enable(o.guard, false);
   }
 
+  // A credit owed for a packet delivered; a link that comes to owe half its
+  // buffer is due to be paid at the next flush, which so visits only the
+  // links it pays, however many links come into this thread.
+  void owe(Incoming& i) {
+    if (2 * ++i.owed >= relays_.capacity_ && 2 * (i.owed - 1) < relays_.capacity_)
+      due_.push_back(static_cast<std::size_t>(&i - incoming_.data()));
+  }
+
   // Staged packets of one incoming link, while its input has room.
   void deliver(Incoming& i) {
     Link& l = relays_.links_[i.link];
     while (!i.staged.empty() && l.deliver(i.staged.front())) {
       i.staged.pop_front();
-      ++i.owed;
+      owe(i);
     }
     if (i.staged.empty()) alt_.enable(i.guard, false);
   }
@@ -264,8 +272,8 @@ class ThreadRelays::Relay {
   // and each is staged (so the input is full and drains as its router
   // reads) or delivered (owed), so the owed reach K/2 as the far end reads.
   void flush() {
-    for (Incoming& i : incoming_) {
-      if (i.owed == 0 || 2 * i.owed < relays_.capacity_) continue;
+    for (const std::size_t k : due_) {
+      Incoming& i = incoming_[k];
       const Link& l = relays_.links_[i.link];
       Ring& ring = relays_.ring(thread_, l.from_thread);
       ring.reserve(1);
@@ -274,6 +282,7 @@ class ThreadRelays::Relay {
       i.owed = 0;
       touched_[l.from_thread] = true;
     }
+    due_.clear();
     for (unsigned t = 0; t < relays_.threads_; ++t) {
       if (!touched_[t]) continue;
       touched_[t] = false;
@@ -289,6 +298,7 @@ class ThreadRelays::Relay {
   std::vector<std::size_t> out_index_, in_index_;  // per link: its place above, or none
   std::vector<std::pair<bool, std::size_t>> guard_owner_;  // per guard: (outgoing?, place)
   std::vector<bool> touched_;                      // per thread: written to since the last flush
+  std::vector<std::size_t> due_;                   // incoming links owing half their buffer or more
   csp::Alt alt_{csp::Alt::Waiting::doorbell};
   std::size_t token_guard_ = 0;
 };
