@@ -4,7 +4,8 @@
 // - Capacity 0 (the default) is a rendezvous: write() returns once a reader
 //   has the value. Capacity k is a bounded buffer: a writer waits only while
 //   k values are held, a reader only while none is. Values keep their order.
-// - try_read() and try_write() never wait; read_for() waits at most a duration.
+// - try_read() and try_write() never wait; read_for() waits at most a duration;
+//   try_read_each() takes up to N values without waiting, under one lock.
 // - A buffer's first slots come with its first value, unless made with
 //   Slots::up_front, for where allocation must not fail: a write never does.
 // - Poison, from either end, is permanent and wakes every waiter: every later
