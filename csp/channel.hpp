@@ -1,6 +1,5 @@
-// Occam channels. Channel<T> owns the shared state and hands out its two
-// ends, In<T> (reading) and Out<T> (writing): cheap copyable handles. A
-// channel has one reading and one writing process.
+// Occam channels. Channel<T> owns the shared state and hands out its two ends,
+// In<T> (reading) and Out<T> (writing), cheap copyable handles; one process reads, one writes.
 // - Capacity 0 (the default) is a rendezvous: write() returns once a reader
 //   has the value. Capacity k is a bounded buffer: a writer waits only while
 //   k values are held, a reader only while none is. Values keep their order.
