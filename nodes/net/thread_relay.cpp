@@ -51,22 +51,9 @@ class ThreadRelays::Ring {
     head_seen_ = head_.load(std::memory_order_acquire);
     if (tail_ - head_seen_ + n > slots_.size()) throw std::logic_error("thread relay: ring full");
   }
-  // After reserve(): moves the packet in, unpublished until publish().
-  void put(std::uint32_t link, Packet& packet) {
-    Entry& e = slots_[tail_slot_];
-    e.link = link;
-    e.credits = 0;
-    e.packet = std::move(packet);
-    tail_slot_ = next(tail_slot_);
-    ++tail_;
-  }
-  void put_credits(std::uint32_t link, std::uint32_t credits) {
-    Entry& e = slots_[tail_slot_];
-    e.link = link;
-    e.credits = credits;
-    tail_slot_ = next(tail_slot_);
-    ++tail_;
-  }
+  // After reserve(): a packet moved in, or credits; unpublished until publish().
+  void put(std::uint32_t link, Packet& packet) { claim(link, 0).packet = std::move(packet); }
+  void put_credits(std::uint32_t link, std::uint32_t credits) { claim(link, credits); }
   void publish() { tail_published_.store(tail_, std::memory_order_release); }
 
   // Takes every entry published so far; the head is published once.
@@ -83,6 +70,15 @@ class ThreadRelays::Ring {
 
  private:
   std::size_t next(std::size_t slot) const { return slot + 1 == slots_.size() ? 0 : slot + 1; }
+  // The entry at the tail, addressed to `link`; the tail moves past it.
+  Entry& claim(std::uint32_t link, std::uint32_t credits) {
+    Entry& e = slots_[tail_slot_];
+    e.link = link;
+    e.credits = credits;
+    tail_slot_ = next(tail_slot_);
+    ++tail_;
+    return e;
+  }
 
   std::vector<Entry> slots_;
   alignas(64) std::atomic<std::uint64_t> tail_published_{0};
