@@ -14,9 +14,13 @@
 //    first 1 KB one;
 //  - the uniform grid against the BVH on the same rays (hit counts and
 //    images checked equal); --grid runs this alone;
+//  - with `povray` on the PATH, the 1 KB Whitted render against POV-Ray 3.7
+//    tracing the same scene (pov_scene.hpp), trace time against trace time;
 // then ear clipping of toothed wheels. A failed check prints one line naming
 // the scene and page size, and the bench exits 1.
+#include <stdlib.h>
 #include <time.h>
+#include <unistd.h>
 
 #include <algorithm>
 #include <charconv>
@@ -30,6 +34,7 @@
 #include <vector>
 
 #include "examples/bench/bench_args.hpp"
+#include "examples/bench/pov_scene.hpp"
 #include "tracer/database.hpp"
 #include "tracer/generators.hpp"
 #include "tracer/geometry.hpp"
@@ -345,6 +350,7 @@ bool bench_embree(const std::string& spec, const tracer::Database& db) {
 // ---- the uniform grid against the BVH ----
 
 float grid_density = tracer::BuildOptions{}.grid_density;  // --density D
+bool with_povray = false;  // `povray` is on the PATH and --no-povray was not given
 
 void print_per_ray(const tracer::Database& db, bool is_grid) {
   tracer::InMemoryPageSource pages(db);
@@ -442,6 +448,49 @@ bool bench_page_sizes(const std::string& spec, const tracer::Scene& scene, const
   return ok;
 }
 
+// ---- POV-Ray on the same scene ----
+
+// vmpray's Whitted render at 1 KB pages and POV-Ray's trace of the same
+// scene, their runs alternating; false if POV-Ray fails.
+bool bench_povray(const std::string& spec, const tracer::Scene& scene, const tracer::Database& db) {
+  char dir[] = "/tmp/tracer_bench.XXXXXX";
+  if (!::mkdtemp(dir)) {
+    report_failure(spec, "cannot make a temporary folder for POV-Ray's scene");
+    return false;
+  }
+  const std::string pov = std::string(dir) + "/scene.pov";
+  std::string error;
+  Series ours;
+  std::vector<double> theirs, parse;
+  bench::PovRun run;
+  if (bench::write_pov(scene, pov, error))
+    for (int rep = 0; rep < kRepeats && error.empty(); ++rep) {
+      std::uint64_t calls = 0;
+      std::vector<tracer::Color> image;
+      ours.add(whitted(db, nullptr, calls, image));
+      run = bench::run_povray(pov, scene.camera.width, scene.camera.height);
+      if (!run.ok) error = run.error;
+      theirs.push_back(run.trace_seconds);
+      parse.push_back(run.parse_seconds);
+    }
+  std::remove(pov.c_str());
+  ::rmdir(dir);
+  if (!error.empty()) {
+    report_failure(spec, "POV-Ray: " + error);
+    return false;
+  }
+  // POV-Ray counts eye, reflected and refracted rays, not shadow rays.
+  tracer::InMemoryPageSource pages(db);
+  tracer::RayStats stats;
+  tracer::render_frame(db.header, pages, {}, stats);
+  std::printf("  whitted povray  trace %.3f s, vmpray %.3f s: time povray/vmpray %.2f  (rays but shadow rays: "
+              "povray %llu, vmpray %llu; povray's parse %.2f s)\n",
+              median(theirs), ours.median_seconds(), median(theirs) / ours.median_seconds(),
+              static_cast<unsigned long long>(run.rays),
+              static_cast<unsigned long long>(stats.rays() - stats.shadow), median(parse));
+  return true;
+}
+
 // false if any check failed.
 bool bench_scene(const std::string& spec, bool grid_only) {
   tracer::Scene scene = tracer::generate_scene(spec);
@@ -458,6 +507,7 @@ bool bench_scene(const std::string& spec, bool grid_only) {
   std::printf("  embree          not built (libembree-dev was missing when the build was configured)\n");
 #endif
   ok = bench_page_sizes(spec, scene, db) && ok;
+  if (with_povray) ok = bench_povray(spec, scene, db) && ok;
   return bench_grid(spec, scene, db) && ok;
 }
 
@@ -504,15 +554,18 @@ bool bench_triangulation() {
 }  // namespace
 
 const char* const usage =
-    "usage: tracer_bench [--grid] [--density CELLS_PER_PRIMITIVE] [SCENE...]\n"
-    "  (default scenes teapot mountain rings4 tetra9; density above 0, at most 64)\n";
+    "usage: tracer_bench [--grid] [--no-povray] [--density CELLS_PER_PRIMITIVE] [SCENE...]\n"
+    "  (default scenes teapot mountain rings4 tetra9; density above 0, at most 64;\n"
+    "  POV-Ray 3.7 is timed on the same scenes when `povray` is on the PATH)\n";
 
 int bench_tracer(const std::vector<std::string>& args) {
   std::vector<std::string> scenes;
-  bool grid_only = false;
+  bool grid_only = false, no_povray = false;
   for (std::size_t i = 0; i < args.size(); ++i) {
     if (args[i] == "--grid") {
       grid_only = true;
+    } else if (args[i] == "--no-povray") {
+      no_povray = true;
     } else if (args[i] == "--density") {
       if (i + 1 == args.size()) throw bench::BadArgument{"--density needs a value"};
       const std::string& v = args[++i];
@@ -528,6 +581,7 @@ int bench_tracer(const std::vector<std::string>& args) {
     }
   }
   if (scenes.empty()) scenes = {"teapot", "mountain", "rings4", "tetra9"};
+  with_povray = !grid_only && !no_povray && bench::povray_available();
   for (const auto& s : scenes) tracer::generate_scene(s);  // an unknown scene fails before any work
   std::printf("tracer_bench: one thread, 512x512, CPU time of the thread; each figure the median of %d runs,\n"
               "the runs of a comparison alternating, ratios of medians; images checked against the 1 KB render\n",
@@ -536,6 +590,8 @@ int bench_tracer(const std::vector<std::string>& args) {
   std::printf("and hit counts against Embree's, rays told apart only within %g of a triangle's edge\n",
               double(kEdge));
 #endif
+  if (!grid_only && !no_povray && !with_povray)
+    std::printf("povray is not on the PATH: POV-Ray is not timed (Debian package povray)\n");
   bool ok = true;
   for (const auto& s : scenes) ok = bench_scene(s, grid_only) && ok;
   if (!grid_only) ok = bench_triangulation() && ok;
