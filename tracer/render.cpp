@@ -342,14 +342,22 @@ bool Tracer::traverse_bvh(const Ray& ray, float t_min, float& t_max_io, Hit* hit
     }
     // Stack the lanes met, farthest first, so the nearest is popped next
     // (any-hit rays need no order).
+    // An entry's child and count are stored as one 8-byte word, so that an
+    // entry moved up by the insertion loop just after being written is read
+    // back as it was stored (two 4-byte stores read as one 8-byte load would
+    // stall the load until the stores retire).
     const std::size_t base = sp;
     for (; mask; mask &= mask - 1) {
       const int lane = std::countr_zero(mask);
       const StackEntry e = lane_entry(node, lane, t[lane]);
+      const std::uint64_t word = std::uint64_t{e.child} | std::uint64_t{e.count} << 32;
       std::size_t k = sp++;
       if constexpr (!Any)
         for (; k > base && stack[k - 1].t < e.t; --k) stack[k] = stack[k - 1];
-      stack[k] = e;
+      static_assert(offsetof(StackEntry, child) == 0 && offsetof(StackEntry, count) == 4 &&
+                    std::endian::native == std::endian::little);
+      std::memcpy(&stack[k], &word, sizeof word);
+      stack[k].t = e.t;
     }
     // Run leaves and pop until the next inner node.
     for (;;) {
