@@ -89,7 +89,7 @@ class ThreadBudget {
 
 class Builder {
  public:
-  Builder(const std::vector<Box3f>& bounds, const std::vector<bool>& triangle, int max_leaf, const BvhParallelism& par)
+  Builder(std::span<const Box3f> bounds, const std::vector<bool>& triangle, int max_leaf, const BvhParallelism& par)
       : bounds_(bounds),
         triangle_(triangle),
         max_leaf_(std::max(1, max_leaf)),
@@ -408,7 +408,7 @@ class Builder {
     return static_cast<std::uint32_t>(mid - out_.order.begin());
   }
 
-  const std::vector<Box3f>& bounds_;
+  std::span<const Box3f> bounds_;
   const std::vector<bool>& triangle_;
   int max_leaf_;
   std::uint32_t large_node_, chunk_;
@@ -489,7 +489,7 @@ void lay_out_treelets(BvhBuild& bvh, std::uint32_t nodes_per_page) {
   }
   std::vector<std::uint32_t> new_index(n);
   for (std::uint32_t i = 0; i < n; ++i) new_index[placed[i]] = i;
-  std::vector<BvhNode> nodes(n);
+  BigVector<BvhNode> nodes(n);
   for (std::uint32_t i = 0; i < n; ++i) {
     nodes[i] = bvh.nodes[placed[i]];
     for (int lane = 0; lane < 4; ++lane)
@@ -549,12 +549,14 @@ void split_piece(const Piece& poly, const Box3f& box, float max_area, int depth,
 
 }  // namespace
 
-BuildRefs split_large_triangles(const std::vector<PrimRecord>& prims,
-                                const std::vector<Box3f>& bounds, int max_depth) {
+BuildRefs split_large_triangles(std::span<const PrimRecord> prims, std::span<const Box3f> bounds, int max_depth) {
   double total = 0;
   for (const Box3f& b : bounds) total += b.half_area();
   const float max_area = bounds.empty() ? 0.0f : static_cast<float>(2.0 * total / bounds.size());
   BuildRefs out;
+  out.bounds.reserve(prims.size());  // most primitives keep one reference
+  out.prim.reserve(prims.size());
+  out.triangle.reserve(prims.size());
   for (std::uint32_t i = 0; i < prims.size(); ++i) {
     const PrimRecord& p = prims[i];
     const bool triangle =

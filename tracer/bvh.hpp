@@ -14,16 +14,18 @@
 #pragma once
 
 #include <cstdint>
+#include <span>
 #include <vector>
 
 #include "tracer/geometry.hpp"
+#include "tracer/huge_pages.hpp"
 #include "tracer/records.hpp"
 
 namespace tracer {
 
 struct BvhBuild {
-  std::vector<BvhNode> nodes;
-  std::vector<std::uint32_t> order;
+  BigVector<BvhNode> nodes;
+  BigVector<std::uint32_t> order;
   std::uint32_t depth = 1;  // nodes on the longest root-to-leaf path
 };
 
@@ -32,8 +34,8 @@ struct BvhBuild {
 // into every leaf that holds one of its references. triangle[k] says whether
 // reference k is a triangle, which a leaf tests four at a time.
 struct BuildRefs {
-  std::vector<Box3f> bounds;
-  std::vector<std::uint32_t> prim;
+  BigVector<Box3f> bounds;
+  BigVector<std::uint32_t> prim;
   std::vector<bool> triangle;
 };
 
@@ -69,8 +71,7 @@ void lay_out_treelets(BvhBuild& bvh, std::uint32_t nodes_per_page);
 // and each piece of the triangle gets its own tight box. Long thin triangles
 // then no longer make every box around them large. Other primitives keep one
 // reference with their own box.
-BuildRefs split_large_triangles(const std::vector<PrimRecord>& prims,
-                                const std::vector<Box3f>& bounds, int max_depth);
+BuildRefs split_large_triangles(std::span<const PrimRecord> prims, std::span<const Box3f> bounds, int max_depth);
 
 // Sets lane i of a node to box b (an empty Box3f makes the lane unused).
 void set_lane_box(BvhNode& node, int lane, const Box3f& b);

@@ -7,9 +7,11 @@
 #include <cmath>
 #include <cstring>
 #include <limits>
+#include <span>
 
 #include "tracer/bvh.hpp"
 #include "tracer/grid.hpp"
+#include "tracer/huge_pages.hpp"
 #include "tracer/parallel.hpp"
 
 namespace tracer {
@@ -24,9 +26,9 @@ Vec3f to_f(const Vec3d& v) { return static_cast<Vec3f>(v); }
 
 // Primitives in scene order with their boxes, before any acceleration structure.
 struct Flattened {
-  std::vector<PrimRecord> prims;
-  std::vector<NormalRecord> normals;
-  std::vector<Box3f> bounds;
+  BigVector<PrimRecord> prims;
+  BigVector<NormalRecord> normals;
+  BigVector<Box3f> bounds;
 };
 
 // Widen a box by a few float ulps of its coordinates, so that float rounding
@@ -131,8 +133,9 @@ class Packer {
  public:
   Packer(std::uint32_t page_size, unsigned threads) : page_size_(page_size), threads_(threads) {}
 
-  template <class T>
-  SectionLayout add(const std::vector<T>& records, const char* what) {
+  template <class Records>
+  SectionLayout add(const Records& records, const char* what) {
+    using T = typename Records::value_type;
     static_assert(std::is_trivially_copyable_v<T>);
     if (sizeof(T) > page_size_)
       throw DatabaseError("page size " + std::to_string(page_size_) + " is too small for a " +
@@ -175,7 +178,7 @@ class Packer {
 // Primitives put in `order` (a permutation), each smooth triangle's normal
 // following it, in pieces on `threads`: a first pass counts each piece's
 // smooth triangles, so every piece knows where its normals start.
-void reorder(Flattened& f, const std::vector<std::uint32_t>& order, unsigned threads) {
+void reorder(Flattened& f, std::span<const std::uint32_t> order, unsigned threads) {
   constexpr std::size_t piece_size = 1 << 16;
   const std::size_t pieces = (order.size() + piece_size - 1) / piece_size;
   std::vector<std::size_t> first_normal(pieces + 1, 0);
@@ -186,8 +189,8 @@ void reorder(Flattened& f, const std::vector<std::uint32_t>& order, unsigned thr
     first_normal[p + 1] = smooth;
   });
   for (std::size_t p = 0; p < pieces; ++p) first_normal[p + 1] += first_normal[p];
-  std::vector<PrimRecord> prims(order.size());
-  std::vector<NormalRecord> normals(first_normal[pieces]);
+  BigVector<PrimRecord> prims(order.size());
+  BigVector<NormalRecord> normals(first_normal[pieces]);
   parallel_pieces(threads, pieces, [&](std::size_t p) {
     std::size_t next_normal = first_normal[p];
     for (std::size_t i = p * piece_size; i < std::min(order.size(), (p + 1) * piece_size); ++i) {

@@ -99,7 +99,7 @@ bool may_overlap(const PrimRecord& p, const Box3f& box) {
 // appended to `lists`; cells[base + c] gets cell c's range. A primitive is
 // listed in the cells of its box's range that it may overlap, or in all of
 // them should the test keep none.
-void fill_level(const std::vector<PrimRecord>& prims, const std::vector<Box3f>& prim_bounds, const std::uint32_t* ids,
+void fill_level(std::span<const PrimRecord> prims, std::span<const Box3f> prim_bounds, const std::uint32_t* ids,
                 std::size_t count, const Box3f& bounds, const int dims[3], std::size_t base,
                 std::vector<GridCell>& cells, std::vector<std::uint32_t>& lists) {
   std::vector<std::size_t> kept;
@@ -150,7 +150,7 @@ void grid_cell_range(const Box3f& bounds, const int dims[3], const Box3f& b, int
   }
 }
 
-GridBuild build_grid(const std::vector<PrimRecord>& prims, const std::vector<Box3f>& prim_bounds, const Box3f& bounds,
+GridBuild build_grid(std::span<const PrimRecord> prims, std::span<const Box3f> prim_bounds, const Box3f& bounds,
                      float density) {
   GridBuild g;
   choose_dims(bounds, prim_bounds.size(), density, kMaxDim, g.dims);

@@ -16,6 +16,7 @@
 #pragma once
 
 #include <cstdint>
+#include <span>
 #include <vector>
 
 #include "tracer/geometry.hpp"
@@ -38,7 +39,7 @@ struct GridBuild {
 // About `density` top cells per primitive, shaped to the box, cut into
 // subgrids where dense; bounds must contain every primitive box.
 // prims[i] has box prim_bounds[i].
-GridBuild build_grid(const std::vector<PrimRecord>& prims, const std::vector<Box3f>& prim_bounds, const Box3f& bounds,
+GridBuild build_grid(std::span<const PrimRecord> prims, std::span<const Box3f> prim_bounds, const Box3f& bounds,
                      float density);
 
 // The cell index range [lo, hi] along each axis overlapped by box b.

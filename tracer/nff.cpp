@@ -5,7 +5,6 @@
 // keyword; see nff.hpp for the choices made where NFF is silent.
 #include "tracer/nff.hpp"
 
-#include <sys/mman.h>
 #include <zlib.h>
 
 #include <algorithm>
@@ -163,22 +162,6 @@ class GzipSource final : public ByteSource {
   std::uint64_t inflated_ = 0;
   std::vector<char> in_ = std::vector<char>(1 << 16);
 };
-
-// Large arrays of objects are asked to be backed by 2 MB pages where the
-// system does so on request: each page of fresh memory costs a fault when
-// first written, and a large scene writes a few hundred megabytes (here, a
-// fault took microseconds, a third of the read's time on 4 KB pages). Only
-// whole 2 MB pages inside the range are advised; a refusal changes nothing.
-void advise_huge_pages(const void* data, std::size_t bytes) {
-#ifdef MADV_HUGEPAGE
-  constexpr std::uintptr_t kHuge = std::uintptr_t{1} << 21;
-  const auto begin = (reinterpret_cast<std::uintptr_t>(data) + kHuge - 1) & ~(kHuge - 1);
-  const auto end = (reinterpret_cast<std::uintptr_t>(data) + bytes) & ~(kHuge - 1);
-  if (end > begin) madvise(reinterpret_cast<void*>(begin), end - begin, MADV_HUGEPAGE);
-#else
-  (void)data, (void)bytes;
-#endif
-}
 
 inline constexpr std::size_t kMaxTokenBytes = 1024;
 // Vertices reserved from a polygon's count, at most: one allocation for the
@@ -535,7 +518,6 @@ class Parser {
     if (chunks_.empty() || chunks_.back().size() == kChunkObjects) {
       chunks_.emplace_back();
       chunks_.back().reserve(kChunkObjects);
-      advise_huge_pages(chunks_.back().data(), kChunkObjects * sizeof(Object));
     }
     chunks_.back().push_back(std::move(o));
   }
@@ -543,14 +525,13 @@ class Parser {
     std::size_t total = 0;
     for (const auto& c : chunks_) total += c.size();
     scene_.objects.reserve(total);
-    advise_huge_pages(scene_.objects.data(), total * sizeof(Object));
     for (auto& c : chunks_) {
       std::move(c.begin(), c.end(), std::back_inserter(scene_.objects));
-      std::vector<Object>().swap(c);  // frees it: the peak is the scene once, not twice
+      BigVector<Object>().swap(c);  // frees it: the peak is the scene once, not twice
     }
     return std::move(scene_);
   }
-  std::vector<std::vector<Object>> chunks_;
+  std::vector<BigVector<Object>> chunks_;
 
   Lexer lex_;
   const std::string& source_;

@@ -13,6 +13,7 @@
 #include <variant>
 #include <vector>
 
+#include "tracer/huge_pages.hpp"
 #include "tracer/vec.hpp"
 
 namespace tracer {
@@ -86,7 +87,7 @@ struct Scene {
   Color background{0, 0, 0};
   std::vector<Light> lights;
   std::vector<Material> materials;
-  std::vector<Object> objects;
+  BigVector<Object> objects;  // large scenes' storage advised for huge pages
 
   // Polygons as the paper counts them: "p" and "pp" entities.
   std::size_t polygon_count() const {

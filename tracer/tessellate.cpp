@@ -115,7 +115,7 @@ std::uint64_t tessellated_object_count(const Scene& scene, int resolution) {
 
 void tessellate(Scene& scene, int resolution) {
   check_resolution(resolution);
-  std::vector<Object> objects;
+  BigVector<Object> objects;
   objects.reserve(scene.objects.size());
   for (Object& o : scene.objects) {
     std::vector<Patch> pieces;
