@@ -341,7 +341,9 @@ bool Tracer::traverse_bvh(const Ray& ray, float t_min, float& t_max_io, Hit* hit
       }
     }
     // Stack the lanes met, farthest first, so the nearest is popped next
-    // (any-hit rays need no order).
+    // (any-hit rays need no order). An inner lane's node, when it lies in the
+    // page at hand (most do: treelets), is prefetched, so that a big scene's
+    // nodes come from memory while the nearer lanes are traversed.
     // An entry's child and count are stored as one 8-byte word, so that an
     // entry moved up by the insertion loop just after being written is read
     // back as it was stored (two 4-byte stores read as one 8-byte load would
@@ -351,6 +353,11 @@ bool Tracer::traverse_bvh(const Ray& ray, float t_min, float& t_max_io, Hit* hit
       const int lane = std::countr_zero(mask);
       const StackEntry e = lane_entry(node, lane, t[lane]);
       const std::uint64_t word = std::uint64_t{e.child} | std::uint64_t{e.count} << 32;
+      if (e.count == 0) {
+        const std::uint64_t byte = std::uint64_t{e.child} * sizeof(BvhNode);
+        if (node_pages + static_cast<PageId>(byte >> page_shift) == last_page_)
+          __builtin_prefetch(last_ptr_ + (byte & offset_mask));
+      }
       std::size_t k = sp++;
       if constexpr (!Any)
         for (; k > base && stack[k - 1].t < e.t; --k) stack[k] = stack[k - 1];
