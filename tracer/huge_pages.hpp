@@ -11,6 +11,7 @@
 #include <sys/mman.h>
 
 #include <cstddef>
+#include <cstdint>
 #include <memory>
 #include <new>
 #include <vector>
@@ -48,6 +49,15 @@ struct HugePageAllocator {
     return true;
   }
 };
+
+// Advises the whole 2 MiB pages inside [data, data + bytes) for huge pages,
+// for storage allocated elsewhere and not yet written (reserved capacity).
+inline void advise_huge_pages(const void* data, std::size_t bytes) {
+  const auto first = reinterpret_cast<std::uintptr_t>(data);
+  const std::uintptr_t begin = (first + kHugePage - 1) & ~(kHugePage - 1);
+  const std::uintptr_t end = (first + bytes) & ~(kHugePage - 1);
+  if (end > begin) ::madvise(reinterpret_cast<void*>(begin), end - begin, MADV_HUGEPAGE);
+}
 
 // A vector whose large storage is advised for huge pages.
 template <class T>

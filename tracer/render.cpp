@@ -12,6 +12,7 @@
 #include <memory>
 
 #include "tracer/grid.hpp"
+#include "tracer/huge_pages.hpp"
 #include "tracer/parallel.hpp"
 
 namespace tracer {
@@ -634,7 +635,10 @@ std::vector<Color> render_frame(const DatabaseHeader& header, PageSource& pages,
                                 const std::function<void(int)>& progress) {
   const int w = header.camera.width, h = header.camera.height;
   Tracer tracer(header, pages, options);
-  std::vector<Color> out(std::size_t(w) * h);
+  std::vector<Color> out;
+  out.reserve(std::size_t(w) * h);
+  advise_huge_pages(out.data(), out.capacity() * sizeof(Color));  // a big frame is written once, pixel by pixel
+  out.resize(std::size_t(w) * h);
   if (!options.spd_procedure) {
     for (int y = 0; y < h; ++y) {
       for (int x = 0; x < w; ++x) out[std::size_t(y) * w + x] = tracer.trace_pixel(x, y, stats);
@@ -694,7 +698,10 @@ std::vector<Color> render_frame(const Database& db, const TraceOptions& options,
   const int w = db.header.camera.width, h = db.header.camera.height;
   std::vector<std::unique_ptr<Lane>> lanes;
   for (unsigned i = 0; i < std::max(1u, threads); ++i) lanes.push_back(std::make_unique<Lane>(db, options));
-  std::vector<Color> out(std::size_t(w) * h);
+  std::vector<Color> out;
+  out.reserve(std::size_t(w) * h);
+  advise_huge_pages(out.data(), out.capacity() * sizeof(Color));  // a big frame is written once, pixel by pixel
+  out.resize(std::size_t(w) * h);
   const auto report = [&](int rows) {
     if (progress) progress(rows);
   };
