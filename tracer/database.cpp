@@ -136,29 +136,37 @@ class Packer {
   template <class Records>
   SectionLayout add(const Records& records, const char* what) {
     using T = typename Records::value_type;
+    return add_each<T>(records.size(), what, [&](std::size_t i, T& out) { out = records[i]; });
+  }
+
+  // A section of `count` records, record i made by fill(i, T&) as its page
+  // is filled, so a permuted section needs no copy of its own.
+  template <class T, class Fill>
+  SectionLayout add_each(std::size_t count, const char* what, const Fill& fill) {
     static_assert(std::is_trivially_copyable_v<T>);
     if (sizeof(T) > page_size_)
       throw DatabaseError("page size " + std::to_string(page_size_) + " is too small for a " +
                           what + " record of " + std::to_string(sizeof(T)) + " bytes");
-    SectionLayout s{static_cast<PageId>(pages_.size()), sizeof(T),
-                    static_cast<std::uint32_t>(records.size())};
-    const std::size_t bytes = records.size() * sizeof(T);
-    const std::size_t npages = (bytes + page_size_ - 1) / page_size_;
+    SectionLayout s{static_cast<PageId>(pages_.size()), sizeof(T), static_cast<std::uint32_t>(count)};
+    const std::size_t per_page = page_size_ / sizeof(T);  // both powers of two: no record spans two pages
+    const std::size_t npages = (count + per_page - 1) / per_page;
     if (pages_.size() + npages > std::numeric_limits<PageId>::max())
       throw DatabaseError("scene too large: more than 2^32 pages");
-    const auto* src = reinterpret_cast<const std::byte*>(records.data());
     const std::size_t base = pages_.size();
     pages_.resize(base + npages);
     const std::size_t pieces = (npages + kPagesPerPiece - 1) / kPagesPerPiece;
     parallel_pieces(threads_, pieces, [&](std::size_t piece) {
+      T record;
       for (std::size_t p = piece * kPagesPerPiece; p < std::min(npages, (piece + 1) * kPagesPerPiece); ++p) {
         std::vector<std::byte> page(page_size_, std::byte{0});
-        const std::size_t n = std::min<std::size_t>(page_size_, bytes - p * page_size_);
-        std::memcpy(page.data(), src + p * page_size_, n);
+        for (std::size_t i = p * per_page, end = std::min(count, (p + 1) * per_page); i < end; ++i) {
+          fill(i, record);
+          std::memcpy(page.data() + (i - p * per_page) * sizeof(T), &record, sizeof(T));
+        }
         pages_[base + p] = std::move(page);
       }
     });
-    payload_ += bytes;
+    payload_ += count * sizeof(T);
     return s;
   }
 
@@ -173,12 +181,19 @@ class Packer {
   std::uint64_t payload_ = 0;
 };
 
-// Puts primitives (and their normal records) in BVH leaf order; a primitive
-// listed in several leaves is copied into each.
-// Primitives put in `order` (a permutation), each smooth triangle's normal
-// following it, in pieces on `threads`: a first pass counts each piece's
-// smooth triangles, so every piece knows where its normals start.
-void reorder(Flattened& f, std::span<const std::uint32_t> order, unsigned threads) {
+// Primitives in an acceleration structure's leaf order (a primitive listed
+// in several leaves is copied into each), each smooth triangle's normal
+// record following it: where each record comes from, worked out in pieces on
+// the build's threads (a first pass counts each piece's smooth triangles,
+// so every piece knows where its normals start). The records themselves are
+// made as their pages are packed, with no second copy of the primitives.
+struct LeafOrder {
+  std::span<const std::uint32_t> prim;  // prim[i]: the flattened primitive at leaf position i
+  BigVector<std::uint32_t> normal;      // normal[i]: its normal record's new index (smooth triangles)
+  BigVector<std::uint32_t> normal_src;  // normal_src[k]: the flattened normal record of new index k
+};
+
+LeafOrder leaf_order(const Flattened& f, std::span<const std::uint32_t> order, unsigned threads) {
   constexpr std::size_t piece_size = 1 << 16;
   const std::size_t pieces = (order.size() + piece_size - 1) / piece_size;
   std::vector<std::size_t> first_normal(pieces + 1, 0);
@@ -189,21 +204,30 @@ void reorder(Flattened& f, std::span<const std::uint32_t> order, unsigned thread
     first_normal[p + 1] = smooth;
   });
   for (std::size_t p = 0; p < pieces; ++p) first_normal[p + 1] += first_normal[p];
-  BigVector<PrimRecord> prims(order.size());
-  BigVector<NormalRecord> normals(first_normal[pieces]);
+  LeafOrder out{order, BigVector<std::uint32_t>(order.size()), BigVector<std::uint32_t>(first_normal[pieces])};
   parallel_pieces(threads, pieces, [&](std::size_t p) {
     std::size_t next_normal = first_normal[p];
     for (std::size_t i = p * piece_size; i < std::min(order.size(), (p + 1) * piece_size); ++i) {
-      PrimRecord r = f.prims[order[i]];
-      if (r.kind == PrimKind::smooth_triangle) {
-        normals[next_normal] = f.normals[r.aux];
-        r.aux = static_cast<std::uint32_t>(next_normal++);
-      }
-      prims[i] = r;
+      const PrimRecord& r = f.prims[order[i]];
+      if (r.kind != PrimKind::smooth_triangle) continue;
+      out.normal_src[next_normal] = r.aux;
+      out.normal[i] = static_cast<std::uint32_t>(next_normal++);
     }
   });
-  f.prims = std::move(prims);
-  f.normals = std::move(normals);
+  return out;
+}
+
+// Packs the primitives and normals in leaf order: the sections' last two.
+void pack_leaf_order(Packer& packer, const Flattened& f, const LeafOrder& leaves, SectionLayout* sections) {
+  sections[int(Section::prims)] =
+      packer.add_each<PrimRecord>(leaves.prim.size(), "primitive", [&](std::size_t i, PrimRecord& r) {
+        r = f.prims[leaves.prim[i]];
+        if (r.kind == PrimKind::smooth_triangle) r.aux = leaves.normal[i];
+      });
+  sections[int(Section::normals)] =
+      packer.add_each<NormalRecord>(leaves.normal_src.size(), "normal", [&](std::size_t k, NormalRecord& n) {
+        n = f.normals[leaves.normal_src[k]];
+      });
 }
 
 std::vector<MaterialRecord> material_records(const Scene& scene) {
@@ -259,22 +283,31 @@ Database build_database(const Scene& scene, const BuildOptions& opt) {
   Packer packer(opt.page_size, opt.threads);
   auto& sec = h.sections;
   sec[int(Section::materials)] = packer.add(material_records(scene), "material");
+  // Each array is freed as soon as the build is done with it, so that a big
+  // scene's peak holds as few of them at once as the steps allow.
+  const auto release = [](auto& v) { std::remove_reference_t<decltype(v)>().swap(v); };
   if (opt.accel == Accel::bvh) {
-    const BuildRefs refs = split_large_triangles(f.prims, f.bounds, opt.bvh_split_depth);
+    BuildRefs refs = split_large_triangles(f.prims, f.bounds, opt.bvh_split_depth);
+    release(f.bounds);
     BvhBuild bvh = build_bvh(refs, opt.bvh_max_leaf, {.threads = opt.threads});
+    release(refs.bounds);
+    release(refs.triangle);
     if (opt.bvh_layout == BvhLayout::treelet) lay_out_treelets(bvh, opt.page_size / sizeof(BvhNode));
     for (std::uint32_t& k : bvh.order) k = refs.prim[k];
-    reorder(f, bvh.order, opt.threads);
+    db.stats.bvh_references = refs.prim.size();
+    release(refs.prim);
+    const LeafOrder leaves = leaf_order(f, bvh.order, opt.threads);
     db.stats.accel_seconds = seconds_since(t0);
     t0 = Clock::now();
     h.bvh_root = bvh.nodes[0];
     h.bvh_depth = bvh.depth;
     db.stats.bvh_nodes = bvh.nodes.size();
-    db.stats.bvh_references = refs.prim.size();
     sec[int(Section::bvh_nodes)] = packer.add(bvh.nodes, "BVH node");
+    release(bvh.nodes);
+    pack_leaf_order(packer, f, leaves, sec);
   } else {
     GridBuild g = build_grid(f.prims, f.bounds, h.bounds, opt.grid_density);
-    reorder(f, g.order, opt.threads);
+    const LeafOrder leaves = leaf_order(f, g.order, opt.threads);
     db.stats.accel_seconds = seconds_since(t0);
     t0 = Clock::now();
     std::copy(g.dims, g.dims + 3, h.grid_dims);
@@ -283,9 +316,8 @@ Database build_database(const Scene& scene, const BuildOptions& opt) {
     db.stats.grid_subgrids = g.subgrids;
     sec[int(Section::grid_cells)] = packer.add(g.cells, "grid cell");
     sec[int(Section::grid_lists)] = packer.add(g.lists, "grid list");
+    pack_leaf_order(packer, f, leaves, sec);
   }
-  sec[int(Section::prims)] = packer.add(f.prims, "primitive");
-  sec[int(Section::normals)] = packer.add(f.normals, "normal");
   db.stats.payload_bytes = packer.payload();
   db.pages = packer.take();
   h.page_count = static_cast<std::uint32_t>(db.pages.size());
