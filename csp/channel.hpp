@@ -111,15 +111,7 @@ class ChannelState final : public ChannelBase {
     for (; n < most; ++n) {
       if (count_ > 0) {
         take(*ring_[head_]);
-        ring_[head_].reset();
-        if (++head_ == ring_.size()) head_ = 0;
-        --count_;
-        if (Record* r = claim_front_locked(writers_)) {
-          push_locked(std::move(*static_cast<T*>(r->slot)));
-          complete(*r->waiter, WaitState::data, r->guard);
-        } else {
-          freed = true;
-        }
+        freed = drop_front_locked() || freed;
       } else if (Record* r = claim_front_locked(writers_)) {
         take(*static_cast<T*>(r->slot));
         complete(*r->waiter, WaitState::data, r->guard);
@@ -129,10 +121,7 @@ class ChannelState final : public ChannelBase {
     }
     if (n == 0) return 0;
     publish_hints_locked();
-    if (freed && count_ < capacity_) {
-      if (Record* alt = claim_front_locked(room_waiters_)) complete(*alt->waiter, WaitState::data, alt->guard);
-      room_bell_.ring();
-    }
+    if (freed) announce_room_locked();
     return n;
   }
 
@@ -191,19 +180,32 @@ class ChannelState final : public ChannelBase {
   // writer, or rings for the room it frees.
   T pop_locked() {
     T v(std::move(*ring_[head_]));
-    ring_[head_].reset();
-    head_ = (head_ + 1) % ring_.size();
-    --count_;
-    if (Record* r = claim_front_locked(writers_)) {
-      push_locked(std::move(*static_cast<T*>(r->slot)));
-      complete(*r->waiter, WaitState::data, r->guard);
-      publish_hints_locked();
-      return v;
-    }
-    if (Record* alt = claim_front_locked(room_waiters_)) complete(*alt->waiter, WaitState::data, alt->guard);
+    const bool freed = drop_front_locked();
     publish_hints_locked();
-    room_bell_.ring();
+    if (freed) announce_room_locked();
     return v;
+  }
+
+  // Lock held, count_ > 0, the first value moved out: frees its slot and
+  // refills the buffer from the first parked writer. Returns whether room
+  // was left (no writer was parked), which the caller announces once its
+  // hints are published.
+  bool drop_front_locked() {
+    ring_[head_].reset();
+    if (++head_ == ring_.size()) head_ = 0;
+    --count_;
+    Record* r = claim_front_locked(writers_);
+    if (!r) return true;
+    push_locked(std::move(*static_cast<T*>(r->slot)));
+    complete(*r->waiter, WaitState::data, r->guard);
+    return false;
+  }
+
+  // Lock held: room was freed; fires the first ALT waiting for room and
+  // rings for processes that watch the room bell.
+  void announce_room_locked() {
+    if (Record* alt = claim_front_locked(room_waiters_)) complete(*alt->waiter, WaitState::data, alt->guard);
+    room_bell_.ring();
   }
 
   // Lock held: a value without waiting (buffer first, then a parked writer).

@@ -115,7 +115,7 @@ void stage(csp::In<int> in, csp::Out<int> out) {
 TEST(Poison, ShutsDownAPipeline) {
   constexpr int n = 6;
   std::vector<csp::Channel<int>> c;
-  for (int i = 0; i <= n; ++i) c.emplace_back("c" + std::to_string(i));
+  for (int i = 0; i <= n; ++i) c.emplace_back(std::to_string(i));  // "x" + to_string: a false GCC 12 -Wrestrict here
   std::vector<int> got;
   csp::Runtime rt(2);
   rt.spawn("source", 0, [out = c[0].writer()]() mutable {
