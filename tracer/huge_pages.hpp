@@ -41,7 +41,7 @@ struct HugePageAllocator {
     if (n * sizeof(T) < kHugePage)
       std::allocator<T>().deallocate(p, n);
     else
-      ::operator delete(p, n * sizeof(T), std::align_val_t{kHugePage});
+      ::operator delete(p, std::align_val_t{kHugePage});
   }
 
   template <class U>
