@@ -20,6 +20,15 @@ namespace tracer {
 
 inline constexpr std::size_t kHugePage = std::size_t{2} << 20;
 
+// Advises the whole 2 MiB pages inside [data, data + bytes) for huge pages,
+// for storage not yet written (a fresh block, or reserved capacity).
+inline void advise_huge_pages(const void* data, std::size_t bytes) {
+  const auto first = reinterpret_cast<std::uintptr_t>(data);
+  const std::uintptr_t begin = (first + kHugePage - 1) & ~(kHugePage - 1);
+  const std::uintptr_t end = (first + bytes) & ~(kHugePage - 1);
+  if (end > begin) ::madvise(reinterpret_cast<void*>(begin), end - begin, MADV_HUGEPAGE);  // a hint
+}
+
 template <class T>
 struct HugePageAllocator {
   using value_type = T;
@@ -33,7 +42,7 @@ struct HugePageAllocator {
     const std::size_t bytes = n * sizeof(T);
     if (bytes < kHugePage) return std::allocator<T>().allocate(n);
     void* p = ::operator new(bytes, std::align_val_t{kHugePage});
-    ::madvise(p, bytes, MADV_HUGEPAGE);  // a hint; failure leaves ordinary pages
+    advise_huge_pages(p, bytes);  // a hint; failure leaves ordinary pages
     return static_cast<T*>(p);
   }
 
@@ -49,15 +58,6 @@ struct HugePageAllocator {
     return true;
   }
 };
-
-// Advises the whole 2 MiB pages inside [data, data + bytes) for huge pages,
-// for storage allocated elsewhere and not yet written (reserved capacity).
-inline void advise_huge_pages(const void* data, std::size_t bytes) {
-  const auto first = reinterpret_cast<std::uintptr_t>(data);
-  const std::uintptr_t begin = (first + kHugePage - 1) & ~(kHugePage - 1);
-  const std::uintptr_t end = (first + bytes) & ~(kHugePage - 1);
-  if (end > begin) ::madvise(reinterpret_cast<void*>(begin), end - begin, MADV_HUGEPAGE);
-}
 
 // A vector whose large storage is advised for huge pages.
 template <class T>

@@ -630,15 +630,24 @@ Color Tracer::average_corners(const Color& c00, const Color& c10, const Color& c
   return (c00 + c10 + c01 + c11) * 0.25f;
 }
 
+namespace {
+// A frame's pixels, advised for huge pages before they are written: a big
+// frame is fresh memory written once, pixel by pixel.
+std::vector<Color> frame_buffer(int w, int h) {
+  std::vector<Color> out;
+  out.reserve(std::size_t(w) * h);
+  advise_huge_pages(out.data(), out.capacity() * sizeof(Color));
+  out.resize(std::size_t(w) * h);
+  return out;
+}
+}  // namespace
+
 std::vector<Color> render_frame(const DatabaseHeader& header, PageSource& pages,
                                 const TraceOptions& options, RayStats& stats,
                                 const std::function<void(int)>& progress) {
   const int w = header.camera.width, h = header.camera.height;
   Tracer tracer(header, pages, options);
-  std::vector<Color> out;
-  out.reserve(std::size_t(w) * h);
-  advise_huge_pages(out.data(), out.capacity() * sizeof(Color));  // a big frame is written once, pixel by pixel
-  out.resize(std::size_t(w) * h);
+  std::vector<Color> out = frame_buffer(w, h);
   if (!options.spd_procedure) {
     for (int y = 0; y < h; ++y) {
       for (int x = 0; x < w; ++x) out[std::size_t(y) * w + x] = tracer.trace_pixel(x, y, stats);
@@ -698,10 +707,7 @@ std::vector<Color> render_frame(const Database& db, const TraceOptions& options,
   const int w = db.header.camera.width, h = db.header.camera.height;
   std::vector<std::unique_ptr<Lane>> lanes;
   for (unsigned i = 0; i < std::max(1u, threads); ++i) lanes.push_back(std::make_unique<Lane>(db, options));
-  std::vector<Color> out;
-  out.reserve(std::size_t(w) * h);
-  advise_huge_pages(out.data(), out.capacity() * sizeof(Color));  // a big frame is written once, pixel by pixel
-  out.resize(std::size_t(w) * h);
+  std::vector<Color> out = frame_buffer(w, h);
   const auto report = [&](int rows) {
     if (progress) progress(rows);
   };

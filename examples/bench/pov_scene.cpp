@@ -8,7 +8,6 @@
 #include <map>
 #include <numbers>
 #include <sstream>
-#include <unistd.h>
 #include <variant>
 #include <vector>
 

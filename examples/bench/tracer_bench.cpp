@@ -66,6 +66,7 @@ struct Run {
   double seconds = 0;
   std::uint64_t hits = 0;      // primary + shadow: eye rays that hit
   std::uint64_t shadowed = 0;  // and shadow rays found occluded
+  std::uint64_t shadow = 0;    // Whitted: the shadow rays among `rays`
 };
 
 // The runs of one side of a comparison.
@@ -169,7 +170,7 @@ Run whitted(const tracer::Database& db, tracer::PageSource* direct, std::uint64_
   image = tracer::render_frame(db.header, pages, {}, stats);
   const double seconds = cpu_seconds() - t0;
   page_calls = stats.page_calls;
-  return {stats.rays(), seconds};
+  return {.rays = stats.rays(), .seconds = seconds, .shadow = stats.shadow};
 }
 
 // ---- Embree on the same triangles ----
@@ -480,14 +481,11 @@ bool bench_povray(const std::string& spec, const tracer::Scene& scene, const tra
     return false;
   }
   // POV-Ray counts eye, reflected and refracted rays, not shadow rays.
-  tracer::InMemoryPageSource pages(db);
-  tracer::RayStats stats;
-  tracer::render_frame(db.header, pages, {}, stats);
   std::printf("  whitted povray  trace %.3f s, vmpray %.3f s: time povray/vmpray %.2f  (rays but shadow rays: "
               "povray %llu, vmpray %llu; povray's parse %.2f s)\n",
               median(theirs), ours.median_seconds(), median(theirs) / ours.median_seconds(),
               static_cast<unsigned long long>(run.rays),
-              static_cast<unsigned long long>(stats.rays() - stats.shadow), median(parse));
+              static_cast<unsigned long long>(ours.last.rays - ours.last.shadow), median(parse));
   return true;
 }
 
@@ -581,7 +579,8 @@ int bench_tracer(const std::vector<std::string>& args) {
     }
   }
   if (scenes.empty()) scenes = {"teapot", "mountain", "rings4", "tetra9"};
-  with_povray = !grid_only && !no_povray && bench::povray_available();
+  const bool want_povray = !grid_only && !no_povray;
+  with_povray = want_povray && bench::povray_available();
   for (const auto& s : scenes) tracer::generate_scene(s);  // an unknown scene fails before any work
   std::printf("tracer_bench: one thread, 512x512, CPU time of the thread; each figure the median of %d runs,\n"
               "the runs of a comparison alternating, ratios of medians; images checked against the 1 KB render\n",
@@ -590,7 +589,7 @@ int bench_tracer(const std::vector<std::string>& args) {
   std::printf("and hit counts against Embree's, rays told apart only within %g of a triangle's edge\n",
               double(kEdge));
 #endif
-  if (!grid_only && !no_povray && !with_povray)
+  if (want_povray && !with_povray)
     std::printf("povray is not on the PATH: POV-Ray is not timed (Debian package povray)\n");
   bool ok = true;
   for (const auto& s : scenes) ok = bench_scene(s, grid_only) && ok;
