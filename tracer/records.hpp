@@ -63,6 +63,9 @@ static_assert(sizeof(BvhNode) == 128);
 // section; or, for a top cell with kGridSubgridFlag set in `count`, a subgrid
 // over the cell's box whose cells start at record `first` of the cell section,
 // its dimensions (1..256 each) in count's bits 0-7, 8-15 and 16-23, less one.
+// An empty cell (count 0) holds in `first` its distance d >= 1 to the nearest
+// cell of its level that is not empty, in cells along the farthest axis:
+// every cell of the level within d - 1 of it on every axis is empty too.
 struct GridCell {
   std::uint32_t first;
   std::uint32_t count;

@@ -536,6 +536,49 @@ bool Tracer::test_cell(const GridCell& cell, std::uint64_t ray_tag, const Ray& r
   return found;
 }
 
+namespace {
+// An empty cell at least this far from the nearest occupied one is jumped
+// over with the cube of empty cells around it; nearer, the walk steps (a
+// jump costs a division, a step reads one cell).
+constexpr std::uint32_t kGridJumpDistance = 2;
+
+// Moves the walk from an empty cell `distance` cells from the nearest
+// occupied one (records.hpp) to the first cell the ray meets beyond the cube
+// of cells within distance - 1 on every axis, all empty, clipped to the grid:
+// each axis steps over the cell boundaries the ray crosses before it leaves
+// the cube, as the walk would one by one. t_enter becomes the distance at
+// which the ray leaves the cube. False when the ray leaves the grid there, or
+// t_max lies before: no later cell can hold a nearer hit.
+bool jump_empty(GridWalk& w, const int dims[3], std::uint32_t distance, float t_max, float& t_enter) {
+  const int r = static_cast<int>(std::min<std::uint32_t>(distance - 1, 1u << 20));
+  int reach[3] = {0, 0, 0};
+  float t_exit = std::numeric_limits<float>::infinity();
+  int exit_axis = -1;
+  for (int a = 0; a < 3; ++a) {
+    if (w.step[a] == 0) continue;
+    reach[a] = std::min(r, w.step[a] > 0 ? dims[a] - 1 - w.cell[a] : w.cell[a]);
+    const float t = w.t_next[a] + static_cast<float>(reach[a]) * w.t_delta[a];
+    if (t < t_exit) t_exit = t, exit_axis = a;
+  }
+  if (exit_axis < 0 || t_exit >= t_max) return false;
+  for (int a = 0; a < 3; ++a) {
+    if (w.step[a] == 0) continue;
+    int k = reach[a] + 1;  // the exit axis also crosses the cube's face
+    if (a != exit_axis) {
+      const float q = (t_exit - w.t_next[a]) / w.t_delta[a];  // NaN for a flat axis: no step
+      k = q > 0 ? (q < static_cast<float>(reach[a]) ? static_cast<int>(q) : reach[a]) : 0;
+      while (k < reach[a] && w.t_next[a] + static_cast<float>(k) * w.t_delta[a] < t_exit) ++k;
+    }
+    w.cell[a] += w.step[a] * k;
+    w.index += w.stride[a] * k;
+    w.t_next[a] += static_cast<float>(k) * w.t_delta[a];
+  }
+  if (w.cell[exit_axis] < 0 || w.cell[exit_axis] >= dims[exit_axis]) return false;
+  t_enter = t_exit;
+  return true;
+}
+}  // namespace
+
 // The walk keeps the nearest hit of the cells met so far and stops at the
 // first cell the ray leaves beyond it: a primitive spans several cells, so a
 // hit found in one cell may lie in a later one, where a primitive met there
@@ -551,6 +594,11 @@ bool Tracer::walk_grid(const Box3f& box, const int dims[3], std::uint64_t base, 
   for (;;) {
     ++stats.box_tests;
     const GridCell cell = read<GridCell>(Section::grid_cells, base + static_cast<std::uint64_t>(w.index), stats);
+    // An empty cell far from any other: jump over the empty cells around it.
+    if (cell.count == 0 && cell.first > kGridJumpDistance) {
+      if (!jump_empty(w, dims, cell.first, t_max, t_enter)) return found;
+      continue;
+    }
     const int axis =
         w.t_next[0] < w.t_next[1] ? (w.t_next[0] < w.t_next[2] ? 0 : 2) : (w.t_next[1] < w.t_next[2] ? 1 : 2);
     if constexpr (Top) {

@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <cstring>
+#include <functional>
 #include <random>
 
 #include "test_scenes.hpp"
@@ -47,8 +48,8 @@ class RandomRays {
   std::uniform_real_distribution<float> u_{-1.5f, 1.5f};
 };
 
-void expect_same_hits_as_brute_force(Accel accel) {
-  const Scene scene = testing::random_scene(7, 400, 60);
+void expect_same_hits_as_brute_force(Accel accel, const Scene& scene = testing::random_scene(7, 400, 60),
+                                     const std::function<Ray(RandomRays&)>& next = &RandomRays::next) {
   const Database db = build_database(scene, {.accel = accel, .page_size = 512});
   if (accel == Accel::grid) {
     EXPECT_GT(db.stats.grid_subgrids, 0u);  // both levels are walked
@@ -58,7 +59,7 @@ void expect_same_hits_as_brute_force(Accel accel) {
   RandomRays rays(11);
   int hits = 0;
   for (int i = 0; i < 3000; ++i) {
-    const Ray ray = rays.next();
+    const Ray ray = next(rays);
     RayStats stats;
     const auto expected = brute_force(db, ray);
     const auto got = tracer.closest_hit(ray, 0.0f, 1e30f, stats);
@@ -75,6 +76,45 @@ void expect_same_hits_as_brute_force(Accel accel) {
 
 TEST(Bvh, ClosestHitsMatchBruteForce) { expect_same_hits_as_brute_force(Accel::bvh); }
 TEST(Grid, ClosestHitsMatchBruteForce) { expect_same_hits_as_brute_force(Accel::grid); }
+
+// Two clusters of small triangles and spheres in opposite corners of the
+// cube, empty space between: the grid's walk jumps over the empty cells far
+// from the clusters (records.hpp), and must meet the same primitives as
+// brute force on rays aimed at the clusters from anywhere in the cube.
+TEST(Grid, JumpsOverEmptySpaceToTheSameHits) {
+  Scene scene = testing::random_scene(5, 600, 40);
+  // A point of the cube moved into the corner its x coordinate picks.
+  const auto cornered = [](const Vec3d& p) {
+    Vec3d q;
+    for (int a = 0; a < 3; ++a) q[a] = (p.x < 0 ? -1.2 : 1.2) + 0.15 * p[a];
+    return q;
+  };
+  for (auto& object : scene.objects) {
+    if (auto* polygon = std::get_if<Polygon>(&object.shape)) {
+      const Vec3d first = polygon->vertices[0], moved = cornered(first);
+      for (Vec3d& v : polygon->vertices) v = moved + (v - first) * 0.3;
+    } else if (auto* sphere = std::get_if<Sphere>(&object.shape)) {
+      sphere->center = cornered(sphere->center);
+      sphere->radius *= 0.5;
+    }
+  }
+  const Database db = build_database(scene, {.accel = Accel::grid, .page_size = 512});
+  const SectionLayout& cells = db.header.section(Section::grid_cells);
+  std::uint32_t farthest = 0;
+  for (std::uint32_t i = 0; i < cells.record_count; ++i) {
+    GridCell c;
+    const std::size_t byte = std::size_t{i} * sizeof c;
+    std::memcpy(&c, db.pages[cells.first_page + byte / 512].data() + byte % 512, sizeof c);
+    if (c.count == 0) farthest = std::max(farthest, c.first);
+  }
+  EXPECT_GE(farthest, 4u) << "no empty cell far enough from the clusters to be jumped over";
+  expect_same_hits_as_brute_force(Accel::grid, scene, [&](RandomRays& rays) {
+    const Ray from = rays.next();
+    const Vec3d target = cornered(Vec3d{from.dir.x, from.dir.y, from.dir.z} * (1 / 1.5));
+    const Vec3f aim{float(target.x), float(target.y), float(target.z)};
+    return Ray{from.origin, aim - from.origin};
+  });
+}
 
 // The four-wide leaf test (and the grid's four-wide test of triangles copied
 // out of their pages) must give the scalar test's barycentrics bit for bit

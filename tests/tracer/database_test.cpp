@@ -3,6 +3,8 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <cstdlib>
 #include <cstring>
 
 #include "test_scenes.hpp"
@@ -21,6 +23,28 @@ T record(const Database& db, Section s, std::uint64_t i) {
   std::memcpy(&out, db.pages.at(l.first_page + byte / db.header.page_size).data() + offset,
               sizeof out);
   return out;
+}
+
+// Each empty cell of the grid level of `dims` cells from record `base`
+// holds its chessboard distance d to the nearest occupied cell of the
+// level, by brute force: none nearer than d, one at d.
+void expect_empty_distances(const Database& db, std::uint64_t base, const int dims[3]) {
+  const auto at = [&](int x, int y, int z) {
+    return record<GridCell>(db, Section::grid_cells, base + x + std::uint64_t(dims[0]) * (y + std::uint64_t(dims[1]) * z));
+  };
+  for (int z = 0; z < dims[2]; ++z)
+    for (int y = 0; y < dims[1]; ++y)
+      for (int x = 0; x < dims[0]; ++x) {
+        const GridCell c = at(x, y, z);
+        if (c.count != 0) continue;
+        int nearest = std::max({dims[0], dims[1], dims[2]});
+        for (int qz = 0; qz < dims[2]; ++qz)
+          for (int qy = 0; qy < dims[1]; ++qy)
+            for (int qx = 0; qx < dims[0]; ++qx)
+              if (at(qx, qy, qz).count != 0)
+                nearest = std::min(nearest, std::max({std::abs(qx - x), std::abs(qy - y), std::abs(qz - z)}));
+        ASSERT_EQ(c.first, std::uint32_t(nearest)) << "empty cell " << x << "," << y << "," << z << " at " << base;
+      }
 }
 
 void expect_consistent(const Database& db) {
@@ -63,15 +87,18 @@ void expect_consistent(const Database& db) {
         int dims[3];
         decode_subgrid(c.count, dims);
         EXPECT_EQ(c.first, next_subgrid);
+        expect_empty_distances(db, c.first, dims);
         next_subgrid += std::uint64_t(dims[0]) * dims[1] * dims[2];
         continue;
       }
+      if (c.count == 0) continue;  // its `first` is a distance, checked by level
       EXPECT_LE(std::uint64_t{c.first} + c.count, lists.record_count);
       for (std::uint32_t k = 1; k < c.count; ++k)
         EXPECT_LT(record<std::uint32_t>(db, Section::grid_lists, c.first + k - 1),
                   record<std::uint32_t>(db, Section::grid_lists, c.first + k));
     }
     EXPECT_EQ(next_subgrid, cells.record_count);
+    expect_empty_distances(db, 0, h.grid_dims);
     for (std::uint32_t i = 0; i < lists.record_count; ++i)
       EXPECT_LT(record<std::uint32_t>(db, Section::grid_lists, i), prims.record_count);
   }
