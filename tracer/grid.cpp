@@ -19,6 +19,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdlib>
 #include <limits>
 
 namespace tracer {
@@ -140,37 +141,40 @@ void fill_level(std::span<const PrimRecord> prims, std::span<const Box3f> prim_b
 }
 
 // Each empty cell of the level at cells[base, base + dims product) gets its
-// chessboard distance to the nearest cell that is not empty (records.hpp), by
-// the two-pass chamfer transform over all 26 neighbours, exact for this
-// metric: a forward pass takes the neighbours met before a cell in x-fastest
-// order, a backward pass the others. A level with no occupied cell keeps
-// the largest distance its dimensions allow.
+// chessboard and city-block distances to the nearest cell that is not empty
+// (records.hpp), each by the two-pass chamfer transform, exact for these
+// metrics: a forward pass takes the neighbours met before a cell in
+// x-fastest order, a backward pass the others; all 26 neighbours count for
+// the chessboard distance, the 6 that share a face for the city-block one.
+// A level with no occupied cell keeps the largest distance a field holds.
 void set_empty_distances(std::vector<GridCell>& cells, std::size_t base, const int dims[3]) {
   const std::int64_t nx = dims[0], ny = dims[1], nz = dims[2];
-  const std::uint32_t far = static_cast<std::uint32_t>(std::max({nx, ny, nz}));
-  std::vector<std::uint32_t> d(static_cast<std::size_t>(nx * ny * nz));
-  for (std::size_t i = 0; i < d.size(); ++i) d[i] = cells[base + i].count != 0 ? 0 : far;
+  constexpr std::uint32_t far = kGridDistanceMax;
+  std::vector<std::uint32_t> chess(static_cast<std::size_t>(nx * ny * nz)), city(chess.size());
+  for (std::size_t i = 0; i < chess.size(); ++i) chess[i] = city[i] = cells[base + i].count != 0 ? 0 : far;
   const auto pass = [&](int dir) {
     const std::int64_t z0 = dir > 0 ? 0 : nz - 1, y0 = dir > 0 ? 0 : ny - 1, x0 = dir > 0 ? 0 : nx - 1;
     for (std::int64_t z = z0; z >= 0 && z < nz; z += dir)
       for (std::int64_t y = y0; y >= 0 && y < ny; y += dir)
         for (std::int64_t x = x0; x >= 0 && x < nx; x += dir) {
-          std::uint32_t& here = d[static_cast<std::size_t>(x + nx * (y + ny * z))];
-          if (here == 0) continue;
+          const auto at = static_cast<std::size_t>(x + nx * (y + ny * z));
+          if (chess[at] == 0) continue;
           // The 13 neighbours that come before (dir > 0) or after (dir < 0) this cell.
           for (int dz = 0; dz <= 1; ++dz)
             for (int dy = dz ? -1 : 0; dy <= 1; ++dy)
               for (int dx = dz || dy ? -1 : 1; dx <= 1; ++dx) {
                 const std::int64_t qx = x - dir * dx, qy = y - dir * dy, qz = z - dir * dz;
                 if (qx < 0 || qx >= nx || qy < 0 || qy >= ny || qz < 0 || qz >= nz) continue;
-                here = std::min(here, d[static_cast<std::size_t>(qx + nx * (qy + ny * qz))] + 1);
+                const auto q = static_cast<std::size_t>(qx + nx * (qy + ny * qz));
+                chess[at] = std::min(chess[at], chess[q] + 1);
+                if (std::abs(dx) + std::abs(dy) + dz == 1) city[at] = std::min(city[at], city[q] + 1);
               }
         }
   };
   pass(1);
   pass(-1);
-  for (std::size_t i = 0; i < d.size(); ++i)
-    if (cells[base + i].count == 0) cells[base + i].first = d[i];
+  for (std::size_t i = 0; i < chess.size(); ++i)
+    if (cells[base + i].count == 0) cells[base + i].first = std::min(chess[i], far) | std::min(city[i], far) << 16;
 }
 
 }  // namespace

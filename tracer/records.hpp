@@ -63,15 +63,19 @@ static_assert(sizeof(BvhNode) == 128);
 // section; or, for a top cell with kGridSubgridFlag set in `count`, a subgrid
 // over the cell's box whose cells start at record `first` of the cell section,
 // its dimensions (1..256 each) in count's bits 0-7, 8-15 and 16-23, less one.
-// An empty cell (count 0) holds in `first` its distance d >= 1 to the nearest
-// cell of its level that is not empty, in cells along the farthest axis:
-// every cell of the level within d - 1 of it on every axis is empty too.
+// An empty cell (count 0) holds in `first` its distances to the nearest
+// cell of its level that is not empty, each at least 1 and at most
+// kGridDistanceMax: in bits 0-15 the chessboard distance d (every cell of
+// the level within d - 1 of it on every axis is empty too), in bits 16-31
+// the city-block distance e (so are the next e - 1 cells of any walk from
+// it, which moves one axis a step at a time).
 struct GridCell {
   std::uint32_t first;
   std::uint32_t count;
 };
 static_assert(sizeof(GridCell) == 8);
 inline constexpr std::uint32_t kGridSubgridFlag = 1u << 31;
+inline constexpr std::uint32_t kGridDistanceMax = 0xffff;
 inline std::uint32_t encode_subgrid(const int dims[3]) {
   return kGridSubgridFlag | std::uint32_t(dims[0] - 1) | std::uint32_t(dims[1] - 1) << 8 |
          std::uint32_t(dims[2] - 1) << 16;

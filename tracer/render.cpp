@@ -595,12 +595,10 @@ bool Tracer::walk_grid(const Box3f& box, const int dims[3], std::uint64_t base, 
     ++stats.box_tests;
     const GridCell cell = read<GridCell>(Section::grid_cells, base + static_cast<std::uint64_t>(w.index), stats);
     // An empty cell far from any other: jump over the empty cells around it.
-    if (cell.count == 0 && cell.first > kGridJumpDistance) {
-      if (!jump_empty(w, dims, cell.first, t_max, t_enter)) return found;
+    if (cell.count == 0 && (cell.first & 0xffff) > kGridJumpDistance) {
+      if (!jump_empty(w, dims, cell.first & 0xffff, t_max, t_enter)) return found;
       continue;
     }
-    const int axis =
-        w.t_next[0] < w.t_next[1] ? (w.t_next[0] < w.t_next[2] ? 0 : 2) : (w.t_next[1] < w.t_next[2] ? 1 : 2);
     if constexpr (Top) {
       if (cell.count & kGridSubgridFlag) {
         int sub[3];
@@ -618,14 +616,19 @@ bool Tracer::walk_grid(const Box3f& box, const int dims[3], std::uint64_t base, 
       found = true;
       if (Any) return true;
     }
-    // Every later cell begins at t_next[axis] or beyond, and a hit must be
-    // nearer than t_max.
-    if (w.t_next[axis] >= t_max) return found;
-    w.cell[axis] += w.step[axis];
-    if (w.cell[axis] < 0 || w.cell[axis] >= dims[axis]) return found;
-    w.index += w.stride[axis];
-    t_enter = w.t_next[axis];
-    w.t_next[axis] += w.t_delta[axis];
+    // The next cell, or from an empty one the next few, which are empty too.
+    for (std::uint32_t steps = cell.count == 0 ? cell.first >> 16 : 1; steps > 0; --steps) {
+      const int axis =
+          w.t_next[0] < w.t_next[1] ? (w.t_next[0] < w.t_next[2] ? 0 : 2) : (w.t_next[1] < w.t_next[2] ? 1 : 2);
+      // Every later cell begins at t_next[axis] or beyond, and a hit must be
+      // nearer than t_max.
+      if (w.t_next[axis] >= t_max) return found;
+      w.cell[axis] += w.step[axis];
+      if (w.cell[axis] < 0 || w.cell[axis] >= dims[axis]) return found;
+      w.index += w.stride[axis];
+      t_enter = w.t_next[axis];
+      w.t_next[axis] += w.t_delta[axis];
+    }
   }
 }
 

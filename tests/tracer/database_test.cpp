@@ -26,8 +26,8 @@ T record(const Database& db, Section s, std::uint64_t i) {
 }
 
 // Each empty cell of the grid level of `dims` cells from record `base`
-// holds its chessboard distance d to the nearest occupied cell of the
-// level, by brute force: none nearer than d, one at d.
+// holds its chessboard and city-block distances to the nearest occupied
+// cell of the level (records.hpp), by brute force.
 void expect_empty_distances(const Database& db, std::uint64_t base, const int dims[3]) {
   const auto at = [&](int x, int y, int z) {
     return record<GridCell>(db, Section::grid_cells, base + x + std::uint64_t(dims[0]) * (y + std::uint64_t(dims[1]) * z));
@@ -37,13 +37,17 @@ void expect_empty_distances(const Database& db, std::uint64_t base, const int di
       for (int x = 0; x < dims[0]; ++x) {
         const GridCell c = at(x, y, z);
         if (c.count != 0) continue;
-        int nearest = std::max({dims[0], dims[1], dims[2]});
+        std::uint32_t chess = kGridDistanceMax, city = kGridDistanceMax;
         for (int qz = 0; qz < dims[2]; ++qz)
           for (int qy = 0; qy < dims[1]; ++qy)
-            for (int qx = 0; qx < dims[0]; ++qx)
-              if (at(qx, qy, qz).count != 0)
-                nearest = std::min(nearest, std::max({std::abs(qx - x), std::abs(qy - y), std::abs(qz - z)}));
-        ASSERT_EQ(c.first, std::uint32_t(nearest)) << "empty cell " << x << "," << y << "," << z << " at " << base;
+            for (int qx = 0; qx < dims[0]; ++qx) {
+              if (at(qx, qy, qz).count == 0) continue;
+              const int d[3] = {std::abs(qx - x), std::abs(qy - y), std::abs(qz - z)};
+              chess = std::min(chess, std::uint32_t(std::max({d[0], d[1], d[2]})));
+              city = std::min(city, std::uint32_t(d[0] + d[1] + d[2]));
+            }
+        ASSERT_EQ(c.first & 0xffff, chess) << "empty cell " << x << "," << y << "," << z << " at " << base;
+        ASSERT_EQ(c.first >> 16, city) << "empty cell " << x << "," << y << "," << z << " at " << base;
       }
 }
 
