@@ -295,24 +295,31 @@ bool Bridge::deliver_staged() {
 }
 
 // Credits ride with packets: a link's credits go into its rank's frame when
-// that frame carries something anyway, when half the link's buffer is owed,
-// or (`all`) when the bridge goes quiet. Held back, they cannot stall the
-// sender: while fewer than half are owed, more than half of its credits
-// are with it or with packets on their way here, and those, delivered,
-// make the owed half.
+// that frame carries something anyway, alone a round of the bridge after
+// half the link's buffer came to be owed, or (`all`) when the bridge goes
+// quiet. The round lets the packets delivered run: a request delivered
+// comes back as a reply, which the credits then ride with (on rings4 over
+// TCP, two messages in five carried credits alone without the round). Held
+// back, they cannot stall the sender: while fewer than half are owed, more
+// than half of its credits are with it or with packets on their way here,
+// and those, delivered, make the owed half; once half are owed, they wait
+// one round at most, and a bridge that owes is active, so its rounds come
+// at the shortest poll interval.
 void Bridge::queue_credits(bool all) {
   const std::uint32_t batch = static_cast<std::uint32_t>((capacity_ + 1) / 2);
   std::size_t kept = 0;
   for (std::size_t i : owing_) {
     Incoming& in = incoming_[i];
     WireWriter& w = frame(in.peer);
-    if (!all && in.credits_owed < batch && w.size() == 0) {
+    if (!all && w.size() == 0 && (in.credits_owed < batch || !in.credits_waited)) {
+      in.credits_waited = in.credits_owed >= batch;
       owing_[kept++] = i;
       continue;
     }
     w.put(BridgeRecord::credit);
     put_fields(w, CreditRecord{in.link, in.credits_owed});
     in.credits_owed = 0;
+    in.credits_waited = false;
   }
   owing_.resize(kept);
 }

@@ -7,9 +7,9 @@
 // and K in the receiver's input, held by credits; the bridge blocks on
 // nothing but its one ALT and never waits inside the transport, so the
 // channel dependency graph is the unsplit machine's and stays acyclic.
-// Credits owed go with the next frame to their rank, or alone once half of
-// K are owed or the bridge goes quiet; where messages are dear, a wake
-// gathers its thread's pass into one frame. Polling backs off from 4 us to
+// Credits owed go with the next frame to their rank, or alone a round after
+// half of K are owed, or when the bridge goes quiet; where messages are dear,
+// a wake gathers its thread's pass into one frame. Polling backs off from 4 us to
 // 1 ms when all is quiet. At the end, a bridge that sees its network shut down,
 // or `end` from a peer, sends `end` (after `abort` with the line of a local
 // failure) and drains until every peer's `end` has come.
@@ -89,6 +89,7 @@ class Bridge {
     int peer = 0;
     std::deque<Packet> staged;
     std::uint32_t credits_owed = 0;
+    bool credits_waited = false;  // owed credits, due, waited a round for a packet to ride with
     std::size_t guard = 0;
   };
 

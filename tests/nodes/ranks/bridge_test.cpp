@@ -79,9 +79,10 @@ class WireLedger {
     std::lock_guard<std::mutex> lk(mutex_);
     try {
       nodes::WireReader r(frame);
-      const std::uint64_t before = packets_;
+      const std::uint64_t before = packets_, credits_before = credits_;
       while (!r.done()) record(from, to, r);
       if (packets_ > before) ++frames_with_packets_[from];
+      else if (credits_ > credits_before) ++frames_of_credits_[from];
     } catch (const std::exception& e) {
       fail("rank " + std::to_string(from) + " to " + std::to_string(to) + ": " + e.what());
     }
@@ -103,6 +104,11 @@ class WireLedger {
     std::lock_guard<std::mutex> lk(mutex_);
     const auto it = frames_with_packets_.find(from);
     return it == frames_with_packets_.end() ? 0 : it->second;
+  }
+  std::uint64_t frames_of_credits(int from) const {  // frames `from` posted with credits and no packet
+    std::lock_guard<std::mutex> lk(mutex_);
+    const auto it = frames_of_credits_.find(from);
+    return it == frames_of_credits_.end() ? 0 : it->second;
   }
   // Whether every rank posted `end` to every other.
   bool all_ended() const {
@@ -132,6 +138,7 @@ class WireLedger {
       }
       case nodes::BridgeRecord::credit: {
         const auto credit = nodes::get_fields<nodes::CreditRecord>(r);
+        ++credits_;
         if (credit.count == 0) fail(describe(credit.link) + ": a credit record of 0");
         if ((out_[key(credit.link)] -= credit.count) < 0)
           fail(describe(credit.link) + ": more credits returned than packets sent");
@@ -161,8 +168,9 @@ class WireLedger {
   std::map<Key, std::int64_t> out_;  // per cut link: packets posted less credits posted
   std::vector<bool> ended_;          // [from * ranks + to]: `end` posted
   std::size_t peak_ = 0;
-  std::uint64_t packets_ = 0;
+  std::uint64_t packets_ = 0, credits_ = 0;  // packet and credit records posted
   std::map<int, std::uint64_t> frames_with_packets_;  // per sending rank
+  std::map<int, std::uint64_t> frames_of_credits_;    // per sending rank: credits and no packet
   std::string error_;
 };
 
@@ -620,6 +628,49 @@ TEST(Bridge, ThePacketsOfOnePassLeaveInOneMessage) {
     EXPECT_EQ(m.world().ledger.packets(), 4u) << where;
     EXPECT_EQ(m.world().ledger.frames_with_packets(0), window.count() > 0 ? 1u : 4u) << where;
   }
+}
+
+// Node 0 on rank 0 sends a packet to node 1 on rank 1 and waits for the
+// answer, 200 times; node 1 answers each at once. With K = 2 each packet
+// delivered makes half of K owed, so without a round's wait every credit
+// would leave alone before the answer it called for; with it, the credit
+// rides with the answer. (A slow machine may let a round end by the poll
+// interval first, so the test asks for most credits, not all, to ride.)
+TEST(Bridge, ACreditRidesWithTheAnswerToItsPacket) {
+  constexpr std::uint64_t exchanges = 200;
+  Case c;
+  c.topology = topology::Topology::ring(2);
+  c.capacity = 2;
+  c.packets = {{0, exchanges}, {exchanges, 0}};
+  c.send.assign(2, Pauses{});
+  c.receive.assign(2, Pauses{});
+  c.delays.assign(2, Delays{});
+  Machine m(c, 1);
+  Rank& asking = m.rank(0);
+  Rank& answering = m.rank(1);
+  spawn_checked(
+      asking, "ask", asking.net.thread_of(0),
+      [&m, &asking, out = asking.net.injector(0), in = asking.net.port(0)]() mutable {
+        for (std::uint64_t k = 0; k < exchanges; ++k) {
+          out.write(make_packet(0, 1, k));
+          if (in.read().id != k) throw std::logic_error("an answer out of turn");
+        }
+        m.world().remaining = 0;
+        asking.net.shutdown();
+      },
+      csp::Priority::high);
+  spawn_checked(
+      answering, "answer", answering.net.thread_of(1),
+      [out = answering.net.injector(1), in = answering.net.port(1)]() mutable {
+        for (std::uint64_t k = 0;; ++k) {
+          if (in.read().id != k) throw std::logic_error("a question out of turn");
+          out.write(make_packet(1, 0, k));
+        }
+      },
+      csp::Priority::high);
+  ASSERT_EQ(m.run("ping-pong"), "");
+  EXPECT_GE(m.world().ledger.frames_with_packets(1), exchanges - 1);
+  EXPECT_LT(m.world().ledger.frames_of_credits(1), exchanges / 4);
 }
 
 }  // namespace
