@@ -1,18 +1,18 @@
-// The paper's uniform voxel grid, with a second level where the scene is
-// dense: the scene box cut into dims[0]*dims[1]*dims[2] top cells, each
-// listing the primitives whose box overlaps it (a primitive may be listed in
-// many cells), or, when it holds more than kSubgridThreshold of them, cut in
-// turn into a grid of its own (at most kMaxSubgridDim cells a side), whose
-// cells list them.
+// The paper's uniform voxel grid, two levels: the scene box cut into
+// dims[0]*dims[1]*dims[2] top cells, each listing the primitives whose box
+// overlaps it or, past kSubgridThreshold of them, cut into a grid of its
+// own (at most kMaxSubgridDim cells a side) whose cells list them.
 // Invariants:
 //  - Top cell (x, y, z) is cells[x + dims[0] * (y + dims[1] * z)]; the cells
 //    of a subgrid follow all top cells, in the same x-fastest order,
 //    starting at the top cell's `first` (see GridCell in records.hpp).
-//  - A list cell's primitives are lists[first .. first + count), ascending ids.
+//  - A list cell's primitives are lists[first .. first + count), ascending
+//    ids; an empty cell holds instead its distances to the nearest occupied
+//    cell of its level (records.hpp), by which the walk skips empty space.
 //  - Primitives are renumbered in the order the cells first list them
 //    (`order`), so the primitives of a cell lie side by side in their pages.
-//  - Builder and tracer compute a cell's box alike (grid_cell_box, below).
-//  - The build is sequential and depends only on its inputs.
+//  - Builder and tracer compute a cell's box alike (grid_cell_box, below);
+//    the build is sequential and depends only on its inputs.
 #pragma once
 
 #include <cstdint>
