@@ -87,7 +87,7 @@ int run(const app::Options& o, const std::vector<std::string>& command_line, nod
   try {
     app::check_output_paths(o);  // before the scene: a render is not done to be lost
     const auto t0 = std::chrono::steady_clock::now();
-    scene = app::load_scene(o);
+    scene = app::naming_memory_shortage("loading the scene", [&] { return app::load_scene(o); });
     load_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     if (o.estimate_memory) return print_memory_estimate(o, scene);
     // Before the minutes of work that an image too large for the memory would waste.

@@ -141,7 +141,7 @@ std::vector<Vec3d> dodec_rings(double minor_radius) {
 }  // namespace
 
 Scene generate_tetra(int size) {
-  spd::check_size("tetra", size, 1, 10);
+  spd::check_size("tetra", size, 1, 11);
   Scene scene;
   spd::begin_scene(scene, {1.022846, -3.177154, -2.174512}, {-0.004103, -0.004103, 0.216539},
                    {-0.816497, -0.816497, 0.816497}, 1.0);

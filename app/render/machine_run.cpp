@@ -92,8 +92,9 @@ RenderResult render_machine(const Options& o, const tracer::Scene& scene, nodes:
   tracer::Database db;
   RunReport report;
   try {
-    db = in_phase("building the database", !o.quiet && stderr_is_terminal(),
-                  [&] { return build_database(scene, build_options(o)); });
+    db = in_phase("building the database", !o.quiet && stderr_is_terminal(), [&] {
+      return naming_memory_shortage("building the database", [&] { return build_database(scene, build_options(o)); });
+    });
     // Before the machine is built: a complete graph of thousands of nodes would
     // take minutes to set up before running out of memory.
     check_machine_memory(o, scene.camera.width, scene.camera.height, db.header.page_count, memory_limit());

@@ -215,6 +215,14 @@ std::string available(const MemoryLimit& limit) {
   return "this machine's " + about(limit.bytes);
 }
 
+}  // namespace
+
+std::string out_of_memory_line(const std::string& what) {
+  return "out of memory " + what + ": it needs more than " + available(memory_limit());
+}
+
+namespace {
+
 // Resident bytes of a machine, measured on teapot at 16x16 (so that the
 // image weighs nothing) on one thread, above the 1-node machine's, fitted
 // over complete graphs, hypercubes, rings, tori and meshes

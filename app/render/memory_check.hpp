@@ -15,7 +15,9 @@
 
 #include <cstdint>
 #include <filesystem>
+#include <new>
 #include <optional>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -50,6 +52,23 @@ std::optional<std::uint64_t> cgroup_memory_limit(const std::filesystem::path& ro
 // The least of this machine's physical memory, its control group's limit and
 // the address space this process may map; no limit if none can be read.
 MemoryLimit memory_limit();
+
+// "out of memory WHAT: it needs more than the 879 MB this process may map
+// (ulimit -v)", the limit being memory_limit() as the checks here name it.
+std::string out_of_memory_line(const std::string& what);
+
+// work(), with a std::bad_alloc out of it turned into a std::runtime_error
+// of out_of_memory_line(what): the steps whose memory no check foresees
+// (reading a scene, building its database) end on a line saying where and
+// against which limit memory ran out.
+template <class Work>
+auto naming_memory_shortage(const std::string& what, Work&& work) -> decltype(work()) {
+  try {
+    return work();
+  } catch (const std::bad_alloc&) {
+    throw std::runtime_error(out_of_memory_line(what));
+  }
+}
 
 // UsageError "--width/--height: a WxH image needs about X GB, more than this
 // machine's Y GB" when the estimate exceeds `limit`.

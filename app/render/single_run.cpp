@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "app/render/cpu_count.hpp"
+#include "app/render/memory_check.hpp"
 #include "app/render/progress.hpp"
 #include "tracer/render.hpp"
 
@@ -34,8 +35,9 @@ RunReport describe_run(const Options& o, const tracer::Database& db) {
 }
 
 RenderResult render_single(const Options& o, const tracer::Scene& scene) {
-  const tracer::Database db = in_phase("building the database", !o.quiet && stderr_is_terminal(),
-                                       [&] { return build_database(scene, build_options(o)); });
+  const tracer::Database db = in_phase("building the database", !o.quiet && stderr_is_terminal(), [&] {
+    return naming_memory_shortage("building the database", [&] { return build_database(scene, build_options(o)); });
+  });
   RunReport report = describe_run(o, db);
   const tracer::TraceOptions trace{.max_depth = o.max_depth,
                                    .spd_procedure = o.spd_procedure,

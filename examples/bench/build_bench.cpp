@@ -13,8 +13,7 @@
 // Every size builds REPEATS times on each thread count, the runs interleaved
 // so that load from other work falls on both sides alike; a line gives the
 // medians. A size is skipped, with a message, when the memory available is
-// short of what it needs (tetra:11, 4.2 million triangles, a few GB) or the
-// generator refuses it (tetra's sizes stop at 10 today).
+// short of what it needs (tetra:11, 4.2 million triangles, a few GB).
 //
 // usage: build_bench [THREADS [REPEATS]]   default: 2 3
 #include <sys/resource.h>

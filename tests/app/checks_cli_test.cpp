@@ -210,6 +210,30 @@ TEST_F(Checks, ATessellationTooLargeForTheMemoryIsRefusedBeforeItIsMade) {
   EXPECT_EQ(fits.exit_code, 0) << fits.err;
 }
 
+// A scene whose loading or database runs out of the memory this process may
+// map (ulimit -v), which no check foresees, ends on one line naming the
+// step and the limit, with no output.
+TEST_F(Checks, ASceneTooLargeForTheMemoryNamesTheStepThatRanOut) {
+#if defined(__SANITIZE_ADDRESS__) || defined(__SANITIZE_THREAD__)
+  GTEST_SKIP() << "a sanitizer's shadow memory does not fit in these address spaces";
+#endif
+  const std::pair<const char*, const char*> cases[] = {
+      {"ulimit -v 120000", "vmpray: out of memory loading the scene: it needs more than the 123 MB this process may "
+                           "map (ulimit -v)\n"},
+      {"ulimit -v 250000", "vmpray: out of memory building the database: it needs more than the 256 MB this process "
+                           "may map (ulimit -v)\n"},
+  };
+  for (const auto& [limit, message] : cases) {
+    for (const char* machine : {"--single", "--nodes 4"}) {
+      const Outcome r = run_vmpray(std::string("tetra10 ") + machine + " --width 8 --height 8 -o out.png",
+                                   "stdout.txt", limit);
+      EXPECT_EQ(r.exit_code, 1) << limit << " " << machine << ": " << r.err;
+      EXPECT_EQ(r.err, message) << limit << " " << machine;
+      EXPECT_FALSE(fs::exists(dir_ / "out.png"));
+    }
+  }
+}
+
 // An image too large, at the size the scene's "resolution" set, is blamed
 // on that line of the scene, not on options that were not given.
 TEST_F(Checks, AnImageTooLargeFromTheSceneNamesItsLine) {

@@ -136,7 +136,7 @@ TEST(Generators, GearsAndTreeCountsFollowSpdFormulas) {
 TEST(Generators, SceneNameIsTheSpec) { EXPECT_EQ(generate_scene("tetra:2").name, "tetra:2"); }
 
 TEST(Generators, BadSpecsNameTheSpec) {
-  for (const char* spec : {"cube", "tetra:0", "tetra:11", "tetra:x", "tetra:3:t0", "tetra:3:q", "tetra9:3",
+  for (const char* spec : {"cube", "tetra:0", "tetra:12", "tetra:x", "tetra:3:t0", "tetra:3:q", "tetra9:3",
                            "mount:8", "rings:2:t1:t2", "", "balls:2:t999"}) {
     try {
       generate_scene(spec);
