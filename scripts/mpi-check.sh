@@ -28,8 +28,10 @@ done
 # CPU of a waiting rank: rank 1 waits for its pages while rank 0 reads and
 # builds the scene, then renders a tiny frame. A rank that only waits must
 # sleep: its CPU time (user + system, its start, its pages and its pixels
-# included) at most a third of its wall time (a rank that spun while
-# waiting would use about as much CPU as wall time).
+# included) at most half its wall time (a rank that spun while waiting
+# would use about as much CPU as wall time). Quiet, it uses a quarter; with
+# another program busy on the cores up to a third, as MPI's own progress
+# spins through a page transfer that a slowed rank 0 stretches.
 # The run's whole output is kept, and shown if it fails or lacks a time.
 if ! timeout -k 10 300 mpirun -np 2 --oversubscribe --mca btl self,vader \
   sh -c 'exec /usr/bin/time -f "rank $OMPI_COMM_WORLD_RANK: %e s wall, %U s user, %S s system" "$0" "$@"' \
@@ -50,7 +52,7 @@ for line in text.splitlines():
 if set(ranks) != {0, 1}:
     sys.exit(text + "mpi-check: expected the times of ranks 0 and 1, got " + repr(sorted(ranks)))
 (wall0, cpu0), (wall1, cpu1) = ranks[0], ranks[1]
-if cpu1 > wall1 / 3:
+if cpu1 > wall1 / 2:
     sys.exit(f"mpi-check: the waiting rank used {cpu1:.2f} s of CPU in {wall1:.2f} s, rank 0 {cpu0:.2f} s: it did not sleep")
 print(f"mpi-check: the waiting rank used {cpu1:.2f} s of CPU in {wall1:.2f} s (rank 0: {cpu0:.2f} s)")
 CHECK
