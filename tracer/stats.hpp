@@ -13,7 +13,7 @@ struct RayStats {
   std::uint64_t shadow = 0;
   std::uint64_t reflected = 0;
   std::uint64_t refracted = 0;
-  std::uint64_t box_tests = 0;      // BVH child boxes tested, or grid cells visited
+  std::uint64_t box_tests = 0;      // BVH child boxes tested, or grid cells read (not those skipped as empty)
   std::uint64_t prim_tests = 0;     // ray-primitive intersection tests
   std::uint64_t record_reads = 0;   // records (nodes, cells, primitives...) read from pages
   std::uint64_t page_calls = 0;     // PageSource::page() calls (reads outside the last page)
