@@ -11,8 +11,8 @@ namespace nodes {
 
 namespace {
 
-constexpr std::chrono::microseconds shortest_poll{4};
-constexpr std::size_t poll_levels = 9;  // 4 us .. 1024 us
+constexpr std::chrono::microseconds shortest_poll{1};
+constexpr std::size_t poll_levels = 11;  // 1 us .. 1024 us
 // A frame is posted once it holds this much: a message under the eager
 // limit of MPI's shared-memory transport (4 KB in Open MPI) is delivered
 // whole by the send; a larger one waits, after the receiver matches it,
@@ -22,6 +22,7 @@ constexpr std::size_t poll_levels = 9;  // 4 us .. 1024 us
 constexpr std::size_t frame_bytes = 3 * 1024;
 constexpr std::size_t gathered_frame_bytes = 32 * 1024;
 constexpr std::chrono::microseconds hot_window{1000};  // since the last activity
+constexpr int reply_rounds = 8;  // yields to let what arrived answer before posting
 
 }  // namespace
 
@@ -102,7 +103,10 @@ void Bridge::carry() {
     bool active = receive_all();
     if (stopping_) continue;
     try {
-      active = deliver_staged() || active;
+      if (deliver_staged()) {
+        active = true;
+        pass_replies();
+      }
     } catch (const csp::Poisoned&) {
       stop();
       continue;
@@ -155,6 +159,20 @@ void Bridge::gather() {
       deliver_staged();
     }
     take_ready();
+  }
+}
+
+// Where messages are dear, what was just delivered runs before the bridge
+// posts: the high-priority processes it made ready (routers, page servers,
+// and those they wake in turn), for a few rounds at most, and what they send
+// is taken, so that a request's reply leaves now, with the credits it owes,
+// and not a gathering window later. The pixel computers do not run first.
+void Bridge::pass_replies() {
+  if (!dear()) return;
+  for (int round = 0; round < reply_rounds; ++round) {
+    csp::yield();
+    take_ready();
+    if (!csp::yield_requested()) return;
   }
 }
 

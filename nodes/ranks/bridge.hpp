@@ -7,12 +7,12 @@
 // and K in the receiver's input, held by credits; the bridge blocks on
 // nothing but its one ALT and never waits inside the transport, so the
 // channel dependency graph is the unsplit machine's and stays acyclic.
-// Credits owed go with the next frame to their rank, or alone a round after
-// half of K are owed, or when the bridge goes quiet; where messages are dear,
-// a wake gathers its thread's pass into one frame. Polling backs off from 4 us to
-// 1 ms when all is quiet. At the end, a bridge that sees its network shut down,
-// or `end` from a peer, sends `end` (after `abort` with the line of a local
-// failure) and drains until every peer's `end` has come.
+// Credits owed go with the next frame to their rank, a round after half of
+// K are owed, or when the bridge goes quiet; where messages are dear, a wake
+// gathers its thread's pass into one frame, and the replies to what arrived
+// leave after one pass. Polling backs off from 1 us to 1 ms when all is
+// quiet. At the end (its network shut down, or `end` from a peer) it sends
+// `end`, after `abort` with a local failure's line, and drains till all end.
 #pragma once
 
 #include <atomic>
@@ -100,6 +100,7 @@ class Bridge {
   bool take(std::size_t guard);
   void take_ready();
   void gather();
+  void pass_replies();
   bool dear() const;  // messages cost enough to gather
   void take_outgoing(Outgoing& out);
   void queue_credits(bool all);
@@ -130,7 +131,7 @@ class Bridge {
   std::size_t level_ = 0;                    // the timeout guard enabled
   std::uint64_t unacknowledged_ = 0;         // packets sent whose credits have not come back
   std::chrono::steady_clock::time_point last_active_{};
-  std::vector<std::size_t> timeout_guards_;  // 4 us, 8 us, ... 1 ms
+  std::vector<std::size_t> timeout_guards_;  // 1 us, 2 us, ... 1 ms
   Gathering gathering_{};
   double post_cost_ = 0;  // nanoseconds a message takes to post, a running average
 };

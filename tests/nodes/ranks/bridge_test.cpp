@@ -14,7 +14,8 @@
 // flight, on one rank, on all at once or from outside the runtimes, ends
 // every rank with no exception, no failure noted and no send pending. A
 // watchdog bounds each run's wall time, so a hang fails instead of stalling.
-// And the packets a rank sends in one pass of its thread leave together.
+// And the packets a rank sends in one pass of its thread leave together,
+// while the answers to what arrives leave at once, without the gathering.
 //
 // A seed fixes the topology, the ranks, K, the threads, the traffic, the
 // pauses, the delays each endpoint draws and whether the bridges gather;
@@ -671,6 +672,54 @@ TEST(Bridge, ACreditRidesWithTheAnswerToItsPacket) {
   ASSERT_EQ(m.run("ping-pong"), "");
   EXPECT_GE(m.world().ledger.frames_with_packets(1), exchanges - 1);
   EXPECT_LT(m.world().ledger.frames_of_credits(1), exchanges / 4);
+}
+
+// As above, but the answering rank gathers for a minute, and a process of
+// low priority on its thread is always ready, so that a gathering bridge
+// would wait out its whole window for every answer (and the run its
+// watchdog). The bridge that delivers a question lets the answer be made
+// first and posts it at once: the 50 exchanges end.
+TEST(Bridge, AnAnswerLeavesWithoutWaitingForTheGatheringWindow) {
+  constexpr std::uint64_t exchanges = 50;
+  Case c;
+  c.topology = topology::Topology::ring(2);
+  c.capacity = 2;
+  c.packets = {{0, exchanges}, {exchanges, 0}};
+  c.send.assign(2, Pauses{});
+  c.receive.assign(2, Pauses{});
+  c.delays.assign(2, Delays{});
+  Machine m(c, 1);
+  Rank& asking = m.rank(0);
+  Rank& answering = m.rank(1);
+  answering.bridge.set_gathering({microseconds(60'000'000), std::chrono::nanoseconds(0)});
+  spawn_checked(
+      asking, "ask", asking.net.thread_of(0),
+      [&m, &asking, out = asking.net.injector(0), in = asking.net.port(0)]() mutable {
+        for (std::uint64_t k = 0; k < exchanges; ++k) {
+          out.write(make_packet(0, 1, k));
+          if (in.read().id != k) throw std::logic_error("an answer out of turn");
+        }
+        m.world().remaining = 0;
+        asking.net.shutdown();
+      },
+      csp::Priority::high);
+  spawn_checked(
+      answering, "answer", answering.net.thread_of(1),
+      [out = answering.net.injector(1), in = answering.net.port(1)]() mutable {
+        for (std::uint64_t k = 0;; ++k) {
+          if (in.read().id != k) throw std::logic_error("a question out of turn");
+          out.write(make_packet(1, 0, k));
+        }
+      },
+      csp::Priority::high);
+  spawn_checked(
+      answering, "busy", answering.net.thread_of(1),
+      [&answering] {
+        while (!answering.net.shut_down()) csp::yield();
+      },
+      csp::Priority::low);
+  ASSERT_EQ(m.run("answers under a long gathering window"), "");
+  EXPECT_GE(m.world().ledger.frames_with_packets(1), exchanges);
 }
 
 }  // namespace
