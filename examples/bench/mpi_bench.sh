@@ -9,8 +9,10 @@
 # excluded, the same measure on every row), the ratio of medians to one
 # process on 2 threads, and what crossed MPI: packets, their bytes, and the
 # MPI messages that carried them (the ranks' bridges only; packets between
-# threads of one process are not MPI traffic). Every run's image is compared
-# with the one-process image of its round; a difference stops the bench.
+# threads of one process are not MPI traffic). After each block a line gives
+# TCP's median over shared memory's for the same ranks, and MPI messages a
+# packet for each. Every run's image is compared with the one-process image
+# of its round; a difference stops the bench.
 #
 # usage: examples/bench/mpi_bench.sh [BUILD_DIR] [REPEAT] [SIZE]
 #        (defaults: build/release 5 512)
@@ -60,6 +62,7 @@ for scene in teapot rings4; do
       done
     done
     base=""
+    declare -A medians=() per_packet=()
     for c in "${configs[@]}"; do
       read -r ranks threads btl <<<"$c"
       sorted=$(tr ' ' '\n' <<<"${times[$c]}" | sed '/^$/d' | sort -g)
@@ -72,7 +75,15 @@ for scene in teapot rings4; do
       printf '%-8s %-12s %-22s %10.3f %10.3f %8.2f %12s %14s %10s\n' "$scene" "$topology" "$label" "$median" "$least" \
         "$(awk -v a="$median" -v b="$base" 'BEGIN { print a / b }')" "$(over_mpi packets_sent "$out")" \
         "$(over_mpi bytes_sent "$out")" "$(over_mpi messages_sent "$out")"
+      medians[$c]=$median
+      [[ $btl != none ]] && per_packet[$c]=$(awk -v m="$(over_mpi messages_sent "$out")" \
+        -v p="$(over_mpi packets_sent "$out")" 'BEGIN { printf "%.3f", (p > 0 ? m / p : 0) }')
     done
-    unset times
+    for ranks in 2 4; do
+      printf '%-8s %-12s %d ranks: TCP over shared memory %.2fx; MPI messages a packet %s shared memory, %s TCP\n' \
+        "$scene" "$topology" "$ranks" "$(awk -v a="${medians[$ranks 1 tcp]}" -v b="${medians[$ranks 1 vader]}" 'BEGIN { print a / b }')" \
+        "${per_packet[$ranks 1 vader]}" "${per_packet[$ranks 1 tcp]}"
+    done
+    unset times medians per_packet
   done
 done
