@@ -96,7 +96,8 @@ int run(const app::Options& o, const std::vector<std::string>& command_line, nod
     if (ranks) nodes::abandon_machine(*ranks, e.what());  // they wait for their pages
     throw;
   }
-  app::RenderResult result = o.single ? app::render_single(o, scene) : app::render_machine(o, scene, ranks);
+  app::RenderResult result =
+      o.single ? app::render_single(o, std::move(scene)) : app::render_machine(o, std::move(scene), ranks);
   result.report.load_seconds = load_seconds;
   result.report.version = VMPRAY_VERSION;
   result.report.command_line = command_line;

@@ -8,6 +8,11 @@
 #include <cstring>
 #include <limits>
 #include <span>
+#include <type_traits>
+
+#ifdef __GLIBC__
+#include <malloc.h>
+#endif
 
 #include "tracer/bvh.hpp"
 #include "tracer/grid.hpp"
@@ -67,10 +72,53 @@ void add_polygon(Flattened& f, const std::vector<Vec3d>& v, const std::vector<Ve
 // Objects flattened in chunks of this many, a chunk on one of the build's
 // threads; the chunks join in order, so the result is the one-thread one.
 constexpr std::size_t objects_per_chunk = 4096;
+constexpr std::size_t chunks_per_return = 16;  // of a scene consumed (malloc_trim scans the heap)
 
-void flatten_range(const Scene& scene, std::size_t begin, std::size_t end, Flattened& f) {
+// The freed vertex arrays go back to the system, not only to the heap's
+// free lists: the build's large arrays are mapped afresh and would not
+// reuse them, so they would still count in the peak.
+void return_freed_memory() {
+#ifdef __GLIBC__
+  malloc_trim(0);
+#endif
+}
+
+// Frees an object's vertex (and normal) arrays once flattened. Its kind
+// stays, so the scene's count of polygons stays right.
+void release_geometry(Object& o) {
+  if (auto* p = std::get_if<Polygon>(&o.shape)) {
+    std::vector<Vec3d>().swap(p->vertices);
+  } else if (auto* pp = std::get_if<Patch>(&o.shape)) {
+    std::vector<Vec3d>().swap(pp->vertices);
+    std::vector<Vec3d>().swap(pp->normals);
+  }
+}
+
+// Room for every primitive the scene's objects can make (a polygon of n
+// vertices n - 2 triangles, fewer only if degenerate), so that the arrays
+// are never moved while they grow, which would hold two copies at once.
+void reserve_for(const Scene& scene, Flattened& f) {
+  std::size_t prims = 0, normals = 0;
+  for (const Object& o : scene.objects) {
+    if (const auto* p = std::get_if<Polygon>(&o.shape)) {
+      prims += p->vertices.size() - 2;
+    } else if (const auto* pp = std::get_if<Patch>(&o.shape)) {
+      prims += pp->vertices.size() - 2;
+      normals += pp->vertices.size() - 2;
+    } else {
+      ++prims;
+    }
+  }
+  f.prims.reserve(prims);
+  f.bounds.reserve(prims);
+  f.normals.reserve(normals);
+}
+
+// SceneT: const Scene, or Scene, whose objects' geometry is freed as read.
+template <class SceneT>
+void flatten_range(SceneT& scene, std::size_t begin, std::size_t end, Flattened& f) {
   for (auto i = static_cast<std::uint32_t>(begin); i < end; ++i) {
-    const Object& o = scene.objects[i];
+    auto& o = scene.objects[i];
     PrimRecord r{};
     r.material = o.material;
     r.object = i;
@@ -93,27 +141,40 @@ void flatten_range(const Scene& scene, std::size_t begin, std::size_t end, Flatt
     } else if (const auto* pp = std::get_if<Patch>(&o.shape)) {
       add_polygon(f, pp->vertices, &pp->normals, o.material, i);
     }
+    if constexpr (!std::is_const_v<SceneT>) release_geometry(o);
   }
 }
 
-Flattened flatten(const Scene& scene, unsigned threads) {
+template <class SceneT>
+Flattened flatten(SceneT& scene, unsigned threads) {
   const std::size_t n = scene.objects.size();
   const std::size_t chunks = (n + objects_per_chunk - 1) / objects_per_chunk;
+  // A scene consumed gives back what it freed every few chunks, so that its
+  // geometry shrinks as the primitives grow.
+  const auto chunk_done = [](std::size_t c) {
+    if (!std::is_const_v<SceneT> && c % chunks_per_return == chunks_per_return - 1) return_freed_memory();
+  };
   Flattened f;
   if (threads <= 1 || chunks <= 1) {
-    flatten_range(scene, 0, n, f);
+    reserve_for(scene, f);
+    for (std::size_t c = 0; c < chunks; ++c) {
+      flatten_range(scene, c * objects_per_chunk, std::min(n, (c + 1) * objects_per_chunk), f);
+      chunk_done(c);
+    }
     return f;
   }
   std::vector<Flattened> parts(chunks);
   parallel_pieces(threads, chunks, [&](std::size_t c) {
     flatten_range(scene, c * objects_per_chunk, std::min(n, (c + 1) * objects_per_chunk), parts[c]);
+    chunk_done(c);
   });
   std::size_t prims = 0, normals = 0;
   for (const Flattened& p : parts) prims += p.prims.size(), normals += p.normals.size();
   f.prims.reserve(prims);
   f.bounds.reserve(prims);
   f.normals.reserve(normals);
-  for (Flattened& p : parts) {
+  for (std::size_t c = 0; c < chunks; ++c) {
+    Flattened& p = parts[c];
     // A smooth triangle's aux indexes the normals, which now follow those of the chunks before.
     const auto offset = static_cast<std::uint32_t>(f.normals.size());
     for (PrimRecord& r : p.prims)
@@ -122,6 +183,7 @@ Flattened flatten(const Scene& scene, unsigned threads) {
     f.bounds.insert(f.bounds.end(), p.bounds.begin(), p.bounds.end());
     f.normals.insert(f.normals.end(), p.normals.begin(), p.normals.end());
     p = Flattened{};
+    chunk_done(c);
   }
   return f;
 }
@@ -239,7 +301,13 @@ std::vector<MaterialRecord> material_records(const Scene& scene) {
   return out;
 }
 
-void fill_header(DatabaseHeader& h, const Scene& scene, const Flattened& f,
+// What the header counts of a scene's objects, taken before they are flattened.
+struct ObjectCounts {
+  std::size_t polygons = 0;
+  std::size_t objects = 0;
+};
+
+void fill_header(DatabaseHeader& h, const Scene& scene, ObjectCounts counts, const Flattened& f,
                  const BuildOptions& opt) {
   h.scene_name = scene.name;
   h.camera = scene.camera;
@@ -253,8 +321,8 @@ void fill_header(DatabaseHeader& h, const Scene& scene, const Flattened& f,
   for (const Box3f& b : f.bounds) h.bounds.extend(b);
   const float diag = h.bounds.empty() ? 1.0f : length(h.bounds.extent());
   h.epsilon = std::max(diag * 2e-5f, 1e-6f);
-  h.polygon_count = scene.polygon_count();
-  h.object_count = scene.objects.size();
+  h.polygon_count = counts.polygons;
+  h.object_count = counts.objects;
   h.primitive_count = f.prims.size();
 }
 
@@ -266,16 +334,44 @@ void validate_page_size(std::int64_t page_size) {
                         " is not a power of two from 256 to 65536");
 }
 
-Database build_database(const Scene& scene, const BuildOptions& opt) {
+namespace {
+
+void check_request(const Scene& scene, const BuildOptions& opt) {
   validate_page_size(opt.page_size);
   if (scene.camera.width < 1 || scene.camera.height < 1)
     throw std::invalid_argument("image size must be at least 1x1");
-  Database db;
-  auto t0 = Clock::now();
+}
+
+Database build_flattened(const Scene& scene, ObjectCounts counts, Flattened f, const BuildOptions& opt,
+                         Clock::time_point t0);
+
+}  // namespace
+
+Database build_database(const Scene& scene, const BuildOptions& opt) {
+  check_request(scene, opt);
+  const auto t0 = Clock::now();
+  const ObjectCounts counts{scene.polygon_count(), scene.objects.size()};
+  return build_flattened(scene, counts, flatten(scene, opt.threads), opt, t0);
+}
+
+Database build_database(Scene&& scene, const BuildOptions& opt) {
+  check_request(scene, opt);
+  const auto t0 = Clock::now();
+  const ObjectCounts counts{scene.polygon_count(), scene.objects.size()};
   Flattened f = flatten(scene, opt.threads);
+  BigVector<Object>().swap(scene.objects);
+  return_freed_memory();
+  return build_flattened(scene, counts, std::move(f), opt, t0);
+}
+
+namespace {
+
+Database build_flattened(const Scene& scene, ObjectCounts counts, Flattened f, const BuildOptions& opt,
+                         Clock::time_point t0) {
+  Database db;
   if (f.prims.size() >= std::numeric_limits<std::uint32_t>::max())
     throw DatabaseError("scene too large: more than 2^32 primitives");
-  fill_header(db.header, scene, f, opt);
+  fill_header(db.header, scene, counts, f, opt);
   db.stats.triangulate_seconds = seconds_since(t0);
 
   t0 = Clock::now();
@@ -324,5 +420,7 @@ Database build_database(const Scene& scene, const BuildOptions& opt) {
   db.stats.pack_seconds = seconds_since(t0);
   return db;
 }
+
+}  // namespace
 
 }  // namespace tracer

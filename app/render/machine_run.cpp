@@ -88,16 +88,18 @@ void note_threads_lowered(unsigned asked, const nodes::MachineReport& r) {
 
 }  // namespace
 
-RenderResult render_machine(const Options& o, const tracer::Scene& scene, nodes::Transport* ranks) {
+RenderResult render_machine(const Options& o, tracer::Scene scene, nodes::Transport* ranks) {
+  const int width = scene.camera.width, height = scene.camera.height;
   tracer::Database db;
   RunReport report;
   try {
     db = in_phase("building the database", !o.quiet && stderr_is_terminal(), [&] {
-      return naming_memory_shortage("building the database", [&] { return build_database(scene, build_options(o)); });
+      return naming_memory_shortage("building the database",
+                                    [&] { return build_database(std::move(scene), build_options(o)); });
     });
     // Before the machine is built: a complete graph of thousands of nodes would
     // take minutes to set up before running out of memory.
-    check_machine_memory(o, scene.camera.width, scene.camera.height, db.header.page_count, memory_limit());
+    check_machine_memory(o, width, height, db.header.page_count, memory_limit());
     report = describe_run(o, db);
   } catch (const std::exception& e) {
     if (ranks) nodes::abandon_machine(*ranks, e.what());  // they wait for their pages

@@ -24,6 +24,7 @@ std::string with_hint(const nodes::ResourceError& error, const std::string& fewe
 // memory or threads comes with its hint. With `ranks`, this process is rank 0
 // of a machine split over them (nodes::run_machine_rank); every other rank
 // runs nodes::run_machine_rank with machine_options(options) meanwhile.
-RenderResult render_machine(const Options& options, const tracer::Scene& scene, nodes::Transport* ranks = nullptr);
+// The scene is consumed by the build (tracer::build_database).
+RenderResult render_machine(const Options& options, tracer::Scene scene, nodes::Transport* ranks = nullptr);
 
 }  // namespace app

@@ -34,20 +34,21 @@ RunReport describe_run(const Options& o, const tracer::Database& db) {
   return r;
 }
 
-RenderResult render_single(const Options& o, const tracer::Scene& scene) {
+RenderResult render_single(const Options& o, tracer::Scene scene) {
+  const int w = scene.camera.width, h = scene.camera.height;
   const tracer::Database db = in_phase("building the database", !o.quiet && stderr_is_terminal(), [&] {
-    return naming_memory_shortage("building the database", [&] { return build_database(scene, build_options(o)); });
+    return naming_memory_shortage("building the database",
+                                  [&] { return build_database(std::move(scene), build_options(o)); });
   });
   RunReport report = describe_run(o, db);
   const tracer::TraceOptions trace{.max_depth = o.max_depth,
                                    .spd_procedure = o.spd_procedure,
                                    .shadow_rays_to_all_lights = o.shadow_rays_all};
-  const int w = scene.camera.width, h = scene.camera.height;
   ProgressBar bar(std::uint64_t(w) * h, "pixels", !o.quiet && stderr_is_terminal());
   const auto t0 = std::chrono::steady_clock::now();
   // Rows are what the threads share out: more threads than rows would only wait.
   const unsigned threads = std::min<unsigned>(o.machine.threads.count == 0 ? usable_cpus() : o.machine.threads.count,
-                                              unsigned(scene.camera.height));
+                                              unsigned(h));
   report.render_threads = threads;
   std::vector<tracer::Color> pixels =
       tracer::render_frame(db, trace, report.rays, threads, [&](int rows) { bar.update(std::uint64_t(rows) * w); });

@@ -16,7 +16,8 @@ struct RenderResult {
 };
 
 // Throws tracer::DatabaseError or std::runtime_error (one line) on bad input.
-RenderResult render_single(const Options& options, const tracer::Scene& scene);
+// The scene is consumed by the build (tracer::build_database).
+RenderResult render_single(const Options& options, tracer::Scene scene);
 
 // The report fields that come from the scene, the options and the database.
 RunReport describe_run(const Options& options, const tracer::Database& db);

@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <cstdlib>
 #include <cstring>
+#include <string>
 
 #include "test_scenes.hpp"
 #include "tracer/generators.hpp"
@@ -192,6 +193,49 @@ TEST(Database, FlatteningInChunksOnThreadsGivesTheSamePages) {
       const Database many = build_database(scene, {.accel = accel, .threads = threads});
       EXPECT_TRUE(one.pages == many.pages) << threads << " threads, accel " << int(accel);
       EXPECT_EQ(one.header.primitive_count, many.header.primitive_count);
+    }
+  }
+}
+
+// A scene the build consumes (build_database(Scene&&), as the command line
+// builds) gives the pages and counts of the scene kept, on any thread count;
+// it keeps its camera, lights and materials, and its objects are gone. The
+// scene has polygons that make fewer triangles than their vertices allow
+// (collinear first corners) and a concave one, patches, spheres and cones,
+// in more chunks than the build gives memory back after.
+TEST(Database, AConsumedSceneGivesThePagesOfTheSceneKept) {
+  Scene scene = testing::showcase_scene(8);
+  for (int i = 0; i < 80000; ++i) {
+    const double x = (i % 300) * 0.02 - 3, y = (i / 300) * 0.02 - 3;
+    switch (i % 5) {
+      case 0: scene.objects.push_back({Polygon{{{x, y, 0}, {x + 0.01, y, 0}, {x + 0.02, y, 0}, {x, y + 0.01, 0}}}, 0}); break;
+      case 1:
+        scene.objects.push_back(
+            {Polygon{{{x, y, 0.1}, {x + 0.02, y, 0.1}, {x + 0.01, y + 0.005, 0.1}, {x + 0.01, y + 0.02, 0.1}}}, 1});
+        break;
+      case 2: {
+        const Vec3d n{0.1, 0, 1};
+        scene.objects.push_back({Patch{{{x, y, 0.2}, {x + 0.015, y, 0.2}, {x, y + 0.015, 0.21}}, {n, n, n}}, 2});
+        break;
+      }
+      case 3: scene.objects.push_back({Sphere{{x, y, 0.3}, 0.005}, 3}); break;
+      default: scene.objects.push_back({Cone{{x, y, 0.4}, 0.005, {x, y, 0.45}, 0.002}, 0}); break;
+    }
+  }
+  for (const Accel accel : {Accel::bvh, Accel::grid}) {
+    const Database kept = build_database(scene, {.accel = accel});
+    for (unsigned threads : {1u, 2u, 3u}) {
+      SCOPED_TRACE(std::to_string(threads) + " threads, accel " + std::to_string(int(accel)));
+      Scene consumed = scene;
+      const Database db = build_database(std::move(consumed), {.accel = accel, .threads = threads});
+      EXPECT_TRUE(db.pages == kept.pages);
+      EXPECT_EQ(db.header.primitive_count, kept.header.primitive_count);
+      EXPECT_EQ(db.header.polygon_count, kept.header.polygon_count);
+      EXPECT_EQ(db.header.object_count, scene.objects.size());
+      EXPECT_TRUE(consumed.objects.empty());  // NOLINT(bugprone-use-after-move): what the build leaves
+      EXPECT_EQ(consumed.materials.size(), scene.materials.size());
+      EXPECT_EQ(consumed.lights.size(), scene.lights.size());
+      EXPECT_EQ(consumed.camera.width, scene.camera.width);
     }
   }
 }
