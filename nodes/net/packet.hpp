@@ -17,7 +17,9 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <memory>
 #include <span>
+#include <utility>
 #include <vector>
 
 #include <boost/container/small_vector.hpp>
@@ -32,6 +34,22 @@ inline constexpr std::size_t inline_payload = 16;
 class Payload : public boost::container::small_vector<std::byte, inline_payload> {
  public:
   using small_vector::small_vector;
+  Payload() = default;
+  Payload(const Payload&) = default;
+  Payload(Payload&&) noexcept = default;
+  Payload& operator=(const Payload&) = default;
+  // Boost leaves a vector whose buffer was moved out with no storage at
+  // all, not its inline one, so moving a short payload into it would
+  // allocate, inside a noexcept operator: a packet in every slot a packet
+  // was moved out of, and std::terminate where memory runs out. The
+  // payload is made afresh instead, which never allocates.
+  Payload& operator=(Payload&& other) noexcept {
+    if (this != &other) {
+      std::destroy_at(this);
+      std::construct_at(this, std::move(other));
+    }
+    return *this;
+  }
   operator std::span<const std::byte>() const { return {data(), size()}; }
 };
 

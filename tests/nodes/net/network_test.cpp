@@ -132,6 +132,26 @@ std::string name_kind(std::uint8_t kind) { return kind == kind_traffic ? "traffi
 
 }  // namespace
 
+// A packet moved out of a slot (a ring entry, a channel's buffer) leaves a
+// payload with no storage; a short payload moved in next must land in the
+// slot's own inline bytes, not in memory allocated for it (an allocation
+// there would be one per packet, inside a noexcept move, and end the
+// program where memory runs out).
+TEST(Packet, AShortPayloadMovedIntoAMovedFromSlotLiesInline) {
+  Packet slot;
+  slot.payload.assign(200, std::byte{7});
+  const Packet taken = std::move(slot);
+  ASSERT_EQ(taken.payload.size(), 200u);
+  Packet next;
+  next.payload.assign(inline_payload, std::byte{3});
+  slot = std::move(next);
+  ASSERT_EQ(slot.payload.size(), inline_payload);
+  EXPECT_TRUE(std::all_of(slot.payload.begin(), slot.payload.end(), [](std::byte b) { return b == std::byte{3}; }));
+  const auto* bytes = reinterpret_cast<const std::byte*>(&slot.payload);
+  EXPECT_TRUE(slot.payload.data() >= bytes && slot.payload.data() < bytes + sizeof(Payload))
+      << "the payload was allocated rather than kept inline";
+}
+
 TEST(Network, RandomStormWithBuffersOfOneDeliversEveryPacketOnce) {
   const std::vector<std::string> specs = {
       "hypercube:0", "hypercube:3", "hypercube:6", "hypercube:8", "mesh:1x1",  "mesh:3x5",
