@@ -72,7 +72,7 @@ void add_polygon(Flattened& f, const std::vector<Vec3d>& v, const std::vector<Ve
 // Objects flattened in chunks of this many, a chunk on one of the build's
 // threads; the chunks join in order, so the result is the one-thread one.
 constexpr std::size_t objects_per_chunk = 4096;
-constexpr std::size_t chunks_per_return = 16;  // of a scene consumed (malloc_trim scans the heap)
+constexpr std::size_t chunks_per_wave = 16;  // of a scene consumed, freed and given back after each
 
 // The freed vertex arrays go back to the system, not only to the heap's
 // free lists: the build's large arrays are mapped afresh and would not
@@ -114,11 +114,9 @@ void reserve_for(const Scene& scene, Flattened& f) {
   f.normals.reserve(normals);
 }
 
-// SceneT: const Scene, or Scene, whose objects' geometry is freed as read.
-template <class SceneT>
-void flatten_range(SceneT& scene, std::size_t begin, std::size_t end, Flattened& f) {
+void flatten_range(const Scene& scene, std::size_t begin, std::size_t end, Flattened& f) {
   for (auto i = static_cast<std::uint32_t>(begin); i < end; ++i) {
-    auto& o = scene.objects[i];
+    const Object& o = scene.objects[i];
     PrimRecord r{};
     r.material = o.material;
     r.object = i;
@@ -141,49 +139,50 @@ void flatten_range(SceneT& scene, std::size_t begin, std::size_t end, Flattened&
     } else if (const auto* pp = std::get_if<Patch>(&o.shape)) {
       add_polygon(f, pp->vertices, &pp->normals, o.material, i);
     }
-    if constexpr (!std::is_const_v<SceneT>) release_geometry(o);
   }
 }
 
+// Appends part's records to f; a smooth triangle's aux indexes the normals,
+// which now follow those of the parts before.
+void append(Flattened& f, Flattened& part) {
+  const auto offset = static_cast<std::uint32_t>(f.normals.size());
+  for (PrimRecord& r : part.prims)
+    if (r.kind == PrimKind::smooth_triangle) r.aux += offset;
+  f.prims.insert(f.prims.end(), part.prims.begin(), part.prims.end());
+  f.bounds.insert(f.bounds.end(), part.bounds.begin(), part.bounds.end());
+  f.normals.insert(f.normals.end(), part.normals.begin(), part.normals.end());
+  part = Flattened{};
+}
+
+// The objects in chunks, a wave of chunks at a time on the build's threads,
+// each wave's parts joined in order: the one-thread result. SceneT is a
+// const Scene, or a Scene consumed, whose objects' geometry the calling
+// thread frees after each wave (threads freeing into one heap at once wait
+// for each other) and gives back, so that it shrinks as the records grow.
 template <class SceneT>
 Flattened flatten(SceneT& scene, unsigned threads) {
+  constexpr bool consumed = !std::is_const_v<SceneT>;
   const std::size_t n = scene.objects.size();
   const std::size_t chunks = (n + objects_per_chunk - 1) / objects_per_chunk;
-  // A scene consumed gives back what it freed every few chunks, so that its
-  // geometry shrinks as the primitives grow.
-  const auto chunk_done = [](std::size_t c) {
-    if (!std::is_const_v<SceneT> && c % chunks_per_return == chunks_per_return - 1) return_freed_memory();
-  };
+  const std::size_t wave = consumed ? chunks_per_wave : std::max<std::size_t>(chunks, 1);
   Flattened f;
-  if (threads <= 1 || chunks <= 1) {
-    reserve_for(scene, f);
-    for (std::size_t c = 0; c < chunks; ++c) {
-      flatten_range(scene, c * objects_per_chunk, std::min(n, (c + 1) * objects_per_chunk), f);
-      chunk_done(c);
+  reserve_for(scene, f);
+  for (std::size_t first = 0; first < chunks; first += wave) {
+    const std::size_t last = std::min(chunks, first + wave);
+    const auto objects = [n](std::size_t c) { return std::min(n, c * objects_per_chunk); };
+    if (threads <= 1 || last - first <= 1) {
+      flatten_range(scene, objects(first), objects(last), f);
+    } else {
+      std::vector<Flattened> parts(last - first);
+      parallel_pieces(threads, parts.size(), [&](std::size_t k) {
+        flatten_range(scene, objects(first + k), objects(first + k + 1), parts[k]);
+      });
+      for (Flattened& part : parts) append(f, part);
     }
-    return f;
-  }
-  std::vector<Flattened> parts(chunks);
-  parallel_pieces(threads, chunks, [&](std::size_t c) {
-    flatten_range(scene, c * objects_per_chunk, std::min(n, (c + 1) * objects_per_chunk), parts[c]);
-    chunk_done(c);
-  });
-  std::size_t prims = 0, normals = 0;
-  for (const Flattened& p : parts) prims += p.prims.size(), normals += p.normals.size();
-  f.prims.reserve(prims);
-  f.bounds.reserve(prims);
-  f.normals.reserve(normals);
-  for (std::size_t c = 0; c < chunks; ++c) {
-    Flattened& p = parts[c];
-    // A smooth triangle's aux indexes the normals, which now follow those of the chunks before.
-    const auto offset = static_cast<std::uint32_t>(f.normals.size());
-    for (PrimRecord& r : p.prims)
-      if (r.kind == PrimKind::smooth_triangle) r.aux += offset;
-    f.prims.insert(f.prims.end(), p.prims.begin(), p.prims.end());
-    f.bounds.insert(f.bounds.end(), p.bounds.begin(), p.bounds.end());
-    f.normals.insert(f.normals.end(), p.normals.begin(), p.normals.end());
-    p = Flattened{};
-    chunk_done(c);
+    if constexpr (consumed) {
+      for (std::size_t i = objects(first); i < objects(last); ++i) release_geometry(scene.objects[i]);
+      return_freed_memory();
+    }
   }
   return f;
 }
