@@ -17,9 +17,7 @@
 
 #include <cstddef>
 #include <cstdint>
-#include <memory>
 #include <span>
-#include <utility>
 #include <vector>
 
 #include <boost/container/small_vector.hpp>
@@ -43,13 +41,7 @@ class Payload : public boost::container::small_vector<std::byte, inline_payload>
   // allocate, inside a noexcept operator: a packet in every slot a packet
   // was moved out of, and std::terminate where memory runs out. The
   // payload is made afresh instead, which never allocates.
-  Payload& operator=(Payload&& other) noexcept {
-    if (this != &other) {
-      std::destroy_at(this);
-      std::construct_at(this, std::move(other));
-    }
-    return *this;
-  }
+  Payload& operator=(Payload&& other) noexcept;  // packet.cpp
   operator std::span<const std::byte>() const { return {data(), size()}; }
 };
 
