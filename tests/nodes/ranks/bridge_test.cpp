@@ -631,14 +631,8 @@ TEST(Bridge, ThePacketsOfOnePassLeaveInOneMessage) {
   }
 }
 
-// Node 0 on rank 0 sends a packet to node 1 on rank 1 and waits for the
-// answer, 200 times; node 1 answers each at once. With K = 2 each packet
-// delivered makes half of K owed, so without a round's wait every credit
-// would leave alone before the answer it called for; with it, the credit
-// rides with the answer. (A slow machine may let a round end by the poll
-// interval first, so the test asks for most credits, not all, to ride.)
-TEST(Bridge, ACreditRidesWithTheAnswerToItsPacket) {
-  constexpr std::uint64_t exchanges = 200;
+// Two nodes on a ring split over two ranks, K = 2, `exchanges` packets each way.
+Case ping_pong_case(std::uint64_t exchanges) {
   Case c;
   c.topology = topology::Topology::ring(2);
   c.capacity = 2;
@@ -646,12 +640,18 @@ TEST(Bridge, ACreditRidesWithTheAnswerToItsPacket) {
   c.send.assign(2, Pauses{});
   c.receive.assign(2, Pauses{});
   c.delays.assign(2, Delays{});
-  Machine m(c, 1);
+  return c;
+}
+
+// Node 0 on rank 0 sends a packet to node 1 on rank 1 and waits for the
+// answer, `exchanges` times, then shuts its network down; node 1 answers
+// each at once.
+void spawn_ping_pong(Machine& m, std::uint64_t exchanges) {
   Rank& asking = m.rank(0);
   Rank& answering = m.rank(1);
   spawn_checked(
       asking, "ask", asking.net.thread_of(0),
-      [&m, &asking, out = asking.net.injector(0), in = asking.net.port(0)]() mutable {
+      [&m, &asking, exchanges, out = asking.net.injector(0), in = asking.net.port(0)]() mutable {
         for (std::uint64_t k = 0; k < exchanges; ++k) {
           out.write(make_packet(0, 1, k));
           if (in.read().id != k) throw std::logic_error("an answer out of turn");
@@ -669,49 +669,35 @@ TEST(Bridge, ACreditRidesWithTheAnswerToItsPacket) {
         }
       },
       csp::Priority::high);
+}
+
+// A ping-pong of 200 exchanges. With K = 2 each packet delivered makes half
+// of K owed, so without a round's wait every credit would leave alone
+// before the answer it called for; with it, the credit rides with the
+// answer. (A slow machine may let a round end by the poll interval first,
+// so the test asks for most credits, not all, to ride.)
+TEST(Bridge, ACreditRidesWithTheAnswerToItsPacket) {
+  constexpr std::uint64_t exchanges = 200;
+  const Case c = ping_pong_case(exchanges);
+  Machine m(c, 1);
+  spawn_ping_pong(m, exchanges);
   ASSERT_EQ(m.run("ping-pong"), "");
   EXPECT_GE(m.world().ledger.frames_with_packets(1), exchanges - 1);
   EXPECT_LT(m.world().ledger.frames_of_credits(1), exchanges / 4);
 }
 
-// As above, but the answering rank gathers for a minute, and a process of
-// low priority on its thread is always ready, so that a gathering bridge
-// would wait out its whole window for every answer (and the run its
-// watchdog). The bridge that delivers a question lets the answer be made
-// first and posts it at once: the 50 exchanges end.
+// A ping-pong of 50 exchanges where the answering rank gathers for a
+// minute, and a process of low priority on its thread is always ready, so
+// that a gathering bridge would wait out its whole window for every answer
+// (and the run its watchdog). The bridge that delivers a question lets the
+// answer be made first and posts it at once: the exchanges end.
 TEST(Bridge, AnAnswerLeavesWithoutWaitingForTheGatheringWindow) {
   constexpr std::uint64_t exchanges = 50;
-  Case c;
-  c.topology = topology::Topology::ring(2);
-  c.capacity = 2;
-  c.packets = {{0, exchanges}, {exchanges, 0}};
-  c.send.assign(2, Pauses{});
-  c.receive.assign(2, Pauses{});
-  c.delays.assign(2, Delays{});
+  const Case c = ping_pong_case(exchanges);
   Machine m(c, 1);
-  Rank& asking = m.rank(0);
   Rank& answering = m.rank(1);
   answering.bridge.set_gathering({microseconds(60'000'000), std::chrono::nanoseconds(0)});
-  spawn_checked(
-      asking, "ask", asking.net.thread_of(0),
-      [&m, &asking, out = asking.net.injector(0), in = asking.net.port(0)]() mutable {
-        for (std::uint64_t k = 0; k < exchanges; ++k) {
-          out.write(make_packet(0, 1, k));
-          if (in.read().id != k) throw std::logic_error("an answer out of turn");
-        }
-        m.world().remaining = 0;
-        asking.net.shutdown();
-      },
-      csp::Priority::high);
-  spawn_checked(
-      answering, "answer", answering.net.thread_of(1),
-      [out = answering.net.injector(1), in = answering.net.port(1)]() mutable {
-        for (std::uint64_t k = 0;; ++k) {
-          if (in.read().id != k) throw std::logic_error("a question out of turn");
-          out.write(make_packet(1, 0, k));
-        }
-      },
-      csp::Priority::high);
+  spawn_ping_pong(m, exchanges);
   spawn_checked(
       answering, "busy", answering.net.thread_of(1),
       [&answering] {
