@@ -87,7 +87,11 @@ fi
 [[ -s $scratch/run/teapot.png ]] || fail "the default render wrote no teapot.png"
 [[ $(head -c 8 "$scratch/run/teapot.png" | od -An -c | tr -d ' ') == '211PNG\r\n032\n' ]] || fail "teapot.png is not a PNG"
 if command -v python3 >/dev/null; then python3 "$source_dir/scripts/png-not-blank.py" "$scratch/run/teapot.png"; fi
-run "$vmpray" --help | grep -q '^Usage: vmpray' || fail "--help"
+# Read whole, then searched: grep -q would stop reading at the first line,
+# and the rest of the help, written into a closed pipe, would end vmpray by
+# SIGPIPE, which pipefail reports as a failure.
+help_text=$(run "$vmpray" --help) || fail "--help exits non-zero"
+grep -q '^Usage: vmpray' <<<"$help_text" || fail "--help"
 version_text=$(run "$vmpray" --version)
 [[ $(head -n 1 <<<"$version_text") == "vmpray $version" ]] || fail "--version says '$version_text', not vmpray $version"
 grep -q '^compiler: ' <<<"$version_text" || fail "--version names no compiler"
