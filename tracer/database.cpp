@@ -165,11 +165,11 @@ Flattened flatten(SceneT& scene, unsigned threads) {
   const std::size_t n = scene.objects.size();
   const std::size_t chunks = (n + objects_per_chunk - 1) / objects_per_chunk;
   const std::size_t wave = consumed ? chunks_per_wave : std::max<std::size_t>(chunks, 1);
+  const auto objects = [n](std::size_t c) { return std::min(n, c * objects_per_chunk); };  // before chunk c
   Flattened f;
   reserve_for(scene, f);
   for (std::size_t first = 0; first < chunks; first += wave) {
     const std::size_t last = std::min(chunks, first + wave);
-    const auto objects = [n](std::size_t c) { return std::min(n, c * objects_per_chunk); };
     if (threads <= 1 || last - first <= 1) {
       flatten_range(scene, objects(first), objects(last), f);
     } else {
@@ -325,45 +325,11 @@ void fill_header(DatabaseHeader& h, const Scene& scene, ObjectCounts counts, con
   h.primitive_count = f.prims.size();
 }
 
-}  // namespace
-
-void validate_page_size(std::int64_t page_size) {
-  if (page_size < 256 || page_size > 65536 || !std::has_single_bit(static_cast<std::uint64_t>(page_size)))
-    throw DatabaseError("page size " + std::to_string(page_size) +
-                        " is not a power of two from 256 to 65536");
-}
-
-namespace {
-
 void check_request(const Scene& scene, const BuildOptions& opt) {
   validate_page_size(opt.page_size);
   if (scene.camera.width < 1 || scene.camera.height < 1)
     throw std::invalid_argument("image size must be at least 1x1");
 }
-
-Database build_flattened(const Scene& scene, ObjectCounts counts, Flattened f, const BuildOptions& opt,
-                         Clock::time_point t0);
-
-}  // namespace
-
-Database build_database(const Scene& scene, const BuildOptions& opt) {
-  check_request(scene, opt);
-  const auto t0 = Clock::now();
-  const ObjectCounts counts{scene.polygon_count(), scene.objects.size()};
-  return build_flattened(scene, counts, flatten(scene, opt.threads), opt, t0);
-}
-
-Database build_database(Scene&& scene, const BuildOptions& opt) {
-  check_request(scene, opt);
-  const auto t0 = Clock::now();
-  const ObjectCounts counts{scene.polygon_count(), scene.objects.size()};
-  Flattened f = flatten(scene, opt.threads);
-  BigVector<Object>().swap(scene.objects);
-  return_freed_memory();
-  return build_flattened(scene, counts, std::move(f), opt, t0);
-}
-
-namespace {
 
 Database build_flattened(const Scene& scene, ObjectCounts counts, Flattened f, const BuildOptions& opt,
                          Clock::time_point t0) {
@@ -421,5 +387,28 @@ Database build_flattened(const Scene& scene, ObjectCounts counts, Flattened f, c
 }
 
 }  // namespace
+
+void validate_page_size(std::int64_t page_size) {
+  if (page_size < 256 || page_size > 65536 || !std::has_single_bit(static_cast<std::uint64_t>(page_size)))
+    throw DatabaseError("page size " + std::to_string(page_size) +
+                        " is not a power of two from 256 to 65536");
+}
+
+Database build_database(const Scene& scene, const BuildOptions& opt) {
+  check_request(scene, opt);
+  const auto t0 = Clock::now();
+  const ObjectCounts counts{scene.polygon_count(), scene.objects.size()};
+  return build_flattened(scene, counts, flatten(scene, opt.threads), opt, t0);
+}
+
+Database build_database(Scene&& scene, const BuildOptions& opt) {
+  check_request(scene, opt);
+  const auto t0 = Clock::now();
+  const ObjectCounts counts{scene.polygon_count(), scene.objects.size()};
+  Flattened f = flatten(scene, opt.threads);
+  BigVector<Object>().swap(scene.objects);
+  return_freed_memory();
+  return build_flattened(scene, counts, std::move(f), opt, t0);
+}
 
 }  // namespace tracer

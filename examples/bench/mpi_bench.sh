@@ -72,12 +72,12 @@ for scene in teapot rings4; do
       out="$work/$ranks-$btl-0.json"
       label="$ranks x $threads thread(s)"
       [[ $btl != none ]] && label+=" $btl"
+      packets=$(over_mpi packets_sent "$out") messages=$(over_mpi messages_sent "$out")
       printf '%-8s %-12s %-22s %10.3f %10.3f %8.2f %12s %14s %10s\n' "$scene" "$topology" "$label" "$median" "$least" \
-        "$(awk -v a="$median" -v b="$base" 'BEGIN { print a / b }')" "$(over_mpi packets_sent "$out")" \
-        "$(over_mpi bytes_sent "$out")" "$(over_mpi messages_sent "$out")"
+        "$(awk -v a="$median" -v b="$base" 'BEGIN { print a / b }')" "$packets" \
+        "$(over_mpi bytes_sent "$out")" "$messages"
       medians[$c]=$median
-      [[ $btl != none ]] && per_packet[$c]=$(awk -v m="$(over_mpi messages_sent "$out")" \
-        -v p="$(over_mpi packets_sent "$out")" 'BEGIN { printf "%.3f", (p > 0 ? m / p : 0) }')
+      per_packet[$c]=$(awk -v m="$messages" -v p="$packets" 'BEGIN { printf "%.3f", (p > 0 ? m / p : 0) }')
     done
     for ranks in 2 4; do
       printf '%-8s %-12s %d ranks: TCP over shared memory %.2fx; MPI messages a packet %s shared memory, %s TCP\n' \
