@@ -190,7 +190,7 @@ int bench_machine(const std::vector<std::string>& args) {
     tracer::BuildOptions build = {};
   };
   const std::vector<Line> variants{
-      {"  as above (affinity, hilbert, grain 16)", {}},
+      {"  as above (affinity, hilbert, grain 64)", {}},
       {"  BVH nodes in depth-first layout", {}, {.bvh_layout = tracer::BvhLayout::depth_first}},
       {"  prefetch 0 (ask when idle)",
        [](nodes::MachineOptions& o, const tracer::DatabaseHeader&) { o.farming.prefetch = 0; }},

@@ -47,7 +47,7 @@ namespace nodes {
 // own compact patch first: the fewest page misses and farming messages
 // (the paper: dynamic, scanline, grain 4, prefetch 0).
 struct Farming {
-  std::uint32_t grain = 16;      // items per tile (1..max_grain): balance vs farming traffic
+  std::uint32_t grain = 64;      // items per tile (1..max_grain): balance vs farming traffic
   std::uint16_t prefetch = 1;    // tiles a worker has asked for beyond the one it traces (..max_prefetch)
   Schedule schedule = Schedule::affinity;
   PixelOrder pixel_order = PixelOrder::hilbert;  // how items are numbered, so where a tile lies

@@ -118,7 +118,7 @@ TEST_F(MachineCli, DefaultMachineWritesImageAndJsonWithMachineFields) {
   EXPECT_TRUE(m.at("serial").is_null());
   EXPECT_EQ(m.at("schedule").get<std::string>(), "affinity");
   EXPECT_EQ(m.at("pixel_order").get<std::string>(), "hilbert");
-  EXPECT_EQ(m.at("grain").get<double>(), 16);
+  EXPECT_EQ(m.at("grain").get<double>(), 64);
   ASSERT_EQ(m.at("host_threads").size(), 2u);
   for (const Json& t : m.at("host_threads")) {
     EXPECT_GT(t.at("seconds").get<double>(), 0);
@@ -188,7 +188,7 @@ TEST_F(MachineCli, AffinityScheduleIsReportedWithItsSteals) {
 TEST_F(MachineCli, ThePapersFarmingIsReported) {
   const Outcome r = run(std::string(kSmall) + " --schedule dynamic --pixel-order scanline -o out.png --stats s.json");
   ASSERT_EQ(r.exit_code, 0) << r.err;
-  EXPECT_NE(r.out.find("dynamic schedule (grain 16) in scanline order"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("dynamic schedule (grain 64) in scanline order"), std::string::npos) << r.out;
   const Json j = Json::parse(read_file(dir_ / "s.json"));
   EXPECT_EQ(j.at("machine").at("schedule").get<std::string>(), "dynamic");
   EXPECT_EQ(j.at("machine").at("pixel_order").get<std::string>(), "scanline");

@@ -128,9 +128,10 @@ TEST(MemoryCheck, RefusesAMachineAboveTheLimitNamingTheOptions) {
   // The image counts too. Worked out from the sizes memory_check.cpp gives: 4096 nodes of 38 KiB (router, page
   // server, page mailbox) with a pixel computer of 7.5 KiB, a page table and the pixel computer's page stamps of
   // 4 bytes a page each; 4095 link queues of 640 bytes at each node; and the 512x512 image at 30 1/8 bytes a
-  // pixel (see the image's test below; the 4096 pixel computers' tiles of 16 pixels weigh less).
+  // pixel (see the image's test below), where the 4096 pixel computers' tiles of 64 pixels, with one more
+  // result on its way, hold 64 colours of 12 bytes more than the image's.
   constexpr std::uint64_t machine = 4096 * (38 * 1024 + 7680 + 2 * 4 * 661) + 4096ull * 4095 * 640;
-  constexpr std::uint64_t needed = machine + 512 * 512 * 30 + 512 * 512 / 8;
+  constexpr std::uint64_t needed = machine + 512 * 512 * 30 + 512 * 512 / 8 + 64 * 12;
   EXPECT_NO_THROW(app::check_machine_memory(o, 512, 512, 661, {needed}));
   EXPECT_THROW(app::check_machine_memory(o, 512, 512, 661, {needed - 1}), app::UsageError);
   EXPECT_NO_THROW(app::check_machine_memory(o, 16, 16, 661, {needed - 1}));
