@@ -100,12 +100,26 @@ class Builder {
     for (std::uint32_t i = 0; i < bounds.size(); ++i) out_.order[i] = i;
   }
 
+  // At most this many binary nodes hold references [begin, end): leaves of
+  // one reference at least, and two children to every inner node. Segments
+  // are reserved for it, so that they never move while they grow (which
+  // would leave the memory they moved out of to the build's peak).
+  static std::size_t node_bound(std::uint32_t begin, std::uint32_t end) { return 2 * std::size_t{end - begin}; }
+
   BvhBuild run() {
     out_.nodes.emplace_back();
     for (int lane = 0; lane < 4; ++lane) set_lane_box(out_.nodes[0], lane, Box3f{});
     if (bounds_.empty()) return std::move(out_);
-    segments_.emplace_back(1);
-    build(segments_[0], 0, 0, 0, static_cast<std::uint32_t>(bounds_.size()));
+    const auto n = static_cast<std::uint32_t>(bounds_.size());
+    segments_.emplace_back(1).reserve(node_bound(0, n));
+    if (n >= large_node_) scratch_.resize(n);
+    build(segments_[0], 0, 0, 0, n);
+    BigVector<std::uint32_t>().swap(scratch_);
+    // Four-wide nodes: at most one for each inner binary node, and an inner
+    // node has two children, so a tree of T nodes has (T - 1) / 2 of them.
+    std::size_t binary = 0;
+    for (const Segment& seg : segments_) binary += seg.size();
+    out_.nodes.reserve(1 + (binary - 1) / 2);
     const BinNode& root = segments_[0][0];
     if (root.count > 0) {  // one leaf: a root with a single used lane
       set_lane_box(out_.nodes[0], 0, root.box);
@@ -170,6 +184,7 @@ class Builder {
       left_segment = static_cast<std::uint32_t>(segments_.size());
       left_seg = &segments_.emplace_back(1);  // deque: earlier segments stay where they are
     }
+    left_seg->reserve(node_bound(begin, mid));
     const auto right = static_cast<std::uint32_t>(seg.size());
     seg.emplace_back();
     seg[index].left = make_ref(left_segment, 0);
@@ -284,7 +299,9 @@ class Builder {
     });
     for (std::uint32_t c = 0; c < chunks; ++c) lefts[c + 1] += lefts[c];
     const std::uint32_t left_total = lefts[chunks];
-    std::vector<std::uint32_t> moved(end - begin);
+    // The references move through [begin, end) of the scratch array, which
+    // no other node being partitioned at the same time overlaps.
+    std::uint32_t* const moved = scratch_.data() + begin;
     for_chunks(chunks, [&](std::uint32_t c) {
       const std::uint32_t first = begin + c * chunk_, last = chunk_end(first, end);
       std::uint32_t l = lefts[c], r = left_total + (first - begin) - lefts[c];
@@ -295,7 +312,7 @@ class Builder {
     });
     for_chunks(chunks, [&](std::uint32_t c) {
       const std::uint32_t first = c * chunk_, last = chunk_end(first, end - begin);
-      std::copy(moved.begin() + first, moved.begin() + last, out_.order.begin() + begin + first);
+      std::copy(moved + first, moved + last, out_.order.begin() + begin + first);
     });
     return begin + left_total;
   }
@@ -415,6 +432,7 @@ class Builder {
   ThreadBudget budget_;
   std::mutex segments_mutex_;     // guards segments_ while threads add to it
   std::deque<Segment> segments_;  // the binary tree; segments_[0][0] is its root
+  BigVector<std::uint32_t> scratch_;  // chunked_partition's, one slot a reference (large builds)
   BvhBuild out_;
 };
 

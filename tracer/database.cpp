@@ -72,7 +72,7 @@ void add_polygon(Flattened& f, const std::vector<Vec3d>& v, const std::vector<Ve
 // Objects flattened in chunks of this many, a chunk on one of the build's
 // threads; the chunks join in order, so the result is the one-thread one.
 constexpr std::size_t objects_per_chunk = 4096;
-constexpr std::size_t chunks_per_wave = 16;  // of a scene consumed, freed and given back after each
+constexpr std::size_t chunks_per_wave = 4;  // of a scene consumed, freed and given back after each
 
 // The freed vertex arrays go back to the system, not only to the heap's
 // free lists: the build's large arrays are mapped afresh and would not
@@ -81,17 +81,6 @@ void return_freed_memory() {
 #ifdef __GLIBC__
   malloc_trim(0);
 #endif
-}
-
-// Frees an object's vertex (and normal) arrays once flattened. Its kind
-// stays, so the scene's count of polygons stays right.
-void release_geometry(Object& o) {
-  if (auto* p = std::get_if<Polygon>(&o.shape)) {
-    std::vector<Vec3d>().swap(p->vertices);
-  } else if (auto* pp = std::get_if<Patch>(&o.shape)) {
-    std::vector<Vec3d>().swap(pp->vertices);
-    std::vector<Vec3d>().swap(pp->normals);
-  }
 }
 
 // Room for every primitive the scene's objects can make (a polygon of n
@@ -142,8 +131,8 @@ void flatten_range(const Scene& scene, std::size_t begin, std::size_t end, Flatt
   }
 }
 
-// Appends part's records to f; a smooth triangle's aux indexes the normals,
-// which now follow those of the parts before.
+// Appends part's records to f and frees them; a smooth triangle's aux
+// indexes the normals, which now follow those of the parts before.
 void append(Flattened& f, Flattened& part) {
   const auto offset = static_cast<std::uint32_t>(f.normals.size());
   for (PrimRecord& r : part.prims)
@@ -154,37 +143,72 @@ void append(Flattened& f, Flattened& part) {
   part = Flattened{};
 }
 
-// The objects in chunks, a wave of chunks at a time on the build's threads,
-// each wave's parts joined in order: the one-thread result. SceneT is a
-// const Scene, or a Scene consumed, whose objects' geometry the calling
-// thread frees after each wave (threads freeing into one heap at once wait
-// for each other) and gives back, so that it shrinks as the records grow.
-template <class SceneT>
-Flattened flatten(SceneT& scene, unsigned threads) {
-  constexpr bool consumed = !std::is_const_v<SceneT>;
+// Chunks [first, last) of the objects into parts[first..last), on the build's threads.
+void flatten_chunks(const Scene& scene, std::size_t first, std::size_t last, std::vector<Flattened>& parts,
+                    unsigned threads) {
   const std::size_t n = scene.objects.size();
-  const std::size_t chunks = (n + objects_per_chunk - 1) / objects_per_chunk;
-  const std::size_t wave = consumed ? chunks_per_wave : std::max<std::size_t>(chunks, 1);
   const auto objects = [n](std::size_t c) { return std::min(n, c * objects_per_chunk); };  // before chunk c
-  Flattened f;
-  reserve_for(scene, f);
-  for (std::size_t first = 0; first < chunks; first += wave) {
-    const std::size_t last = std::min(chunks, first + wave);
-    if (threads <= 1 || last - first <= 1) {
-      flatten_range(scene, objects(first), objects(last), f);
-    } else {
-      std::vector<Flattened> parts(last - first);
-      parallel_pieces(threads, parts.size(), [&](std::size_t k) {
-        flatten_range(scene, objects(first + k), objects(first + k + 1), parts[k]);
-      });
-      for (Flattened& part : parts) append(f, part);
-    }
-    if constexpr (consumed) {
-      for (std::size_t i = objects(first); i < objects(last); ++i) release_geometry(scene.objects[i]);
-      return_freed_memory();
-    }
+  parallel_pieces(threads, last - first, [&](std::size_t k) {
+    flatten_range(scene, objects(first + k), objects(first + k + 1), parts[first + k]);
+  });
+}
+
+// The parts joined in order into arrays of their exact size; each part is
+// freed once copied, and the freed memory given back every wave of parts,
+// so that the join holds little more than one copy.
+Flattened join(std::vector<Flattened>& parts) {
+  std::size_t prims = 0, normals = 0;
+  for (const Flattened& part : parts) {
+    prims += part.prims.size();
+    normals += part.normals.size();
   }
+  Flattened f;
+  f.prims.reserve(prims);
+  f.bounds.reserve(prims);
+  f.normals.reserve(normals);
+  for (std::size_t k = 0; k < parts.size(); ++k) {
+    append(f, parts[k]);
+    if ((k + 1) % chunks_per_wave == 0) return_freed_memory();
+  }
+  return_freed_memory();
   return f;
+}
+
+std::size_t chunk_count(const Scene& scene) {
+  return (scene.objects.size() + objects_per_chunk - 1) / objects_per_chunk;
+}
+
+// A scene kept: one pass on one thread, or all chunks at once and joined.
+Flattened flatten(const Scene& scene, unsigned threads) {
+  const std::size_t chunks = chunk_count(scene);
+  if (threads <= 1 || chunks <= 1) {
+    Flattened f;
+    reserve_for(scene, f);
+    flatten_range(scene, 0, scene.objects.size(), f);
+    return f;
+  }
+  std::vector<Flattened> parts(chunks);
+  flatten_chunks(scene, 0, chunks, parts, threads);
+  return join(parts);
+}
+
+// A scene consumed: its chunks a wave at a time from the last to the first,
+// and after each wave the wave's objects are destroyed and their memory,
+// the objects' storage past those left and the vertex arrays, given back.
+// So the scene shrinks as the records grow, and the peak is about the
+// larger of the two and one wave. The objects left are those of the chunks
+// still to flatten, which the build's threads read while the calling thread
+// alone frees (threads freeing into one heap at once wait for each other).
+Flattened flatten(Scene& scene, unsigned threads) {
+  std::vector<Flattened> parts(chunk_count(scene));
+  for (std::size_t last = parts.size(); last > 0;) {
+    const std::size_t first = last > chunks_per_wave ? last - chunks_per_wave : 0;
+    flatten_chunks(scene, first, last, parts, threads);
+    truncate_and_give_back(scene.objects, first * objects_per_chunk);
+    return_freed_memory();
+    last = first;
+  }
+  return join(parts);
 }
 
 // Appends sections of fixed-size records, each starting on a fresh page.
@@ -353,6 +377,7 @@ Database build_flattened(const Scene& scene, ObjectCounts counts, Flattened f, c
     BvhBuild bvh = build_bvh(refs, opt.bvh_max_leaf, {.threads = opt.threads});
     release(refs.bounds);
     release(refs.triangle);
+    return_freed_memory();  // the binary tree's, before the pages are made
     if (opt.bvh_layout == BvhLayout::treelet) lay_out_treelets(bvh, opt.page_size / sizeof(BvhNode));
     for (std::uint32_t& k : bvh.order) k = refs.prim[k];
     db.stats.bvh_references = refs.prim.size();

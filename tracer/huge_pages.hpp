@@ -6,10 +6,12 @@
 // touches some 300 MB of fresh memory. The advice is a hint: where huge
 // pages are off, or the call fails, the block is ordinary memory. Smaller
 // blocks come from std::allocator. Stateless: any two compare equal.
+// truncate_and_give_back lets a vector consumed from its back shrink.
 #pragma once
 
 #include <sys/mman.h>
 
+#include <algorithm>
 #include <cstddef>
 #include <cstdint>
 #include <memory>
@@ -62,5 +64,19 @@ struct HugePageAllocator {
 // A vector whose large storage is advised for huge pages.
 template <class T>
 using BigVector = std::vector<T, HugePageAllocator<T>>;
+
+// Destroys the elements of v from `count` on, and gives the whole pages of
+// storage past the elements left back to the system (madvise MADV_DONTNEED):
+// they hold no object, and read as zeros if the vector grows into them again.
+// So a vector consumed from its back shrinks in memory as it goes.
+template <class T>
+void truncate_and_give_back(BigVector<T>& v, std::size_t count) {
+  v.erase(v.begin() + static_cast<std::ptrdiff_t>(std::min(count, v.size())), v.end());
+  constexpr std::uintptr_t page = 4096;  // the smallest page: a larger one is whole pages of it
+  const auto used = reinterpret_cast<std::uintptr_t>(v.data() + v.size());
+  const auto end = reinterpret_cast<std::uintptr_t>(v.data() + v.capacity()) & ~(page - 1);
+  const std::uintptr_t begin = (used + page - 1) & ~(page - 1);
+  if (end > begin) ::madvise(reinterpret_cast<void*>(begin), end - begin, MADV_DONTNEED);
+}
 
 }  // namespace tracer

@@ -1,7 +1,8 @@
 // HugePageAllocator and advise_huge_pages: a large block is 2 MiB-aligned
 // and its mapping carries the kernel's huge-page advice (the "hg" flag in
 // /proc/self/smaps), a small one is ordinary, contents survive growth across
-// the threshold, and advising a range marks only the whole 2 MiB pages in it.
+// the threshold, advising a range marks only the whole 2 MiB pages in it, and
+// a vector truncated gives back the whole pages past the elements it keeps.
 #include "tracer/huge_pages.hpp"
 
 #include <gtest/gtest.h>
@@ -12,6 +13,7 @@
 #include <fstream>
 #include <sstream>
 #include <string>
+#include <vector>
 
 namespace tracer {
 namespace {
@@ -85,6 +87,32 @@ TEST(HugePages, AdvisingARangeMarksOnlyItsWholeHugePages) {
   EXPECT_NE(vm_flags_of(p).find(" hg"), std::string::npos);
   EXPECT_EQ(vm_flags_of(p + kHugePage).find(" hg"), std::string::npos);
   ::munmap(map, bytes);
+}
+
+TEST(HugePages, TruncatingGivesBackTheWholePagesPastTheElementsKept) {
+  constexpr std::size_t page = 4096;
+  BigVector<std::uint32_t> v(3 * kHugePage / sizeof(std::uint32_t));  // every page written
+  for (std::size_t i = 0; i < v.size(); ++i) v[i] = static_cast<std::uint32_t>(i * 2654435761u);
+  const std::uint32_t* data = v.data();
+  const std::size_t capacity = v.capacity();
+  const std::size_t keep = 1500;  // 6000 bytes: the first page and part of the second
+  truncate_and_give_back(v, keep);
+  ASSERT_EQ(v.size(), keep);
+  EXPECT_EQ(v.data(), data);  // the storage stays the vector's
+  EXPECT_EQ(v.capacity(), capacity);
+  for (std::size_t i = 0; i < keep; ++i) ASSERT_EQ(v[i], static_cast<std::uint32_t>(i * 2654435761u)) << i;
+  ASSERT_EQ(reinterpret_cast<std::uintptr_t>(data) % page, 0u);
+  const std::size_t pages = capacity * sizeof(std::uint32_t) / page;
+  std::vector<unsigned char> resident(pages);
+  ASSERT_EQ(::mincore(const_cast<std::uint32_t*>(data), pages * page, resident.data()), 0);
+  EXPECT_TRUE(resident[0] & 1);
+  EXPECT_TRUE(resident[1] & 1);  // holds the last elements kept
+  std::size_t still_resident = 0;
+  for (std::size_t p = 2; p < pages; ++p) still_resident += resident[p] & 1;
+  EXPECT_EQ(still_resident, 0u) << "of " << pages - 2 << " pages past the elements";
+  v.resize(capacity);  // grown back into storage that was given back
+  EXPECT_EQ(v[keep], 0u);
+  EXPECT_EQ(v[capacity - 1], 0u);
 }
 
 }  // namespace
