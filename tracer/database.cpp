@@ -225,9 +225,11 @@ class Packer {
   }
 
   // A section of `count` records, record i made by fill(i, T&) as its page
-  // is filled, so a permuted section needs no copy of its own.
-  template <class T, class Fill>
-  SectionLayout add_each(std::size_t count, const char* what, const Fill& fill) {
+  // is filled, so a permuted section needs no copy of its own. Given
+  // `consumed`, the pages are filled a batch at a time from the last, and
+  // consumed(k) is called once the records from k on are packed.
+  template <class T, class Fill, class Consumed = std::nullptr_t>
+  SectionLayout add_each(std::size_t count, const char* what, const Fill& fill, const Consumed& consumed = nullptr) {
     static_assert(std::is_trivially_copyable_v<T>);
     if (sizeof(T) > page_size_)
       throw DatabaseError("page size " + std::to_string(page_size_) + " is too small for a " +
@@ -240,7 +242,7 @@ class Packer {
     const std::size_t base = pages_.size();
     pages_.resize(base + npages);
     const std::size_t pieces = (npages + kPagesPerPiece - 1) / kPagesPerPiece;
-    parallel_pieces(threads_, pieces, [&](std::size_t piece) {
+    const auto fill_piece = [&](std::size_t piece) {
       T record;
       for (std::size_t p = piece * kPagesPerPiece; p < std::min(npages, (piece + 1) * kPagesPerPiece); ++p) {
         std::vector<std::byte> page(page_size_, std::byte{0});
@@ -250,7 +252,17 @@ class Packer {
         }
         pages_[base + p] = std::move(page);
       }
-    });
+    };
+    if constexpr (std::is_null_pointer_v<Consumed>) {
+      parallel_pieces(threads_, pieces, fill_piece);
+    } else {
+      for (std::size_t last = pieces; last > 0;) {
+        const std::size_t first = last > kPiecesPerBatch ? last - kPiecesPerBatch : 0;
+        parallel_pieces(threads_, last - first, [&](std::size_t k) { fill_piece(first + k); });
+        consumed(first * kPagesPerPiece * per_page);
+        last = first;
+      }
+    }
     payload_ += count * sizeof(T);
     return s;
   }
@@ -260,20 +272,20 @@ class Packer {
 
  private:
   static constexpr std::size_t kPagesPerPiece = 256;  // filled together on one thread
+  static constexpr std::size_t kPiecesPerBatch = 16;  // of a consumed section, before its records are freed
   std::uint32_t page_size_;
   unsigned threads_;
   std::vector<std::vector<std::byte>> pages_;
   std::uint64_t payload_ = 0;
 };
 
-// Primitives in an acceleration structure's leaf order (a primitive listed
-// in several leaves is copied into each), each smooth triangle's normal
-// record following it: where each record comes from, worked out in pieces on
-// the build's threads (a first pass counts each piece's smooth triangles,
-// so every piece knows where its normals start). The records themselves are
-// made as their pages are packed, with no second copy of the primitives.
+// The normal records of the smooth triangles in an acceleration structure's
+// leaf order (a primitive listed in several leaves has its record copied
+// for each): each leaf position's new normal index and each new record's
+// source, worked out in pieces on the build's threads (a first pass counts
+// each piece's smooth triangles, so every piece knows where its normals
+// start). No normals, no index array.
 struct LeafOrder {
-  std::span<const std::uint32_t> prim;  // prim[i]: the flattened primitive at leaf position i
   BigVector<std::uint32_t> normal;      // normal[i]: its normal record's new index (smooth triangles)
   BigVector<std::uint32_t> normal_src;  // normal_src[k]: the flattened normal record of new index k
 };
@@ -289,7 +301,8 @@ LeafOrder leaf_order(const Flattened& f, std::span<const std::uint32_t> order, u
     first_normal[p + 1] = smooth;
   });
   for (std::size_t p = 0; p < pieces; ++p) first_normal[p + 1] += first_normal[p];
-  LeafOrder out{order, BigVector<std::uint32_t>(order.size()), BigVector<std::uint32_t>(first_normal[pieces])};
+  const std::size_t normals = first_normal[pieces];
+  LeafOrder out{BigVector<std::uint32_t>(normals > 0 ? order.size() : 0), BigVector<std::uint32_t>(normals)};
   parallel_pieces(threads, pieces, [&](std::size_t p) {
     std::size_t next_normal = first_normal[p];
     for (std::size_t i = p * piece_size; i < std::min(order.size(), (p + 1) * piece_size); ++i) {
@@ -302,13 +315,99 @@ LeafOrder leaf_order(const Flattened& f, std::span<const std::uint32_t> order, u
   return out;
 }
 
+// The primitives put in leaf order where they lie, for packing from the
+// last page to the first with each batch's records freed once packed, so
+// that the primitives are held about once. Leaf position i takes either
+// the first leaf entry of its primitive, whose record is moved in place to
+// prims[source[i]], first entries in leaf order; or a later entry of a
+// primitive copied into several leaves (split references), whose record is
+// copied out beforehand to copies[source[i] - kCopy]. Primitives no leaf
+// names go after the first entries, and are freed with the first batch.
+class LeafRecords {
+ public:
+  static constexpr std::uint32_t kCopy = 1u << 31;
+
+  // Takes `order` over as its source array.
+  static LeafRecords make(BigVector<PrimRecord>& prims, std::span<std::uint32_t> order) {
+    if (order.size() >= kCopy) throw DatabaseError("scene too large: 2^31 leaf entries or more");
+    LeafRecords out(prims);
+    const std::size_t n = prims.size();
+    std::vector<bool> named(n);
+    std::vector<std::uint32_t> first_of;  // first_of[j]: the primitive moved to prims[j]
+    first_of.reserve(n);
+    for (std::uint32_t& k : order) {
+      if (named[k]) {
+        out.copies_.push_back(prims[k]);
+        k = kCopy + static_cast<std::uint32_t>(out.copies_.size() - 1);
+      } else {
+        named[k] = true;
+        first_of.push_back(k);
+        k = static_cast<std::uint32_t>(first_of.size() - 1);
+      }
+    }
+    out.firsts_ = first_of.size();
+    for (std::uint32_t k = 0; k < n; ++k)
+      if (!named[k]) first_of.push_back(k);
+    permute(prims, first_of);
+    out.source_ = order;
+    return out;
+  }
+
+  const PrimRecord& at(std::size_t i) const {
+    const std::uint32_t k = source_[i];
+    return k >= kCopy ? copies_[k - kCopy] : prims_[k];
+  }
+  // Leaf positions from `packed_from` on are packed: frees their records.
+  void packed(std::size_t packed_from) {
+    std::size_t keep = firsts_;  // first entries before packed_from: the rank of the next one
+    for (std::size_t i = packed_from; i < source_.size(); ++i)
+      if (source_[i] < kCopy) {
+        keep = source_[i];
+        break;
+      }
+    truncate_and_give_back(prims_, keep);
+  }
+
+ private:
+  explicit LeafRecords(BigVector<PrimRecord>& prims) : prims_(prims) {}
+
+  // prims[j] becomes what was prims[from[j]], a cycle of the permutation at
+  // a time: no second copy.
+  static void permute(BigVector<PrimRecord>& prims, const std::vector<std::uint32_t>& from) {
+    std::vector<bool> done(prims.size());
+    for (std::size_t start = 0; start < prims.size(); ++start) {
+      if (done[start]) continue;
+      const PrimRecord first = prims[start];
+      for (std::size_t i = start;;) {
+        done[i] = true;
+        if (from[i] == start) {
+          prims[i] = first;
+          break;
+        }
+        prims[i] = prims[from[i]];
+        i = from[i];
+      }
+    }
+  }
+
+  BigVector<PrimRecord>& prims_;
+  std::vector<PrimRecord> copies_;
+  std::span<const std::uint32_t> source_;
+  std::size_t firsts_ = 0;
+};
+
 // Packs the primitives and normals in leaf order: the sections' last two.
-void pack_leaf_order(Packer& packer, const Flattened& f, const LeafOrder& leaves, SectionLayout* sections) {
-  sections[int(Section::prims)] =
-      packer.add_each<PrimRecord>(leaves.prim.size(), "primitive", [&](std::size_t i, PrimRecord& r) {
-        r = f.prims[leaves.prim[i]];
+// The leaf order `order` is used up (see LeafRecords).
+void pack_leaf_order(Packer& packer, Flattened& f, std::span<std::uint32_t> order, const LeafOrder& leaves,
+                     SectionLayout* sections) {
+  LeafRecords records = LeafRecords::make(f.prims, order);
+  sections[int(Section::prims)] = packer.add_each<PrimRecord>(
+      order.size(), "primitive",
+      [&](std::size_t i, PrimRecord& r) {
+        r = records.at(i);
         if (r.kind == PrimKind::smooth_triangle) r.aux = leaves.normal[i];
-      });
+      },
+      [&](std::size_t packed_from) { records.packed(packed_from); });
   sections[int(Section::normals)] =
       packer.add_each<NormalRecord>(leaves.normal_src.size(), "normal", [&](std::size_t k, NormalRecord& n) {
         n = f.normals[leaves.normal_src[k]];
@@ -390,7 +489,7 @@ Database build_flattened(const Scene& scene, ObjectCounts counts, Flattened f, c
     db.stats.bvh_nodes = bvh.nodes.size();
     sec[int(Section::bvh_nodes)] = packer.add(bvh.nodes, "BVH node");
     release(bvh.nodes);
-    pack_leaf_order(packer, f, leaves, sec);
+    pack_leaf_order(packer, f, bvh.order, leaves, sec);
   } else {
     GridBuild g = build_grid(f.prims, f.bounds, h.bounds, opt.grid_density);
     const LeafOrder leaves = leaf_order(f, g.order, opt.threads);
@@ -402,7 +501,7 @@ Database build_flattened(const Scene& scene, ObjectCounts counts, Flattened f, c
     db.stats.grid_subgrids = g.subgrids;
     sec[int(Section::grid_cells)] = packer.add(g.cells, "grid cell");
     sec[int(Section::grid_lists)] = packer.add(g.lists, "grid list");
-    pack_leaf_order(packer, f, leaves, sec);
+    pack_leaf_order(packer, f, g.order, leaves, sec);
   }
   db.stats.payload_bytes = packer.payload();
   db.pages = packer.take();

@@ -125,10 +125,11 @@ struct Database {
 // treelet layout numbers BVH nodes by pages, but the tree is the same), nor
 // on BuildOptions::threads: every thread count gives the same pages.
 Database build_database(const Scene& scene, const BuildOptions& options = {});
-// The same database from a scene it consumes: each object's vertices are
-// freed once flattened, and the objects after, so that a large scene's peak
-// memory holds its geometry or its primitives, not both. The scene keeps
-// its name, camera, lights, materials and background; its objects are gone.
+// The same database from a scene it consumes: the objects are flattened
+// from the last and freed as they go, so that a large scene's peak memory
+// holds its geometry or its primitives, not both (the primitives are then
+// packed the same way, freed as their pages are made). The scene keeps its
+// name, camera, lights, materials and background; its objects are gone.
 Database build_database(Scene&& scene, const BuildOptions& options = {});
 
 // The single-process page source: every page in memory, shared read-only.

@@ -4,11 +4,14 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cmath>
 #include <cstdlib>
 #include <cstring>
 #include <string>
+#include <vector>
 
 #include "test_scenes.hpp"
+#include "tracer/bvh.hpp"
 #include "tracer/generators.hpp"
 
 namespace tracer {
@@ -237,6 +240,56 @@ TEST(Database, AConsumedSceneGivesThePagesOfTheSceneKept) {
       EXPECT_EQ(consumed.lights.size(), scene.lights.size());
       EXPECT_EQ(consumed.camera.width, scene.camera.width);
     }
+  }
+}
+
+// Triangles much longer than the rest are split among several leaves, so
+// the leaves list some primitives more than once; a sphere far away is in
+// one leaf of its own. Every leaf's records are primitives whose boxes
+// meet the leaf's box, every primitive is in a leaf, and a split one is in
+// several: the records were put in leaf order right, copies included.
+TEST(Database, EveryLeafHoldsRecordsOfItsOwnPrimitives) {
+  Scene scene = testing::random_scene(7, 3000, 40);
+  for (int i = 0; i < 30; ++i) {
+    const double y = -1 + i * 0.07;
+    scene.objects.push_back({Polygon{{{-1, y, -1}, {1, y + 0.01, 1}, {1, y + 0.02, -1}}}, 0});
+  }
+  for (const unsigned threads : {1u, 2u}) {
+    const Database db = build_database(scene, {.threads = threads});
+    const auto& nodes = db.header.section(Section::bvh_nodes);
+    std::vector<int> leaves_of(scene.objects.size(), 0);
+    std::uint64_t entries = 0;
+    for (std::uint32_t i = 0; i < nodes.record_count; ++i) {
+      const auto n = record<BvhNode>(db, Section::bvh_nodes, i);
+      for (int lane = 0; lane < 4; ++lane) {
+        if (n.count[lane] == 0) continue;  // inner or unused
+        const Box3f box = lane_box(n, lane);
+        for (std::uint32_t k = n.child[lane]; k < n.child[lane] + n.count[lane]; ++k) {
+          const auto p = record<PrimRecord>(db, Section::prims, k);
+          ASSERT_LT(p.object, scene.objects.size());
+          ++leaves_of[p.object];
+          ++entries;
+          Box3f prim;
+          if (p.kind == PrimKind::sphere) {
+            const float r = std::fabs(p.p1.x);
+            prim = {p.p0 - Vec3f{r, r, r}, p.p0 + Vec3f{r, r, r}};
+            EXPECT_EQ(p.p0, static_cast<Vec3f>(std::get<Sphere>(scene.objects[p.object].shape).center));
+          } else {
+            for (const Vec3f v : {p.p0, p.p0 + p.p1, p.p0 + p.p2}) prim.extend(v);
+            EXPECT_EQ(p.p0, static_cast<Vec3f>(std::get<Polygon>(scene.objects[p.object].shape).vertices[0]));
+          }
+          for (int a = 0; a < 3; ++a) {
+            EXPECT_LE(prim.lo[a], box.hi[a] + 1e-4f) << "object " << p.object << " in a leaf it does not meet";
+            EXPECT_GE(prim.hi[a], box.lo[a] - 1e-4f) << "object " << p.object << " in a leaf it does not meet";
+          }
+        }
+      }
+    }
+    EXPECT_EQ(entries, db.header.section(Section::prims).record_count);
+    EXPECT_EQ(std::count(leaves_of.begin(), leaves_of.end(), 0), 0) << "a primitive in no leaf";
+    int split = 0;
+    for (std::size_t o = 3040; o < scene.objects.size(); ++o) split += leaves_of[o] > 1;
+    EXPECT_GE(split, 20) << "the long triangles were not split: nothing was listed twice";
   }
 }
 
