@@ -40,7 +40,7 @@ struct Flattened {
 // in the intersection routines never puts a hit outside its primitive's box.
 Box3f padded(const Box3f& b) { return widened(b, 1e-6f); }
 
-void add_polygon(Flattened& f, const std::vector<Vec3d>& v, const std::vector<Vec3d>* normals,
+void add_polygon(Flattened& f, std::span<const Vec3d> v, const std::vector<Vec3d>* normals,
                  std::uint32_t material, std::uint32_t object) {
   const Vec3d n = cross(v[1] - v[0], v[2] - v[0]);
   if (!(length(n) > 0)) return;  // first three vertices collinear: no plane, nothing visible
@@ -124,7 +124,7 @@ void flatten_range(const Scene& scene, std::size_t begin, std::size_t end, Flatt
       f.bounds.push_back(padded(cone_bounds({r.p0, r.p1, r.p2.x, r.p2.y})));
       f.prims.push_back(r);
     } else if (const auto* p = std::get_if<Polygon>(&o.shape)) {
-      add_polygon(f, p->vertices, nullptr, o.material, i);
+      add_polygon(f, points(p->vertices), nullptr, o.material, i);
     } else if (const auto* pp = std::get_if<Patch>(&o.shape)) {
       add_polygon(f, pp->vertices, &pp->normals, o.material, i);
     }

@@ -16,9 +16,9 @@ constexpr int kTeeth = 36;
 
 // One face outline of a gear: four points per tooth. The first three points
 // span a convex corner, as NFF requires.
-std::vector<Vec3d> gear_outline(const Vec3d& center, double offset, double outer, double inner, double z, int sense) {
+Vertices gear_outline(const Vec3d& center, double offset, double outer, double inner, double z, int sense) {
   const double tooth = sense * 2 * kPi / kTeeth;
-  std::vector<Vec3d> pts;
+  Vertices pts;
   for (int t = 0; t < kTeeth; ++t) {
     double a = offset + sense * 2 * kPi * t / kTeeth;
     pts.push_back(spd::rotate_z({outer, 0, z}, a - 0.19 * tooth) + center);
@@ -30,7 +30,7 @@ std::vector<Vec3d> gear_outline(const Vec3d& center, double offset, double outer
 }
 
 void add_gear(Scene& scene, const Vec3d& center, double offset, double outer, double inner, double thickness) {
-  std::vector<Vec3d> top = gear_outline(center, offset, outer, inner, 0, +1);
+  const Vertices top = gear_outline(center, offset, outer, inner, 0, +1);
   spd::add_polygon(scene, top);
   for (std::size_t i = 0; i < top.size(); ++i) {
     const Vec3d& a = top[i];

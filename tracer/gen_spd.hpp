@@ -36,7 +36,7 @@ inline std::uint32_t current_material(const Scene& scene) {
   return static_cast<std::uint32_t>(scene.materials.size() - 1);
 }
 
-inline void add_polygon(Scene& scene, std::vector<Vec3d> vertices) {
+inline void add_polygon(Scene& scene, Vertices vertices) {
   scene.objects.push_back({Polygon{std::move(vertices)}, current_material(scene)});
 }
 

@@ -258,7 +258,7 @@ void clip_ears(const std::vector<P2>& pts, double sign, Triangles& tris) {
 }
 }  // namespace
 
-std::vector<std::array<std::uint32_t, 3>> triangulate_polygon(const std::vector<Vec3d>& v) {
+std::vector<std::array<std::uint32_t, 3>> triangulate_polygon(std::span<const Vec3d> v) {
   Triangles tris;
   if (v.size() < 3) return tris;
   // Project onto the plane that drops the normal's dominant axis.

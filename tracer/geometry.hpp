@@ -11,6 +11,7 @@
 #include <cmath>
 #include <cstdint>
 #include <optional>
+#include <span>
 #include <vector>
 
 #include "tracer/vec.hpp"
@@ -136,6 +137,6 @@ Box3f cone_bounds(const ConeShape& c);
 // clipped on a walk round it, each ear tested against the vertices near it;
 // one that has no ear left (self-intersecting or degenerate) is finished as
 // a fan. Every input gives n - 2 triangles.
-std::vector<std::array<std::uint32_t, 3>> triangulate_polygon(const std::vector<Vec3d>& vertices);
+std::vector<std::array<std::uint32_t, 3>> triangulate_polygon(std::span<const Vec3d> vertices);
 
 }  // namespace tracer

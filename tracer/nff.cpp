@@ -20,6 +20,7 @@
 #include <limits>
 #include <optional>
 #include <sstream>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -508,7 +509,7 @@ class Parser {
   void polygon();
   void patch();
   std::uint32_t current_material();
-  void check_polygon_shape(const std::vector<Vec3d>& vertices, const std::string& what);
+  void check_polygon_shape(std::span<const Vec3d> vertices, const std::string& what);
 
   // Objects gather in chunks of fixed capacity, moved once into the scene at
   // the end: a growing vector would move every object again at each doubling
@@ -615,7 +616,7 @@ void Parser::sphere() {
 // triangle that turns the way the whole polygon does, judged by its area
 // (Newell) normal; and every vertex must lie in the plane, up to the rounding
 // of coordinates printed with few digits.
-void Parser::check_polygon_shape(const std::vector<Vec3d>& v, const std::string& what) {
+void Parser::check_polygon_shape(std::span<const Vec3d> v, const std::string& what) {
   const Vec3d a = v[1] - v[0], b = v[2] - v[0];
   const Vec3d corner = cross(a, b);
   if (!(length(corner) > 1e-12 * length(a) * length(b)))
@@ -646,7 +647,7 @@ void Parser::polygon() {
   Polygon p;
   p.vertices.reserve(static_cast<std::size_t>(std::min(n, kReserveVertices)));
   for (long long i = 0; i < n; ++i) p.vertices.push_back(vec3("polygon vertex"));
-  check_polygon_shape(p.vertices, "polygon");
+  check_polygon_shape(points(p.vertices), "polygon");
   add({std::move(p), current_material()});
 }
 

@@ -81,7 +81,7 @@ bool write_pov(const tracer::Scene& scene, const std::string& path, std::string&
       std::fprintf(f, "cone { %s, %.9g, %s, %.9g open %s }\n", vec(c->base).c_str(), std::abs(c->base_radius),
                    vec(c->apex).c_str(), std::abs(c->apex_radius), tex.c_str());
     } else if (const auto* p = std::get_if<tracer::Polygon>(&o.shape)) {
-      for (const auto& t : tracer::triangulate_polygon(p->vertices))
+      for (const auto& t : tracer::triangulate_polygon(tracer::points(p->vertices)))
         meshes[o.material].push_back("triangle { " + vec(p->vertices[t[0]]) + "," + vec(p->vertices[t[1]]) +
                                      "," + vec(p->vertices[t[2]]) + " }");
     } else if (const auto* q = std::get_if<tracer::Patch>(&o.shape)) {
