@@ -11,10 +11,14 @@
 // GCC 12 warns that Boost's copy of a small vector may read past the inline
 // elements, on a size it cannot bound (-Wstringop-overread, a false positive
 // of its middle end, which also reaches code in system headers).
+#if defined(__GNUC__) && !defined(__clang__)
 #pragma GCC diagnostic push
 #pragma GCC diagnostic ignored "-Wstringop-overread"
+#endif
 #include <boost/container/small_vector.hpp>
+#if defined(__GNUC__) && !defined(__clang__)
 #pragma GCC diagnostic pop
+#endif
 
 #include <cstdint>
 #include <span>
