@@ -126,7 +126,7 @@ void flatten_range(const Scene& scene, std::size_t begin, std::size_t end, Flatt
     } else if (const auto* p = std::get_if<Polygon>(&o.shape)) {
       add_polygon(f, points(p->vertices), nullptr, o.material, i);
     } else if (const auto* pp = std::get_if<Patch>(&o.shape)) {
-      add_polygon(f, pp->vertices, &pp->normals, o.material, i);
+      add_polygon(f, points(pp->vertices), &pp->normals, o.material, i);
     }
   }
 }

@@ -97,7 +97,7 @@ void add_teapot(Scene& scene, int n) {
     for (int si = 0; si < n; ++si)
       for (int ti = 0; ti < n; ++ti)
         for (int tri = 0; tri < 2; ++tri) {
-          Patch p{std::vector<Vec3d>(3), std::vector<Vec3d>(3)};
+          Patch p{Vertices(3), std::vector<Vec3d>(3)};
           for (int k = 0; k < 3; ++k) {
             int corner = (k + tri * 2) % 4;  // quad corners 0..3, split along 0-2
             double s = double(si + (corner / 2 ? 1 : 0)) / n, t = double(ti + (corner % 3 ? 1 : 0)) / n;

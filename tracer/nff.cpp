@@ -661,7 +661,7 @@ void Parser::patch() {
     p.normals.push_back(vec3("patch vertex normal"));
     if (length(p.normals.back()) == 0) fail_here("patch vertex normal has zero length");
   }
-  check_polygon_shape(p.vertices, "patch");
+  check_polygon_shape(points(p.vertices), "patch");
   add({std::move(p), current_material()});
 }
 

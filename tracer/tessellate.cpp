@@ -116,7 +116,9 @@ std::uint64_t tessellated_object_count(const Scene& scene, int resolution) {
 void tessellate(Scene& scene, int resolution) {
   check_resolution(resolution);
   BigVector<Object> objects;
-  objects.reserve(scene.objects.size());
+  // Room for every piece at once (fewer only where one is degenerate), so
+  // that the objects are never moved while they grow: two copies at once.
+  objects.reserve(tessellated_object_count(scene, resolution));
   for (Object& o : scene.objects) {
     std::vector<Patch> pieces;
     auto* s = std::get_if<Sphere>(&o.shape);

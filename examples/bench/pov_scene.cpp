@@ -85,7 +85,7 @@ bool write_pov(const tracer::Scene& scene, const std::string& path, std::string&
         meshes[o.material].push_back("triangle { " + vec(p->vertices[t[0]]) + "," + vec(p->vertices[t[1]]) +
                                      "," + vec(p->vertices[t[2]]) + " }");
     } else if (const auto* q = std::get_if<tracer::Patch>(&o.shape)) {
-      for (const auto& t : tracer::triangulate_polygon(q->vertices)) {
+      for (const auto& t : tracer::triangulate_polygon(tracer::points(q->vertices))) {
         std::string tri = "smooth_triangle { ";
         for (int k = 0; k < 3; ++k)
           tri += (k ? "," : "") + vec(q->vertices[t[k]]) + "," + vec(q->normals[t[k]]);
