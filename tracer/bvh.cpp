@@ -22,6 +22,7 @@
 #include <condition_variable>
 #include <deque>
 #include <exception>
+#include <memory>
 #include <mutex>
 #include <thread>
 
@@ -100,27 +101,18 @@ class Builder {
     for (std::uint32_t i = 0; i < bounds.size(); ++i) out_.order[i] = i;
   }
 
-  // At most this many binary nodes hold references [begin, end): leaves of
-  // one reference at least, and two children to every inner node. Segments
-  // are reserved for it, so that they never move while they grow (which
-  // would leave the memory they moved out of to the build's peak).
-  static std::size_t node_bound(std::uint32_t begin, std::uint32_t end) { return 2 * std::size_t{end - begin}; }
-
   BvhBuild run() {
     out_.nodes.emplace_back();
     for (int lane = 0; lane < 4; ++lane) set_lane_box(out_.nodes[0], lane, Box3f{});
     if (bounds_.empty()) return std::move(out_);
     const auto n = static_cast<std::uint32_t>(bounds_.size());
-    segments_.emplace_back(1).reserve(node_bound(0, n));
+    segments_.emplace_back().grow(1);
     if (n >= large_node_) scratch_.resize(n);
     build(segments_[0], 0, 0, 0, n);
     BigVector<std::uint32_t>().swap(scratch_);
-    // Four-wide nodes: at most one for each inner binary node, and an inner
-    // node has two children, so a tree of T nodes has (T - 1) / 2 of them.
-    std::size_t binary = 0;
-    for (const Segment& seg : segments_) binary += seg.size();
-    out_.nodes.reserve(1 + (binary - 1) / 2);
     const BinNode& root = segments_[0][0];
+    // Room for exactly the four-wide nodes, so that they are never moved.
+    if (root.count == 0) out_.nodes.reserve(four_wide_nodes(0));
     if (root.count > 0) {  // one leaf: a root with a single used lane
       set_lane_box(out_.nodes[0], 0, root.box);
       out_.nodes[0].child[0] = root.first;
@@ -132,7 +124,24 @@ class Builder {
   }
 
  private:
-  using Segment = std::vector<BinNode>;
+  // Binary nodes in blocks of 2^16 that never move as the segment grows:
+  // growing leaves no copy behind, and maps at most one block beyond the nodes.
+  class Segment {
+   public:
+    BinNode& operator[](std::size_t i) { return blocks_[i >> kShift][i & kMask]; }
+    const BinNode& operator[](std::size_t i) const { return blocks_[i >> kShift][i & kMask]; }
+    std::size_t size() const { return size_; }
+    void grow(std::size_t n) {  // appends n nodes
+      size_ += n;
+      while (blocks_.size() << kShift < size_) blocks_.push_back(std::make_unique<BinNode[]>(std::size_t{1} << kShift));
+    }
+
+   private:
+    static constexpr unsigned kShift = 16;
+    static constexpr std::size_t kMask = (std::size_t{1} << kShift) - 1;
+    std::vector<std::unique_ptr<BinNode[]>> blocks_;
+    std::size_t size_ = 0;
+  };
 
   const BinNode& node(NodeRef ref) const { return segments_[ref >> 32][ref & 0xffffffffu]; }
 
@@ -165,7 +174,7 @@ class Builder {
       return;
     }
     const auto left = static_cast<std::uint32_t>(seg.size());
-    seg.resize(seg.size() + 2);
+    seg.grow(2);
     seg[index].left = make_ref(segment, left);
     seg[index].right = make_ref(segment, left + 1);
     build(seg, segment, left, begin, mid);
@@ -182,11 +191,11 @@ class Builder {
     {
       std::lock_guard lock(segments_mutex_);
       left_segment = static_cast<std::uint32_t>(segments_.size());
-      left_seg = &segments_.emplace_back(1);  // deque: earlier segments stay where they are
+      left_seg = &segments_.emplace_back();  // deque: earlier segments stay where they are
+      left_seg->grow(1);
     }
-    left_seg->reserve(node_bound(begin, mid));
     const auto right = static_cast<std::uint32_t>(seg.size());
-    seg.emplace_back();
+    seg.grow(1);
     seg[index].left = make_ref(left_segment, 0);
     seg[index].right = make_ref(segment, right);
     std::exception_ptr left_error;
@@ -341,6 +350,14 @@ class Builder {
       lanes.insert(lanes.begin() + pick + 1, opened.right);
     }
     return lanes;
+  }
+
+  // The four-wide nodes collapse() makes from inner binary node `ref`.
+  std::size_t four_wide_nodes(NodeRef ref) const {
+    std::size_t count = 1;
+    for (const NodeRef lane : lanes_of(ref))
+      if (node(lane).count == 0) count += four_wide_nodes(lane);
+    return count;
   }
 
   // Fills four-wide node `slot` from inner binary node `ref`. The inner

@@ -208,6 +208,7 @@ Flattened flatten(Scene& scene, unsigned threads) {
     return_freed_memory();
     last = first;
   }
+  BigVector<Object>().swap(scene.objects);  // its storage unmapped before the join maps the records'
   return join(parts);
 }
 
@@ -530,8 +531,6 @@ Database build_database(Scene&& scene, const BuildOptions& opt) {
   const auto t0 = Clock::now();
   const ObjectCounts counts{scene.polygon_count(), scene.objects.size()};
   Flattened f = flatten(scene, opt.threads);
-  BigVector<Object>().swap(scene.objects);
-  return_freed_memory();
   return build_flattened(scene, counts, std::move(f), opt, t0);
 }
 
