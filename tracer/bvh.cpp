@@ -110,9 +110,13 @@ class Builder {
     if (n >= large_node_) scratch_.resize(n);
     build(segments_[0], 0, 0, 0, n);
     BigVector<std::uint32_t>().swap(scratch_);
+    // Four-wide nodes: at most one for each inner binary node, and an inner
+    // node has two children, so a tree of T nodes has (T - 1) / 2 of them.
+    // Reserved, they are never moved (which would leave a copy behind).
+    std::size_t binary = 0;
+    for (const Segment& seg : segments_) binary += seg.size();
+    out_.nodes.reserve(1 + (binary - 1) / 2);
     const BinNode& root = segments_[0][0];
-    // Room for exactly the four-wide nodes, so that they are never moved.
-    if (root.count == 0) out_.nodes.reserve(four_wide_nodes(0));
     if (root.count > 0) {  // one leaf: a root with a single used lane
       set_lane_box(out_.nodes[0], 0, root.box);
       out_.nodes[0].child[0] = root.first;
@@ -350,14 +354,6 @@ class Builder {
       lanes.insert(lanes.begin() + pick + 1, opened.right);
     }
     return lanes;
-  }
-
-  // The four-wide nodes collapse() makes from inner binary node `ref`.
-  std::size_t four_wide_nodes(NodeRef ref) const {
-    std::size_t count = 1;
-    for (const NodeRef lane : lanes_of(ref))
-      if (node(lane).count == 0) count += four_wide_nodes(lane);
-    return count;
   }
 
   // Fills four-wide node `slot` from inner binary node `ref`. The inner
