@@ -244,12 +244,14 @@ TEST(Database, AConsumedSceneGivesThePagesOfTheSceneKept) {
 }
 
 // Triangles much longer than the rest are split among several leaves, so
-// the leaves list some primitives more than once; a sphere far away is in
-// one leaf of its own. Every leaf's records are primitives whose boxes
-// meet the leaf's box, every primitive is in a leaf, and a split one is in
-// several: the records were put in leaf order right, copies included.
+// the leaves list some primitives more than once. Every leaf's records are
+// primitives whose boxes meet the leaf's box, every primitive is in a
+// leaf, and a split one is in several: the records were put in leaf order
+// right, copies included. The scene is large enough for the binary tree
+// to span several blocks of nodes (the build's Segment).
 TEST(Database, EveryLeafHoldsRecordsOfItsOwnPrimitives) {
-  Scene scene = testing::random_scene(7, 3000, 40);
+  Scene scene = testing::random_scene(7, 200000, 40);
+  const std::size_t long_ones = scene.objects.size();
   for (int i = 0; i < 30; ++i) {
     const double y = -1 + i * 0.07;
     scene.objects.push_back({Polygon{{{-1, y, -1}, {1, y + 0.01, 1}, {1, y + 0.02, -1}}}, 0});
@@ -288,8 +290,11 @@ TEST(Database, EveryLeafHoldsRecordsOfItsOwnPrimitives) {
     EXPECT_EQ(entries, db.header.section(Section::prims).record_count);
     EXPECT_EQ(std::count(leaves_of.begin(), leaves_of.end(), 0), 0) << "a primitive in no leaf";
     int split = 0;
-    for (std::size_t o = 3040; o < scene.objects.size(); ++o) split += leaves_of[o] > 1;
+    for (std::size_t o = long_ones; o < scene.objects.size(); ++o) split += leaves_of[o] > 1;
     EXPECT_GE(split, 20) << "the long triangles were not split: nothing was listed twice";
+    // A four-wide node stands for one inner binary node at least, and a
+    // binary tree has more leaves than inner nodes.
+    EXPECT_GT(2 * db.stats.bvh_nodes, 65536u) << "the binary tree may fit in one block of nodes";
   }
 }
 
