@@ -194,7 +194,7 @@ TEST_F(Checks, ATessellationTooLargeForTheMemoryIsRefusedBeforeItIsMade) {
   const auto limited = [&](const std::string& args) { return run_vmpray(args, "stdout.txt", "ulimit -v 2000000"); };
   const std::pair<const char*, const char*> refused[] = {
       {"balls:4 --tessellate 64 --width 8 --height 8 -o out.png",
-       "vmpray: --tessellate 64: the scene tessellated becomes 362790913 objects, needing about 261.2 GB, more than "
+       "vmpray: --tessellate 64: the scene tessellated becomes 362790913 objects, needing about 145.1 GB, more than "
        "the 2.0 GB this process may map (ulimit -v)\n"},
       {"balls:4:t64 --width 8 --height 8 -o out.png",
        "vmpray: scene 'balls:4:t64': the scene tessellated becomes 362790913 objects"},
