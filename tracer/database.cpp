@@ -10,10 +10,6 @@
 #include <span>
 #include <type_traits>
 
-#ifdef __GLIBC__
-#include <malloc.h>
-#endif
-
 #include "tracer/bvh.hpp"
 #include "tracer/grid.hpp"
 #include "tracer/huge_pages.hpp"
@@ -74,14 +70,6 @@ void add_polygon(Flattened& f, std::span<const Vec3d> v, const std::vector<Vec3d
 constexpr std::size_t objects_per_chunk = 4096;
 constexpr std::size_t chunks_per_wave = 4;  // of a scene consumed, freed and given back after each
 
-// The freed vertex arrays go back to the system, not only to the heap's
-// free lists: the build's large arrays are mapped afresh and would not
-// reuse them, so they would still count in the peak.
-void return_freed_memory() {
-#ifdef __GLIBC__
-  malloc_trim(0);
-#endif
-}
 
 // Room for every primitive the scene's objects can make (a polygon of n
 // vertices n - 2 triangles, fewer only if degenerate), so that the arrays
@@ -168,9 +156,9 @@ Flattened join(std::vector<Flattened>& parts) {
   f.normals.reserve(normals);
   for (std::size_t k = 0; k < parts.size(); ++k) {
     append(f, parts[k]);
-    if ((k + 1) % chunks_per_wave == 0) return_freed_memory();
+    if ((k + 1) % chunks_per_wave == 0) return_freed_heap();
   }
-  return_freed_memory();
+  return_freed_heap();
   return f;
 }
 
@@ -205,7 +193,7 @@ Flattened flatten(Scene& scene, unsigned threads) {
     const std::size_t first = last > chunks_per_wave ? last - chunks_per_wave : 0;
     flatten_chunks(scene, first, last, parts, threads);
     truncate_and_give_back(scene.objects, first * objects_per_chunk);
-    return_freed_memory();
+    return_freed_heap();
     last = first;
   }
   BigVector<Object>().swap(scene.objects);  // its storage unmapped before the join maps the records'
@@ -477,7 +465,7 @@ Database build_flattened(const Scene& scene, ObjectCounts counts, Flattened f, c
     BvhBuild bvh = build_bvh(refs, opt.bvh_max_leaf, {.threads = opt.threads});
     release(refs.bounds);
     release(refs.triangle);
-    return_freed_memory();  // the binary tree's, before the pages are made
+    return_freed_heap();  // the binary tree's, before the pages are made
     if (opt.bvh_layout == BvhLayout::treelet) lay_out_treelets(bvh, opt.page_size / sizeof(BvhNode));
     for (std::uint32_t& k : bvh.order) k = refs.prim[k];
     db.stats.bvh_references = refs.prim.size();

@@ -6,10 +6,14 @@
 // touches some 300 MB of fresh memory. The advice is a hint: where huge
 // pages are off, or the call fails, the block is ordinary memory. Smaller
 // blocks come from std::allocator. Stateless: any two compare equal.
-// truncate_and_give_back lets a vector consumed from its back shrink.
+// truncate_and_give_back lets a vector consumed from its back shrink, and
+// return_freed_heap gives what a step freed back to the system.
 #pragma once
 
 #include <sys/mman.h>
+#ifdef __GLIBC__
+#include <malloc.h>
+#endif
 
 #include <algorithm>
 #include <cstddef>
@@ -64,6 +68,15 @@ struct HugePageAllocator {
 // A vector whose large storage is advised for huge pages.
 template <class T>
 using BigVector = std::vector<T, HugePageAllocator<T>>;
+
+// Gives the heap's free memory back to the system (glibc's malloc_trim),
+// not only to its free lists: a big step's arrays are mapped afresh and
+// would not reuse what an earlier one freed, so it would count in the peak.
+inline void return_freed_heap() {
+#ifdef __GLIBC__
+  malloc_trim(0);
+#endif
+}
 
 // Destroys the elements of v from `count` on, and gives the whole pages of
 // storage past the elements left back to the system (madvise MADV_DONTNEED):

@@ -10,6 +10,7 @@
 #include <chrono>
 #include <memory>
 #include <new>
+#include <span>
 #include <stdexcept>
 #include <string>
 #include <thread>
@@ -22,6 +23,7 @@
 #include "nodes/machine/report_wire.hpp"
 #include "nodes/net/mailbox.hpp"
 #include "topology/spec.hpp"
+#include "tracer/huge_pages.hpp"
 
 namespace nodes {
 
@@ -50,10 +52,9 @@ struct Host {
   std::vector<std::uint16_t> owners;  // per pixel or corner sample in scanline order, filled by the collector
 };
 
-std::unique_ptr<NodeState> node_state(const PagePlacement& placement, int n, std::size_t page_size,
-                                      std::vector<std::vector<std::byte>> own, std::uint32_t cache_pages) {
+std::unique_ptr<NodeState> node_state(NodeMemory memory) {
   auto state = std::make_unique<NodeState>();
-  state->svm = std::make_unique<NodeSvm>(NodeMemory(placement, n, page_size, std::move(own), cache_pages));
+  state->svm = std::make_unique<NodeSvm>(std::move(memory));
   return state;
 }
 
@@ -79,17 +80,24 @@ void check_fields(const MachineOptions& options) {
                                       std::to_string(options.shape.buffer_capacity) + " packets)");
 }
 
-// Moves each page from the host's database into its owner's memory.
+// Moves each page from the host's database into its owner's memory, in
+// page order, each freed once placed and the freed memory given back every
+// few megabytes: the pages of a database, allocated in that order, are
+// then held about once, not by the host and the nodes at the same time.
 std::vector<std::unique_ptr<NodeState>> distribute(tracer::Database& db, const PagePlacement& placement,
                                                    std::uint32_t cache_pages) {
   std::vector<std::unique_ptr<NodeState>> nodes;
-  for (int n = 0; n < placement.nodes(); ++n) {
-    std::vector<std::vector<std::byte>> own(placement.own_count(n));
-    for (std::uint32_t i = 0; i < own.size(); ++i) own[i] = std::move(db.pages[placement.page_of(n, i)]);
-    nodes.push_back(node_state(placement, n, db.header.page_size, std::move(own), cache_pages));
+  for (int n = 0; n < placement.nodes(); ++n)
+    nodes.push_back(node_state(NodeMemory(placement, n, db.header.page_size, cache_pages)));
+  constexpr std::uint32_t pages_per_return = 4096;
+  for (std::uint32_t p = 0; p < db.pages.size(); ++p) {
+    nodes[static_cast<std::size_t>(placement.owner(p))]->svm->memory().place_own(placement.own_index(p), db.pages[p]);
+    std::vector<std::byte>().swap(db.pages[p]);
+    if ((p + 1) % pages_per_return == 0) tracer::return_freed_heap();
   }
   db.pages.clear();
   db.pages.shrink_to_fit();  // the host keeps no copy
+  tracer::return_freed_heap();
   return nodes;
 }
 
@@ -650,7 +658,7 @@ void send_setup(tracer::Database& db, const RankPlan& plan, const PagePlacement&
     if (plan.runs(0, n)) {
       std::vector<std::vector<std::byte>> pages(own);
       for (std::uint32_t i = 0; i < own; ++i) pages[i] = std::move(db.pages[placement.page_of(owner, i)]);
-      nodes[n] = node_state(placement, owner, page_size, std::move(pages), cache_pages);
+      nodes[n] = node_state(NodeMemory(placement, owner, page_size, std::move(pages), cache_pages));
       continue;
     }
     Bytes share;
@@ -682,12 +690,10 @@ tracer::DatabaseHeader receive_setup(const MachineOptions& options, const RankPl
     if (share.bytes.size() != std::size_t{own} * header.page_size)
       throw std::runtime_error("node " + std::to_string(n) + ": rank 0 sent " + std::to_string(share.bytes.size()) +
                                " bytes of pages, not " + std::to_string(own) + " pages");
-    std::vector<std::vector<std::byte>> pages(own);
-    for (std::uint32_t i = 0; i < own; ++i) {
-      const auto* p = share.bytes.data() + std::size_t{i} * header.page_size;
-      pages[i].assign(p, p + header.page_size);
-    }
-    nodes[n] = node_state(placement, static_cast<int>(n), header.page_size, std::move(pages), cache_pages);
+    NodeMemory memory(placement, static_cast<int>(n), header.page_size, cache_pages);
+    for (std::uint32_t i = 0; i < own; ++i)
+      memory.place_own(i, std::span(share.bytes.data() + std::size_t{i} * header.page_size, header.page_size));
+    nodes[n] = node_state(std::move(memory));
   }
   return header;
 }

@@ -47,22 +47,33 @@ std::uint32_t PagePlacement::own_count(int node) const {
 
 NodeMemory::NodeMemory(const PagePlacement& placement, int node, std::size_t page_size,
                        std::vector<std::vector<std::byte>> own_pages, std::uint32_t cache_pages)
-    : page_size_(page_size),
-      own_count_(placement.own_count(node)),
-      own_(std::make_unique<std::byte[]>(own_count_ * page_size)),
-      entry_(placement.page_count(), -1) {
+    : NodeMemory(placement, node, page_size, cache_pages) {
   if (own_pages.size() != own_count_)
     throw std::logic_error("node " + std::to_string(node) + " given the wrong number of own pages");
   for (std::size_t i = 0; i < own_count_; ++i) {
-    if (own_pages[i].size() != page_size) throw std::logic_error("own page of the wrong size");
-    std::memcpy(own_.get() + i * page_size, own_pages[i].data(), page_size);
+    place_own(static_cast<std::uint32_t>(i), own_pages[i]);
     std::vector<std::byte>().swap(own_pages[i]);
-    entry_[placement.page_of(node, static_cast<std::uint32_t>(i))] = static_cast<std::int32_t>(i);
   }
+}
+
+NodeMemory::NodeMemory(const PagePlacement& placement, int node, std::size_t page_size, std::uint32_t cache_pages)
+    : page_size_(page_size),
+      own_count_(placement.own_count(node)),
+      own_(std::make_unique_for_overwrite<std::byte[]>(own_count_ * page_size)),
+      placement_(placement),
+      node_(node),
+      entry_(placement.page_count(), -1) {
   // More slots than remote pages could never be filled.
   capacity_ = std::min(cache_pages, placement.page_count() - static_cast<std::uint32_t>(own_count_));
   slots_.reserve(capacity_);
   uses_.reserve(capacity_);
+}
+
+void NodeMemory::place_own(std::uint32_t index, std::span<const std::byte> bytes) {
+  if (index >= own_count_) throw std::logic_error("own page " + std::to_string(index) + " out of range");
+  if (bytes.size() != page_size_) throw std::logic_error("own page of the wrong size");
+  std::memcpy(own_.get() + std::size_t{index} * page_size_, bytes.data(), page_size_);
+  entry_[placement_.page_of(node_, index)] = static_cast<std::int32_t>(index);
 }
 
 int NodeMemory::take_slot(std::span<const int> in_use) {

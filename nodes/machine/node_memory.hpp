@@ -51,6 +51,11 @@ class NodeMemory {
   // host keeps no copy.
   NodeMemory(const PagePlacement& placement, int node, std::size_t page_size,
              std::vector<std::vector<std::byte>> own_pages, std::uint32_t cache_pages);
+  // A memory whose own pages are placed later, each once by place_own and
+  // all before any other use: their block is mapped but not yet written, so
+  // a host that places pages one by one, freeing each, never holds two.
+  NodeMemory(const PagePlacement& placement, int node, std::size_t page_size, std::uint32_t cache_pages);
+  void place_own(std::uint32_t index, std::span<const std::byte> bytes);
 
   std::int32_t entry(std::uint32_t page) const { return entry_[page]; }
   static bool is_slot(std::int32_t entry) { return entry <= -2; }
@@ -133,6 +138,8 @@ class NodeMemory {
   std::uint32_t capacity_;
   std::size_t own_count_;
   std::unique_ptr<std::byte[]> own_;  // own_count_ pages end to end
+  PagePlacement placement_;
+  int node_;
   std::vector<std::int32_t> entry_;
   std::vector<Slot> slots_;
   std::vector<Use> uses_;  // by slot, as slots_

@@ -1,6 +1,7 @@
 // Own pages, page placement and the LRU page cache of one processor, driven
-// directly (no fibers): placement covers every page once, LRU order, slots
-// in use kept from eviction, and miss coalescing bookkeeping.
+// directly (no fibers): placement covers every page once, own pages given
+// at once or placed one by one, LRU order, slots in use kept from eviction,
+// and miss coalescing bookkeeping.
 #include "nodes/machine/node_memory.hpp"
 
 #include <gtest/gtest.h>
@@ -50,6 +51,39 @@ TEST(PagePlacement, EveryPageHasExactlyOneOwnerAndRoundTrips) {
       }
     }
   }
+}
+
+// Own pages placed one by one, in any order (the host places a database's
+// pages in page order across every node), give the memory that own pages
+// handed over at once give: the same bytes where each page's entry says.
+TEST(NodeMemory, OwnPagesPlacedOneByOneAreTheOwnPagesGivenAtOnce) {
+  for (auto distribution : {Distribution::modulo, Distribution::block}) {
+    const PagePlacement placement(distribution, 5, 47);
+    std::vector<NodeMemory> given, placed;
+    for (int n = 0; n < placement.nodes(); ++n) {
+      given.emplace_back(placement, n, page_size, own_pages(placement, n), 4);
+      placed.emplace_back(placement, n, page_size, 4);
+    }
+    std::vector<std::uint32_t> order(placement.page_count());
+    for (std::uint32_t p = 0; p < order.size(); ++p) order[p] = p;
+    std::shuffle(order.begin(), order.end(), std::mt19937(3));
+    for (const std::uint32_t p : order)
+      placed[static_cast<std::size_t>(placement.owner(p))].place_own(placement.own_index(p), page_bytes(p));
+    for (int n = 0; n < placement.nodes(); ++n)
+      for (std::uint32_t p = 0; p < placement.page_count(); ++p) {
+        const auto& a = given[static_cast<std::size_t>(n)];
+        const auto& b = placed[static_cast<std::size_t>(n)];
+        ASSERT_EQ(b.entry(p), a.entry(p)) << "node " << n << ", page " << p;
+        if (b.entry(p) < 0) continue;
+        EXPECT_EQ(b.entry(p) >= 0, placement.owner(p) == n);
+        EXPECT_TRUE(std::equal(b.own_page(b.entry(p)), b.own_page(b.entry(p)) + page_size, page_bytes(p).begin()))
+            << "node " << n << ", page " << p;
+      }
+  }
+  const PagePlacement placement(Distribution::modulo, 2, 4);
+  NodeMemory memory(placement, 0, page_size, 1);
+  EXPECT_THROW(memory.place_own(2, page_bytes(4)), std::logic_error);  // node 0 owns two pages
+  EXPECT_THROW(memory.place_own(0, std::vector<std::byte>(page_size + 1)), std::logic_error);
 }
 
 TEST(PagePlacement, BlockGivesContiguousRanges) {
