@@ -70,7 +70,6 @@ void add_polygon(Flattened& f, std::span<const Vec3d> v, const std::vector<Vec3d
 constexpr std::size_t objects_per_chunk = 4096;
 constexpr std::size_t chunks_per_wave = 4;  // of a scene consumed, freed and given back after each
 
-
 // Room for every primitive the scene's objects can make (a polygon of n
 // vertices n - 2 triangles, fewer only if degenerate), so that the arrays
 // are never moved while they grow, which would hold two copies at once.

@@ -656,9 +656,13 @@ void send_setup(tracer::Database& db, const RankPlan& plan, const PagePlacement&
     const int owner = static_cast<int>(n);
     const std::uint32_t own = placement.own_count(owner);
     if (plan.runs(0, n)) {
-      std::vector<std::vector<std::byte>> pages(own);
-      for (std::uint32_t i = 0; i < own; ++i) pages[i] = std::move(db.pages[placement.page_of(owner, i)]);
-      nodes[n] = node_state(NodeMemory(placement, owner, page_size, std::move(pages), cache_pages));
+      NodeMemory memory(placement, owner, page_size, cache_pages);
+      for (std::uint32_t i = 0; i < own; ++i) {
+        auto& page = db.pages[placement.page_of(owner, i)];
+        memory.place_own(i, page);
+        std::vector<std::byte>().swap(page);
+      }
+      nodes[n] = node_state(std::move(memory));
       continue;
     }
     Bytes share;

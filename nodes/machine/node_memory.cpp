@@ -60,9 +60,8 @@ NodeMemory::NodeMemory(const PagePlacement& placement, int node, std::size_t pag
     : page_size_(page_size),
       own_count_(placement.own_count(node)),
       own_(std::make_unique_for_overwrite<std::byte[]>(own_count_ * page_size)),
-      placement_(placement),
-      node_(node),
       entry_(placement.page_count(), -1) {
+  for (std::uint32_t i = 0; i < own_count_; ++i) entry_[placement.page_of(node, i)] = static_cast<std::int32_t>(i);
   // More slots than remote pages could never be filled.
   capacity_ = std::min(cache_pages, placement.page_count() - static_cast<std::uint32_t>(own_count_));
   slots_.reserve(capacity_);
@@ -73,7 +72,6 @@ void NodeMemory::place_own(std::uint32_t index, std::span<const std::byte> bytes
   if (index >= own_count_) throw std::logic_error("own page " + std::to_string(index) + " out of range");
   if (bytes.size() != page_size_) throw std::logic_error("own page of the wrong size");
   std::memcpy(own_.get() + std::size_t{index} * page_size_, bytes.data(), page_size_);
-  entry_[placement_.page_of(node_, index)] = static_cast<std::int32_t>(index);
 }
 
 int NodeMemory::take_slot(std::span<const int> in_use) {

@@ -138,8 +138,6 @@ class NodeMemory {
   std::uint32_t capacity_;
   std::size_t own_count_;
   std::unique_ptr<std::byte[]> own_;  // own_count_ pages end to end
-  PagePlacement placement_;
-  int node_;
   std::vector<std::int32_t> entry_;
   std::vector<Slot> slots_;
   std::vector<Use> uses_;  // by slot, as slots_
