@@ -17,6 +17,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <chrono>
 #include <condition_variable>
 #include <cstdint>
@@ -65,11 +66,21 @@ inline std::string replay_line(std::uint64_t seed, const std::string& program) {
 }
 
 // Bounds the wall time of one run: past `limit`, stop() once; past twice
-// the limit, abort with `what` (the case and its replay line).
+// the limit, abort with `what` (the case and its replay line). Given
+// `progress` (a count the run raises as it works, read from the watchdog's
+// thread), the limit bounds the time the run goes without the count
+// changing instead, and ten limits its whole time: a run the OS slows down
+// (a loaded machine, a sanitizer) is not taken for a hung one, while a hung
+// one, or one that works on without end, is still stopped.
 class Watchdog {
  public:
-  Watchdog(std::chrono::milliseconds limit, std::function<void()> stop, std::string what)
-      : limit_(limit), stop_(std::move(stop)), what_(std::move(what)), thread_([this] { watch(); }) {}
+  Watchdog(std::chrono::milliseconds limit, std::function<void()> stop, std::string what,
+           std::function<std::uint64_t()> progress = nullptr)
+      : limit_(limit),
+        stop_(std::move(stop)),
+        what_(std::move(what)),
+        progress_(std::move(progress)),
+        thread_([this] { watch(); }) {}
   ~Watchdog() {
     {
       std::lock_guard<std::mutex> lk(mutex_);
@@ -88,9 +99,29 @@ class Watchdog {
   }
 
  private:
+  // Waits until done (true) or until the run has gone `limit_` without
+  // progress (false), looking at the count every twentieth of the limit.
+  bool wait_for_end(std::unique_lock<std::mutex>& lk) {
+    if (!progress_) return woken_.wait_for(lk, limit_, [this] { return done_; });
+    const auto last = std::chrono::steady_clock::now() + 10 * limit_;
+    std::uint64_t seen = progress_();
+    auto deadline = std::chrono::steady_clock::now() + limit_;
+    for (;;) {
+      const auto step = std::min(std::chrono::steady_clock::now() + limit_ / 20, deadline);
+      if (woken_.wait_until(lk, step, [this] { return done_; })) return true;
+      const std::uint64_t now_seen = progress_();
+      if (now_seen != seen) {
+        seen = now_seen;
+        deadline = std::min(std::chrono::steady_clock::now() + limit_, last);
+      } else if (std::chrono::steady_clock::now() >= deadline) {
+        return false;
+      }
+    }
+  }
+
   void watch() {
     std::unique_lock<std::mutex> lk(mutex_);
-    if (woken_.wait_for(lk, limit_, [this] { return done_; })) return;
+    if (wait_for_end(lk)) return;
     fired_ = true;
     lk.unlock();
     stop_();
@@ -104,6 +135,7 @@ class Watchdog {
   const std::chrono::milliseconds limit_;
   const std::function<void()> stop_;
   const std::string what_;
+  const std::function<std::uint64_t()> progress_;
   mutable std::mutex mutex_;
   std::condition_variable woken_;
   bool done_ = false;

@@ -13,7 +13,9 @@
 // after its `end`; all-to-all traffic ends; a shutdown while packets are in
 // flight, on one rank, on all at once or from outside the runtimes, ends
 // every rank with no exception, no failure noted and no send pending. A
-// watchdog bounds each run's wall time, so a hang fails instead of stalling.
+// watchdog stops a run that delivers no packet for 20 s (or runs 200 s),
+// so a hang fails instead of stalling, and a run slowed by a busy machine
+// is not taken for one.
 // And the packets a rank sends in one pass of its thread leave together,
 // while the answers to what arrives leave at once, without the gathering.
 //
@@ -405,7 +407,7 @@ class Machine {
         [this] {
           for (auto& r : ranks_) r->net.shutdown();
         },
-        what);
+        what, [this] { return world_.delivered.load(std::memory_order_relaxed); });
     std::vector<std::thread> threads;
     for (auto& r : ranks_)
       threads.emplace_back([&r = *r] {
@@ -416,7 +418,7 @@ class Machine {
         }
       });
     for (auto& t : threads) t.join();
-    if (dog.fired()) return "no end within " + std::to_string(run_limit.count()) + " ms";
+    if (dog.fired()) return "no packet delivered for " + std::to_string(run_limit.count()) + " ms, or no end within ten times that";
     if (!world_.ledger.error().empty()) return world_.ledger.error();
     for (int k = 0; k < case_.ranks; ++k) {
       Rank& r = rank(k);
@@ -514,6 +516,39 @@ std::uint64_t packets_to(const Case& c, NodeId n) {
   std::uint64_t total = 0;
   for (const auto& row : c.packets) total += row[n];
   return total;
+}
+
+// The watchdog these runs go under: a run that goes on raising its
+// progress count past the limit is not stopped; one whose count stands
+// still is stopped once the limit has passed since the count last moved;
+// one that raises it without end is stopped at ten limits.
+TEST(BridgeWatchdog, StopsARunThatMakesNoProgressAndNotOneThatIsSlow) {
+  using namespace std::chrono_literals;
+  const auto limit = 200ms;
+  // A run of at most `runs` that looks every 10 ms whether it was stopped
+  // and, when it `moves`, raises its count each time.
+  const auto watched = [&](std::chrono::milliseconds runs, bool moves) {
+    std::atomic<std::uint64_t> count{0};
+    std::atomic<bool> stopped{false};
+    const auto start = std::chrono::steady_clock::now();
+    test::Watchdog dog(limit, [&] { stopped = true; }, "test", [&] { return count.load(); });
+    while (!stopped && std::chrono::steady_clock::now() - start < runs) {
+      std::this_thread::sleep_for(10ms);
+      if (moves) ++count;
+    }
+    return std::pair{dog.fired(), std::chrono::steady_clock::now() - start};
+  };
+  const auto [slow_fired, slow_took] = watched(3 * limit, true);  // three limits, moving on
+  EXPECT_FALSE(slow_fired);
+  EXPECT_GE(slow_took, 3 * limit);
+  const auto [still_fired, still_took] = watched(20 * limit, false);
+  EXPECT_TRUE(still_fired);
+  EXPECT_GE(still_took, limit);
+  EXPECT_LT(still_took, 10 * limit);
+  const auto [endless_fired, endless_took] = watched(20 * limit, true);  // moving on without end
+  EXPECT_TRUE(endless_fired);
+  EXPECT_GE(endless_took, 10 * limit);
+  EXPECT_LT(endless_took, 19 * limit);
 }
 
 // All-to-all traffic between every pair of nodes, K from 1 to 5, one or two
