@@ -209,6 +209,25 @@ void print_thread_use(std::ostream& out, const std::vector<csp::ThreadUse>& thre
   out << std::setprecision(3);
 }
 
+}  // namespace
+
+std::string busy_cores_note(const std::vector<csp::ThreadUse>& threads, bool over_ranks) {
+  if (threads.size() < 2) return "";
+  double cpu = 0, wanted = 0;
+  for (const csp::ThreadUse& u : threads) {
+    cpu += u.cpu_seconds;
+    wanted += u.running_seconds + u.spinning_seconds;
+  }
+  if (!(wanted > 0) || cpu >= 0.9 * wanted) return "";
+  std::ostringstream out;
+  out << std::fixed << std::setprecision(0) << "busy cores     the threads had a core " << 100 * cpu / wanted
+      << "% of the time they ran or spun: other programs took the cores, and fewer "
+      << (over_ranks ? "ranks or --threads" : "--threads") << " may be faster (a machine's threads wait on each other)\n";
+  return out.str();
+}
+
+namespace {
+
 // What crossed between threads through the relays: packets, and the wakes
 // and signals they took (packets per wake is the batching).
 void print_relays(std::ostream& out, const nodes::MachineReport& r) {
@@ -274,7 +293,10 @@ void print_machine_report(std::ostream& out, const MachineSummary& m) {
   else
     out << "; predicted " << r.predicted_seconds << " s (" << r.model->describe() << ")";
   out << "\n";
-  if (!r.model) print_thread_use(out, r.host_threads, r.ranks);
+  if (!r.model) {
+    print_thread_use(out, r.host_threads, r.ranks);
+    out << busy_cores_note(r.host_threads, !r.ranks.empty());
+  }
   print_relays(out, r);
   if (m.serial)
     out << "speedup        " << m.speedup() << " (1 node: " << m.serial->seconds << " s on "
