@@ -221,8 +221,9 @@ std::string busy_cores_note(const std::vector<csp::ThreadUse>& threads, bool ove
   if (!(wanted > 0) || cpu >= 0.9 * wanted) return "";
   std::ostringstream out;
   out << std::fixed << std::setprecision(0) << "busy cores     the threads had a core " << 100 * cpu / wanted
-      << "% of the time they ran or spun: other programs took the cores, and fewer "
-      << (over_ranks ? "ranks or --threads" : "--threads") << " may be faster (a machine's threads wait on each other)\n";
+      << "% of the time they ran or spun: other programs" << (over_ranks ? ", or ranks beyond the cores," : "")
+      << " took the cores, and fewer " << (over_ranks ? "ranks or --threads" : "--threads")
+      << " may be faster (a machine's threads wait on each other)\n";
   return out.str();
 }
 

@@ -43,9 +43,10 @@ void print_machine_report(std::ostream& out, const MachineSummary& m);
 
 // When the machine's threads had a core for less than 90% of the time they
 // ran processes or spun for work (summed over the threads: their CPU time
-// over their running and spinning time), other programs took the cores: a
-// line saying so and that fewer threads (or ranks, `over_ranks`) may be
-// faster, since a machine's threads wait on each other. "" for one thread.
+// over their running and spinning time), other programs (or, `over_ranks`,
+// ranks beyond the cores) took the cores: a line saying so and that fewer
+// threads or ranks may be faster, since a machine's threads wait on each
+// other. "" for one thread.
 std::string busy_cores_note(const std::vector<csp::ThreadUse>& threads, bool over_ranks);
 
 // The routes --trace-routes recorded, under a heading, one packet a line
