@@ -8,6 +8,7 @@
 #include <tuple>
 #include <vector>
 
+#include "app/render/cpu_count.hpp"
 #include "app/render/wording.hpp"
 #include "nodes/machine/messages.hpp"
 #include "topology/topology.hpp"
@@ -211,7 +212,7 @@ void print_thread_use(std::ostream& out, const std::vector<csp::ThreadUse>& thre
 
 }  // namespace
 
-std::string busy_cores_note(const std::vector<csp::ThreadUse>& threads, bool over_ranks) {
+std::string busy_cores_note(const std::vector<csp::ThreadUse>& threads, bool over_ranks, unsigned cpus) {
   if (threads.size() < 2) return "";
   double cpu = 0, wanted = 0;
   for (const csp::ThreadUse& u : threads) {
@@ -221,9 +222,14 @@ std::string busy_cores_note(const std::vector<csp::ThreadUse>& threads, bool ove
   if (!(wanted > 0) || cpu >= 0.9 * wanted) return "";
   std::ostringstream out;
   out << std::fixed << std::setprecision(0) << "busy cores     the threads had a core " << 100 * cpu / wanted
-      << "% of the time they ran or spun: other programs" << (over_ranks ? ", or ranks beyond the cores," : "")
-      << " took the cores, and fewer " << (over_ranks ? "ranks or --threads" : "--threads")
-      << " may be faster (a machine's threads wait on each other)\n";
+      << "% of the time they ran or spun: ";
+  if (over_ranks)
+    out << "other programs, or ranks beyond the cores, took the cores, and fewer ranks or --threads";
+  else if (cpus > 0 && threads.size() > cpus)
+    out << threads.size() << " threads took turns on the " << cpus << " CPUs this process may use, and fewer --threads";
+  else
+    out << "other programs took the cores, and fewer --threads";
+  out << " may be faster (a machine's threads wait on each other)\n";
   return out.str();
 }
 
@@ -296,7 +302,7 @@ void print_machine_report(std::ostream& out, const MachineSummary& m) {
   out << "\n";
   if (!r.model) {
     print_thread_use(out, r.host_threads, r.ranks);
-    out << busy_cores_note(r.host_threads, !r.ranks.empty());
+    out << busy_cores_note(r.host_threads, !r.ranks.empty(), usable_cpus());
   }
   print_relays(out, r);
   if (m.serial)

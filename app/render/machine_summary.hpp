@@ -43,11 +43,12 @@ void print_machine_report(std::ostream& out, const MachineSummary& m);
 
 // When the machine's threads had a core for less than 90% of the time they
 // ran processes or spun for work (summed over the threads: their CPU time
-// over their running and spinning time), other programs (or, `over_ranks`,
-// ranks beyond the cores) took the cores: a line saying so and that fewer
-// threads or ranks may be faster, since a machine's threads wait on each
-// other. "" for one thread.
-std::string busy_cores_note(const std::vector<csp::ThreadUse>& threads, bool over_ranks);
+// over their running and spinning time), something else took the cores:
+// more threads than the `cpus` the process may use, other programs, or
+// (`over_ranks`) ranks beyond the cores. A line saying which, and that
+// fewer threads or ranks may be faster, since a machine's threads wait on
+// each other. "" for one thread.
+std::string busy_cores_note(const std::vector<csp::ThreadUse>& threads, bool over_ranks, unsigned cpus);
 
 // The routes --trace-routes recorded, under a heading, one packet a line
 // ("  page_request 17: 5 → 4 → 6 (2 hops)"); nothing when none were traced.
