@@ -210,6 +210,22 @@ void print_thread_use(std::ostream& out, const std::vector<csp::ThreadUse>& thre
   out << std::setprecision(3);
 }
 
+// What crossed between threads through the relays: packets, and the wakes
+// and signals they took (packets per wake is the batching).
+void print_relays(std::ostream& out, const nodes::MachineReport& r) {
+  if (r.relays.empty()) return;
+  std::uint64_t packets = 0, wakes = 0, signals = 0;
+  for (const auto& t : r.relays) {
+    packets += t.packets_sent;
+    wakes += t.wakes;
+    signals += t.signals;
+  }
+  out << "between threads " << packets << " packets on " << r.relayed_links << " relayed links, in " << wakes
+      << " relay wakes (" << std::setprecision(2) << (wakes ? static_cast<double>(packets) / wakes : 0.0)
+      << " per wake) and " << signals << " signals\n"
+      << std::setprecision(3);
+}
+
 }  // namespace
 
 std::string busy_cores_note(const std::vector<csp::ThreadUse>& threads, bool over_ranks, unsigned cpus) {
@@ -232,26 +248,6 @@ std::string busy_cores_note(const std::vector<csp::ThreadUse>& threads, bool ove
   out << " may be faster (a machine's threads wait on each other)\n";
   return out.str();
 }
-
-namespace {
-
-// What crossed between threads through the relays: packets, and the wakes
-// and signals they took (packets per wake is the batching).
-void print_relays(std::ostream& out, const nodes::MachineReport& r) {
-  if (r.relays.empty()) return;
-  std::uint64_t packets = 0, wakes = 0, signals = 0;
-  for (const auto& t : r.relays) {
-    packets += t.packets_sent;
-    wakes += t.wakes;
-    signals += t.signals;
-  }
-  out << "between threads " << packets << " packets on " << r.relayed_links << " relayed links, in " << wakes
-      << " relay wakes (" << std::setprecision(2) << (wakes ? static_cast<double>(packets) / wakes : 0.0)
-      << " per wake) and " << signals << " signals\n"
-      << std::setprecision(3);
-}
-
-}  // namespace
 
 double MachineSummary::parallel_seconds() const {
   return report.model ? report.predicted_seconds : report.wall_seconds;

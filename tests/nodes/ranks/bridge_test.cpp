@@ -418,7 +418,8 @@ class Machine {
         }
       });
     for (auto& t : threads) t.join();
-    if (dog.fired()) return "no packet delivered for " + std::to_string(run_limit.count()) + " ms, or no end within ten times that";
+    if (dog.fired())
+      return "no packet delivered for " + std::to_string(run_limit.count()) + " ms, or no end within ten times that";
     if (!world_.ledger.error().empty()) return world_.ledger.error();
     for (int k = 0; k < case_.ranks; ++k) {
       Rank& r = rank(k);
