@@ -1,0 +1,88 @@
+#!/usr/bin/env bash
+# The figures of docs/performance.md that need a machine of many cores, in
+# one run of a few minutes (about four on 16 cores), from programs built
+# elsewhere: a build folder, or a folder packed with every library the
+# programs load (bin/NAME and a `run` script that starts bin/NAME through
+# the packed loader), for a bare machine.
+#
+#   1. `scaling_bench` on the cases of "Several threads": machine and plain
+#      renderer at 1, 2, 4, ... threads up to the CPUs, 512x512, medians of
+#      3, the default thread count beside the fastest, and for the most
+#      threads their running, spinning and sleeping shares and the packets
+#      that crossed threads per packet.
+#   2. The cases that only the most threads and one are asked for: a 64-page
+#      cache, four pixel computers a node, 256 nodes.
+#   3. For every built-in scene on 16, 64 and 256 nodes, the default thread
+#      count beside the fastest of a quarter, half and all of the CPUs.
+#   4. `commstime`: a cache line's round trip between two cores.
+#
+# Each part has its own time limit, so one that runs long leaves the others
+# their turn; its output so far is kept. Each part's output goes to OUT
+# (default: many-cores-HOSTNAME) and to the terminal. A bench that finds an
+# image different from the plain renderer's exits 1, and so does this script.
+#
+# usage: examples/bench/many_cores.sh DIR [OUT]
+#   DIR: a build folder (DIR/examples/bench/scaling_bench) or a packed one
+#   (DIR/run, DIR/bin/scaling_bench)
+set -uo pipefail
+if [ $# -lt 1 ] || [ $# -gt 2 ]; then sed -n 2,26p "$0"; exit 2; fi
+dir=$(realpath "$1")
+out=${2:-many-cores-$(hostname)}
+mkdir -p "$out" || exit 2
+
+# prog NAME: the command that starts program NAME from DIR.
+prog() {
+  if [ -x "$dir/run" ] && [ -x "$dir/bin/$1" ]; then
+    echo "$dir/run $1"
+  elif [ -x "$dir/examples/bench/$1" ]; then
+    echo "$dir/examples/bench/$1"
+  elif [ -x "$dir/examples/$1/$1" ]; then
+    echo "$dir/examples/$1/$1"
+  else
+    echo "many_cores: no program $1 in $dir" >&2
+    exit 2
+  fi
+}
+scaling=$(prog scaling_bench) || exit 2
+commstime=$(prog commstime) || exit 2
+
+cpus=$(nproc)
+threads=1
+for ((t = 2; t < cpus; t *= 2)); do threads+=",$t"; done
+[ "$cpus" -gt 1 ] && threads+=",$cpus"
+quarter=$(( cpus / 4 > 0 ? cpus / 4 : 1 ))
+half=$(( cpus / 2 > 0 ? cpus / 2 : 1 ))
+some=$(printf '%s\n' "$quarter" "$half" "$cpus" | sort -nu | paste -sd,)
+ends=$(printf '%s\n' 1 "$cpus" | sort -nu | paste -sd,)
+status=0
+
+# part NAME LIMIT_S COMMAND...: runs COMMAND, its output to OUT/NAME.txt too.
+part() {
+  local name=$1 limit=$2
+  shift 2
+  echo "== $name ($(date -u +%H:%M:%S), at most ${limit} s): $*"
+  timeout --kill-after=5 "$limit" "$@" 2>&1 | tee "$out/$name.txt"
+  local rc=${PIPESTATUS[0]}
+  case $rc in
+    0) ;;
+    124 | 137) echo "== $name: stopped after ${limit} s" ; status=1 ;;
+    *) echo "== $name: exit status $rc"; status=1 ;;
+  esac
+}
+
+# $scaling and $commstime may be "DIR/run NAME": split on purpose.
+echo "many_cores: $cpus CPUs, threads $threads; $(uname -srm); output in $out"
+grep -m1 'model name' /proc/cpuinfo || true
+# shellcheck disable=SC2086
+part threads 150 $scaling rings4:16,rings4:64,teapot:16,teapot:64 "$threads" 512 3
+# shellcheck disable=SC2086
+part most-threads 60 $scaling rings4:64:c64,rings4:16:w4,teapot:256 "$ends" 512 3
+cases=""
+for scene in teapot tetra mount rings balls gears tree mountain; do
+  for nodes in 16 64 256; do cases+="${cases:+,}$scene:$nodes"; done
+done
+# shellcheck disable=SC2086
+part default 120 $scaling "$cases" "$some" 512 3
+# shellcheck disable=SC2086
+part commstime 20 $commstime 50000 3
+exit $status
