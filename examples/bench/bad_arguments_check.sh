@@ -53,4 +53,22 @@ expect 2 network_bench abc
 expect 2 scaling_bench teapot:3
 expect 2 scaling_bench teapot:16 2,1
 expect 1 nff_bench --read /nonexistent
+
+# many_cores.sh, a script beside this one: the same rules, for a missing or
+# wrong DIR, before it runs anything.
+script=$(dirname "$0")/many_cores.sh
+for args in "" "$scratch/nosuch" "$scratch"; do
+  # shellcheck disable=SC2086 # "" is no argument at all
+  bash "$script" $args >"$scratch/out" 2>"$scratch/err"
+  rc=$?
+  if [[ $rc -ne 2 || $(head -n 1 "$scratch/err") != "many_cores.sh: "* || $(sed -n 2p "$scratch/err") != usage:* ||
+        -s "$scratch/out" ]]; then
+    echo "FAIL: many_cores.sh $args -> exit $rc (want 2); stderr: $(head -c 300 "$scratch/err")"
+    failed=1
+  fi
+done
+if ! bash "$script" --help | head -n 1 | grep -q '^usage: '; then
+  echo "FAIL: many_cores.sh --help prints no usage"
+  failed=1
+fi
 exit $failed

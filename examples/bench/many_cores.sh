@@ -25,10 +25,18 @@
 #   DIR: a build folder (DIR/examples/bench/scaling_bench) or a packed one
 #   (DIR/run, DIR/bin/scaling_bench)
 set -uo pipefail
-if [ $# -lt 1 ] || [ $# -gt 2 ]; then sed -n 2,26p "$0"; exit 2; fi
+usage() { echo "usage: examples/bench/many_cores.sh DIR [OUT]  (the script's head says more)"; }
+# bad ARGS...: one line naming the script, then the usage, exit 2.
+bad() {
+  echo "many_cores.sh: $*" >&2
+  usage >&2
+  exit 2
+}
+case ${1:-} in -h | --help) usage; sed -n 2,26p "$0"; exit 0 ;; esac
+if [ $# -lt 1 ] || [ $# -gt 2 ]; then bad "expected DIR [OUT], got $# arguments"; fi
+[ -d "$1" ] || bad "DIR '$1' is not a folder"
 dir=$(realpath "$1")
 out=${2:-many-cores-$(hostname)}
-mkdir -p "$out" || exit 2
 
 # prog NAME: the command that starts program NAME from DIR.
 prog() {
@@ -39,12 +47,12 @@ prog() {
   elif [ -x "$dir/examples/$1/$1" ]; then
     echo "$dir/examples/$1/$1"
   else
-    echo "many_cores: no program $1 in $dir" >&2
-    exit 2
+    bad "no program $1 in $dir (a build folder, or a packed one with bin/$1)"
   fi
 }
 scaling=$(prog scaling_bench) || exit 2
 commstime=$(prog commstime) || exit 2
+mkdir -p "$out" || exit 1
 
 cpus=$(nproc)
 threads=1
