@@ -4,6 +4,7 @@
 #include "nodes/net/router.hpp"
 
 #include <algorithm>
+#include <cstring>
 #include <optional>
 #include <stdexcept>
 #include <string>
@@ -32,15 +33,32 @@ struct ThreadRelays::Link {
 // a push or a drain reads the other side's line only when the view says
 // full or empty. The ring holds exactly the entries that can be out on it
 // (a complete graph has millions of relayed links), and each side keeps
-// its own slot index rather than a power-of-two mask. A Packet's vectors
-// move in and out of a slot without allocating.
+// its own slot index rather than a power-of-two mask.
+// An entry is one cache line, written by the producer only and read by the
+// consumer only, so a packet moves one line across. A packet of the usual
+// shape (no route, a payload of up to inline_payload bytes: every message
+// of the machine but a result) is packed into it field by field and made
+// afresh on the far side, which allocates nothing; any other is moved to
+// the heap and the entry carries the pointer.
 class ThreadRelays::Ring {
  public:
-  struct Entry {
+  struct alignas(64) Entry {
     std::uint32_t link = 0;
     std::uint32_t credits = 0;
-    Packet packet;
+    NodeId source = 0;
+    NodeId destination = 0;
+    std::uint64_t id = 0;
+    const std::byte* shared = nullptr;
+    std::uint64_t shared_size = 0;
+    std::byte payload[inline_payload] = {};  // or, when boxed, the Packet*
+    std::uint16_t port = 0;
+    std::uint16_t hops = 0;
+    std::uint8_t kind = 0;
+    std::uint8_t flags = 0;
+    std::uint8_t payload_size = 0;
   };
+  static_assert(sizeof(Entry) == ring_entry_bytes);
+  static constexpr std::uint8_t traced = 1, recorded = 2, boxed = 4;
 
   explicit Ring(std::size_t capacity) : slots_(std::max<std::size_t>(capacity, 1)) {}
 
@@ -51,21 +69,76 @@ class ThreadRelays::Ring {
     head_seen_ = head_.load(std::memory_order_acquire);
     if (tail_ - head_seen_ + n > slots_.size()) throw std::logic_error("thread relay: ring full");
   }
-  // After reserve(): a packet moved in, or credits; unpublished until publish().
-  void put(std::uint32_t link, Packet& packet) { claim(link, 0).packet = std::move(packet); }
+  // After reserve(): a packet (left valid but unspecified), or credits;
+  // unpublished until publish().
+  void put(std::uint32_t link, Packet& packet) {
+    Entry& e = claim(link, 0);
+    if (packet.payload.size() > inline_payload || !packet.route.empty()) {
+      auto* box = new Packet(std::move(packet));
+      e.flags = boxed;
+      std::memcpy(e.payload, &box, sizeof box);
+      return;
+    }
+    e.source = packet.source;
+    e.destination = packet.destination;
+    e.id = packet.id;
+    e.shared = packet.shared.data();
+    e.shared_size = packet.shared.size();
+    std::memcpy(e.payload, packet.payload.data(), packet.payload.size());
+    e.port = packet.port;
+    e.hops = packet.hops;
+    e.kind = packet.kind;
+    e.flags = static_cast<std::uint8_t>((packet.traced ? traced : 0) | (packet.recorded ? recorded : 0));
+    e.payload_size = static_cast<std::uint8_t>(packet.payload.size());
+  }
   void put_credits(std::uint32_t link, std::uint32_t credits) { claim(link, credits); }
   void publish() { tail_published_.store(tail_, std::memory_order_release); }
 
-  // Takes every entry published so far; the head is published once.
+  // The packet an entry carries (credits == 0).
+  static Packet unpack(const Entry& e) {
+    if (e.flags & boxed) {
+      Packet* box = nullptr;
+      std::memcpy(&box, e.payload, sizeof box);
+      const std::unique_ptr<Packet> owner(box);
+      return std::move(*box);
+    }
+    Packet p;
+    p.source = e.source;
+    p.destination = e.destination;
+    p.kind = e.kind;
+    p.port = e.port;
+    p.hops = e.hops;
+    p.traced = (e.flags & traced) != 0;
+    p.recorded = (e.flags & recorded) != 0;
+    p.id = e.id;
+    p.payload.assign(e.payload, e.payload + e.payload_size);
+    p.shared = {e.shared, static_cast<std::size_t>(e.shared_size)};
+    return p;
+  }
+
+  // Takes every entry published so far; the head is published once. An
+  // entry is taken once even if `take` throws (a poisoned network), for
+  // taking a boxed packet frees it.
   template <class F>
   void drain(F&& take) {
     const std::uint64_t tail = tail_published_.load(std::memory_order_acquire);
     if (tail == head_local_) return;
-    for (; head_local_ != tail; ++head_local_) {
-      take(slots_[head_slot_]);
+    while (head_local_ != tail) {
+      const Entry& e = slots_[head_slot_];
       head_slot_ = next(head_slot_);
+      ++head_local_;
+      take(e);
     }
     head_.store(head_local_, std::memory_order_release);
+  }
+
+  // Boxed packets still in the ring (a run that ended with packets in flight).
+  ~Ring() {
+    for (; head_local_ != tail_; ++head_local_) {
+      const Entry& e = slots_[head_slot_];
+      if (e.credits == 0 && (e.flags & boxed)) (void)unpack(e);
+      head_slot_ = next(head_slot_);
+    }
   }
 
  private:
@@ -210,7 +283,7 @@ class ThreadRelays::Relay {
     ++relays_.counters_[thread_].wakes;
     for (unsigned from = 0; from < relays_.threads_; ++from) {
       if (from == thread_) continue;
-      relays_.ring(from, thread_).drain([this](Ring::Entry& e) {
+      relays_.ring(from, thread_).drain([this](const Ring::Entry& e) {
         if (e.credits > 0) {
           Outgoing& o = outgoing_[out_index_[e.link]];
           if (o.credits == 0) alt_.enable(o.guard, true);
@@ -219,12 +292,13 @@ class ThreadRelays::Relay {
         }
         Incoming& i = incoming_[in_index_[e.link]];
         ++relays_.counters_[thread_].packets_received;
-        if (i.staged.empty() && relays_.links_[i.link].deliver(e.packet)) {
+        Packet packet = Ring::unpack(e);
+        if (i.staged.empty() && relays_.links_[i.link].deliver(packet)) {
           owe(i);
           return;
         }
         if (i.staged.empty()) alt_.enable(i.guard, true);
-        i.staged.push_back(std::move(e.packet));
+        i.staged.push_back(std::move(packet));
       });
     }
   }

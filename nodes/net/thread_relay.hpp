@@ -63,6 +63,10 @@ class ThreadRelays {
   // The most credit entries of one link out on a ring at once, for links of
   // `capacity` packets.
   static std::size_t credit_entries(std::size_t capacity);
+  // The bytes of one ring entry (a packet or credits); a packet that is not
+  // of the usual shape (a route, or more than inline_payload bytes of
+  // payload) takes a Packet on the heap besides while it is in the ring.
+  static constexpr std::size_t ring_entry_bytes = 64;
 
  private:
   struct Link;

@@ -8,13 +8,14 @@
 // from csp::SeededScheduler.)
 //
 // What every seed must show: each packet arrives once, in its link's order,
-// with its payload intact; a link never holds more than its three buffers
-// of K packets (the queue, the relays' credits, the input), and one whose
-// receiver stalls fills to 3K but for the credits held back (fewer than
-// K/2); all-to-all traffic with one very slow reader ends; poison while
-// packets are in flight, from a process or from outside the runtime, ends
-// every process with no exception. A watchdog bounds each run's wall time,
-// so a hang fails instead of stalling.
+// with every field intact (payload, shared bytes, route); a link never
+// holds more than its three buffers of K packets (the queue, the relays'
+// credits, the input), and one whose receiver stalls fills to 3K but for
+// the credits held back (fewer than K/2); all-to-all traffic with one very
+// slow reader ends; poison while packets are in flight, from a process or
+// from outside the runtime, ends every process with no exception. A
+// watchdog bounds each run's wall time, so a hang fails instead of
+// stalling.
 //
 // A seed fixes the threads, K, the links, their traffic and every process's
 // pauses; the OS still interleaves the threads, so a seed replays its case,
@@ -26,6 +27,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <array>
 #include <atomic>
 #include <chrono>
 #include <cstdint>
@@ -103,19 +105,34 @@ Case draw_case(std::uint64_t seed, std::uint64_t min_packets, std::uint64_t max_
   return c;
 }
 
-// Packet `id` of link `link`: every field and the payload (0 to 47 bytes)
-// follow from the two, so that a receiver can check it whole.
+// Bytes that packets carry by reference (Packet::shared).
+const std::array<std::byte, 256> shared_bytes = [] {
+  std::array<std::byte, 256> b{};
+  for (std::size_t i = 0; i < b.size(); ++i) b[i] = static_cast<std::byte>(i);
+  return b;
+}();
+
+// Packet `id` of link `link`: every field, the payload (0 to 47 bytes:
+// inside a ring entry up to 16, on the heap beyond), the shared bytes and,
+// for a traced packet, a route (on the heap too) follow from the two, so
+// that a receiver can check it whole.
 Packet make_packet(std::size_t link, std::uint64_t id) {
   const std::uint64_t h = mix(link * 0x9e3779b97f4a7c15ULL + id + 1);
   Packet p;
   p.source = static_cast<nodes::NodeId>(link);
   p.destination = static_cast<nodes::NodeId>(h >> 40);
-  p.kind = nodes::kind_traffic;
+  p.kind = static_cast<std::uint8_t>(h >> 56);
   p.port = static_cast<std::uint16_t>(h);
+  p.hops = static_cast<std::uint16_t>(h >> 16);
+  p.traced = (h >> 32 & 7) == 0;
+  p.recorded = (h >> 35 & 1) != 0;
   p.id = id;
   p.payload.resize(h % 48);
   for (std::size_t i = 0; i < p.payload.size(); ++i)
     p.payload[i] = static_cast<std::byte>(mix(h + i) & 0xff);
+  p.shared = std::span<const std::byte>(shared_bytes).subspan(h >> 24 & 0x7f, h >> 36 & 0x7f);
+  if (p.traced)
+    for (std::uint64_t k = 0; k <= (h >> 44 & 3); ++k) p.route.push_back(static_cast<nodes::NodeId>(mix(h + k)));
   return p;
 }
 
@@ -126,7 +143,9 @@ void check_packet(const Packet& p, std::size_t link, std::uint64_t id) {
   if (p.source != want.source || p.id != id)
     throw std::logic_error(where + "packet " + std::to_string(p.id) + " of link " + std::to_string(p.source) +
                            " arrived where packet " + std::to_string(id) + " was due");
-  if (p.destination != want.destination || p.kind != want.kind || p.port != want.port || p.payload != want.payload)
+  if (p.destination != want.destination || p.kind != want.kind || p.port != want.port || p.hops != want.hops ||
+      p.traced != want.traced || p.recorded != want.recorded || p.payload != want.payload ||
+      p.shared.data() != want.shared.data() || p.shared.size() != want.shared.size() || p.route != want.route)
     throw std::logic_error(where + "packet " + std::to_string(id) + " arrived altered");
 }
 
