@@ -239,7 +239,7 @@ namespace {
 constexpr std::uint64_t node_bytes = 38 * 1024, virtual_node_bytes = 67 * 1024;
 constexpr std::uint64_t worker_bytes = 7680;
 constexpr std::uint64_t link_queue_bytes = 640, virtual_link_queue_bytes = 9600;
-constexpr std::uint64_t relayed_link_bytes = 480;
+constexpr std::uint64_t relayed_link_bytes = 576;
 constexpr std::uint64_t ring_entry_bytes = nodes::ThreadRelays::ring_entry_bytes;
 constexpr std::uint64_t recorded_packet_bytes = 600, recorded_hop_bytes = 240;  // a packet, and each hop it makes
 constexpr std::uint64_t page_entry = sizeof(std::int32_t);  // a node's page table, and a tracer's page stamps

@@ -143,7 +143,7 @@ TEST(MemoryCheck, RefusesAMachineAboveTheLimitNamingTheOptions) {
   } catch (const app::UsageError& e) {
     EXPECT_STREQ(e.what(),
                  "--nodes/--topology: complete:4096 (4096 nodes, 16773120 link queues, 8388608 of them between 2 "
-                 "threads) needs about 18.2 GB with its image, more than the 11.0 GB this process's control group may use");
+                 "threads) needs about 19.0 GB with its image, more than the 11.0 GB this process's control group may use");
   }
 }
 
