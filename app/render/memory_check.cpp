@@ -393,10 +393,16 @@ std::string describe_memory(const Options& o, int width, int height, std::uint32
   const std::uint64_t image = image_memory_bytes(o, width, height);
   const std::uint64_t needed = (o.single ? 0 : m.total()) + image;
   const std::uint64_t mapped = (o.single ? 0 : m.mapped()) + image;
-  const std::uint64_t held = limit.source == MemoryLimit::Source::address_space ? mapped : needed;
+  // The comparison follows the figure the limit holds: the bytes mapped
+  // under ulimit -v, else the resident ones.
+  const bool address_space = limit.source == MemoryLimit::Source::address_space;
+  const auto against = [&](std::uint64_t bytes) {
+    return std::string(bytes > limit.bytes ? ", more" : ", less") + " than " + available(limit);
+  };
   std::ostringstream text;
-  text << "needs about " << about(needed) << " (" << needed << " bytes) resident, and maps about " << about(mapped)
-       << ": " << (held > limit.bytes ? "more" : "less") << " than " << available(limit) << "\n";
+  text << "needs about " << about(needed) << " (" << needed << " bytes) resident"
+       << (address_space ? "" : against(needed)) << ", and maps about " << about(mapped)
+       << (address_space ? against(mapped) : "") << "\n";
   text << "  image " << width << "x" << height << ": " << about(image) << "\n";
   if (o.single) return text.str();
   text << "  machine " << machine_words(m) << ":\n";

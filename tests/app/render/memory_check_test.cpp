@@ -9,6 +9,7 @@
 #include <filesystem>
 #include <fstream>
 #include <optional>
+#include <regex>
 #include <string>
 #include <utility>
 #include <vector>
@@ -266,6 +267,26 @@ TEST(MemoryCheck, TheLimitIsTheLeastOfPhysicalMemoryControlGroupAndAddressSpace)
   const app::MemoryLimit limit = app::memory_limit();
   EXPECT_EQ(limit.bytes, expected.bytes);
   EXPECT_EQ(limit.source, expected.source);
+}
+
+// --estimate-memory's first line holds the limit against the figure the
+// check compares: the resident bytes, or under ulimit -v the bytes mapped,
+// which a machine's stacks make the larger.
+TEST(MemoryCheck, TheEstimateSetsTheLimitBesideTheFigureItHolds) {
+  using Source = app::MemoryLimit::Source;
+  const app::Options o = parse_words("--topology complete:256 --threads 2");
+  const auto first_line = [&](app::MemoryLimit limit) {
+    const std::string text = app::describe_memory(o, 16, 16, 661, limit);
+    return text.substr(0, text.find('\n'));
+  };
+  const std::regex resident_held(R"(needs about \S+ \S+ \(\d+ bytes\) resident, less than this machine's 1000\.0 GB, )"
+                                 R"(and maps about \S+ \S+)");
+  EXPECT_TRUE(std::regex_match(first_line({1'000'000'000'000, Source::machine}), resident_held))
+      << first_line({1'000'000'000'000, Source::machine});
+  const std::regex mapped_held(R"(needs about \S+ MB \(\d+ bytes\) resident, and maps about \S+ MB, more than )"
+                               R"(the 1 MB this process may map \(ulimit -v\))");
+  EXPECT_TRUE(std::regex_match(first_line({1'000'000, Source::address_space}), mapped_held))
+      << first_line({1'000'000, Source::address_space});
 }
 
 }  // namespace
