@@ -15,6 +15,8 @@
 #   3. For every built-in scene on 16, 64 and 256 nodes, the default thread
 #      count beside the fastest of a quarter, half and all of the CPUs.
 #   4. `commstime`: a cache line's round trip between two cores.
+# Last, the cases where the default thread count was more than 10% slower
+# than the fastest (OUT/summary.txt).
 #
 # Each part has its own time limit, so one that runs long leaves the others
 # their turn; its output so far is kept. Each part's output goes to OUT
@@ -32,7 +34,7 @@ bad() {
   usage >&2
   exit 2
 }
-case ${1:-} in -h | --help) usage; sed -n 2,26p "$0"; exit 0 ;; esac
+case ${1:-} in -h | --help) usage; awk 'NR > 1 && /^#/ {print; next} NR > 1 {exit}' "$0"; exit 0 ;; esac
 if [ $# -lt 1 ] || [ $# -gt 2 ]; then bad "expected DIR [OUT], got $# arguments"; fi
 [ -d "$1" ] || bad "DIR '$1' is not a folder"
 dir=$(realpath "$1")
@@ -93,4 +95,14 @@ done
 part default 120 $scaling "$cases" "$some" 512 3
 # shellcheck disable=SC2086
 part commstime 20 $commstime 50000 3
+
+# The default thread count against the fastest, over every case of the
+# runs above: the cases where it is more than 10% slower.
+cat "$out"/threads.txt "$out"/most-threads.txt "$out"/default.txt 2>/dev/null |
+  awk '/ machine .*x the fastest/ {
+         n++; r = $0; sub(/x the fastest.*/, "", r); sub(/.* /, "", r)
+         if (r + 0 > 1.10) { slow++; print "  default beyond 10% of the fastest: " $1 " " r "x" }
+       }
+       END { printf "== default thread count: %d of %d cases more than 10%% slower than the fastest\n", slow, n }' |
+  tee "$out/summary.txt"
 exit $status
