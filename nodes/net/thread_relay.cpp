@@ -58,6 +58,9 @@ class ThreadRelays::Ring {
     std::uint8_t payload_size = 0;
   };
   static_assert(sizeof(Entry) == ring_entry_bytes);
+  // put() and unpack() carry every field of a Packet; one added there
+  // changes its size, and must be carried here too.
+  static_assert(sizeof(Packet) == 104, "a Packet field that put() and unpack() do not carry");
   static constexpr std::uint8_t traced = 1, recorded = 2, boxed = 4;
 
   explicit Ring(std::size_t capacity) : slots_(std::max<std::size_t>(capacity, 1)) {}
