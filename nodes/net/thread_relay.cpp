@@ -6,9 +6,11 @@
 #include <algorithm>
 #include <cstring>
 #include <optional>
+#include <span>
 #include <stdexcept>
 #include <string>
 #include <utility>
+#include <vector>
 
 namespace nodes {
 
@@ -58,9 +60,19 @@ class ThreadRelays::Ring {
     std::uint8_t payload_size = 0;
   };
   static_assert(sizeof(Entry) == ring_entry_bytes);
-  // put() and unpack() carry every field of a Packet; one added there
-  // changes its size, and must be carried here too.
-  static_assert(sizeof(Packet) == 104, "a Packet field that put() and unpack() do not carry");
+  // The fields put() and unpack() carry, in Packet's order: a field added
+  // to Packet most likely makes the two sizes differ, whatever the ABI.
+  struct Carried {
+    NodeId source, destination;
+    std::uint8_t kind;
+    std::uint16_t port, hops;
+    bool traced, recorded;
+    std::uint64_t id;
+    Payload payload;
+    std::span<const std::byte> shared;
+    std::vector<NodeId> route;
+  };
+  static_assert(sizeof(Packet) == sizeof(Carried), "a Packet field that put() and unpack() do not carry");
   static constexpr std::uint8_t traced = 1, recorded = 2, boxed = 4;
 
   explicit Ring(std::size_t capacity) : slots_(std::max<std::size_t>(capacity, 1)) {}
