@@ -87,13 +87,16 @@ class ThreadRelays::Ring {
   // After reserve(): a packet (left valid but unspecified), or credits;
   // unpublished until publish().
   void put(std::uint32_t link, Packet& packet) {
-    Entry& e = claim(link, 0);
     if (packet.payload.size() > inline_payload || !packet.route.empty()) {
+      // Boxed before the entry is claimed: an allocation that fails leaves
+      // the ring as it was.
       auto* box = new Packet(std::move(packet));
+      Entry& e = claim(link, 0);
       e.flags = boxed;
       std::memcpy(e.payload, &box, sizeof box);
       return;
     }
+    Entry& e = claim(link, 0);
     e.source = packet.source;
     e.destination = packet.destination;
     e.id = packet.id;
