@@ -404,7 +404,8 @@ struct GridWalk {
 };
 
 // The walk of a grid of `dims` cells over `box` from the point at distance t.
-GridWalk start_walk(const Box3f& box, const int dims[3], const Ray& ray, const RayInverse& inv, float t) {
+[[gnu::always_inline]] inline GridWalk start_walk(const Box3f& box, const int dims[3], const Ray& ray,
+                                                  const RayInverse& inv, float t) {
   GridWalk w{};
   const Vec3f p = ray.origin + ray.dir * t;
   const std::int64_t strides[3] = {1, dims[0], std::int64_t{dims[0]} * dims[1]};
@@ -492,8 +493,14 @@ bool Tracer::test_cell(const GridCell& cell, std::uint64_t ray_tag, const Ray& r
     const std::uint64_t byte = (std::uint64_t{cell.first} + k) * sizeof(std::uint32_t);
     const std::size_t run = std::min<std::uint64_t>(
         {cell.count - k, kRun, (header_.page_size - (byte & offset_mask)) / sizeof(std::uint32_t)});
-    std::memcpy(ids, fetch(lists.first_page + static_cast<PageId>(byte >> page_shift), stats) + (byte & offset_mask),
-                run * sizeof(std::uint32_t));
+    const std::byte* from =
+        fetch(lists.first_page + static_cast<PageId>(byte >> page_shift), stats) + (byte & offset_mask);
+    // A short run is copied as sixteen ids when the page holds them, a copy of
+    // fixed size that needs no call; the ids past the run are not used.
+    if (run <= 16 && header_.page_size - (byte & offset_mask) >= 16 * sizeof(std::uint32_t))
+      std::memcpy(ids, from, 16 * sizeof(std::uint32_t));
+    else
+      std::memcpy(ids, from, run * sizeof(std::uint32_t));
     stats.record_reads += run;
     k += static_cast<std::uint32_t>(run);
     for (std::size_t i = 0; i < run; ++i) {
@@ -584,11 +591,13 @@ bool jump_empty(GridWalk& w, const int dims[3], std::uint32_t distance, float t_
 // hit found in one cell may lie in a later one, where a primitive met there
 // could be nearer; with the mailbox each primitive is tested once a ray. A
 // top cell holding a subgrid is walked the same way from where the ray
-// enters it (Top = false: a subgrid holds no subgrid).
+// enters it (Top = false: a subgrid holds no subgrid). Inlined, as the
+// walk's start is, so that entering a subgrid costs no call.
 template <bool Any, bool Top>
-bool Tracer::walk_grid(const Box3f& box, const int dims[3], std::uint64_t base, float t_enter, const Ray& ray,
-                       const RayInverse& inv, std::uint64_t ray_tag, float t_min, float& t_max, Hit* hit,
-                       RayStats& stats) {
+[[gnu::always_inline]] inline bool Tracer::walk_grid(const Box3f& box, const int dims[3], std::uint64_t base,
+                                                   float t_enter, const Ray& ray, const RayInverse& inv,
+                                                   std::uint64_t ray_tag, float t_min, float& t_max, Hit* hit,
+                                                   RayStats& stats) {
   GridWalk w = start_walk(box, dims, ray, inv, t_enter);
   bool found = false;
   for (;;) {
