@@ -505,13 +505,13 @@ bool Tracer::test_cell(const GridCell& cell, std::uint64_t ray_tag, const Ray& r
   };
   for (std::uint32_t k = 0; k < cell.count;) {
     const std::uint64_t byte = (std::uint64_t{cell.first} + k) * sizeof(std::uint32_t);
-    const std::size_t run = std::min<std::uint64_t>(
-        {cell.count - k, kRun, (header_.page_size - (byte & offset_mask)) / sizeof(std::uint32_t)});
-    const std::byte* from =
-        fetch(lists.first_page + static_cast<PageId>(byte >> page_shift), stats) + (byte & offset_mask);
+    const std::uint64_t offset = byte & offset_mask;
+    const std::uint64_t in_page = (header_.page_size - offset) / sizeof(std::uint32_t);  // ids left in the page
+    const std::size_t run = std::min<std::uint64_t>({cell.count - k, kRun, in_page});
+    const std::byte* from = fetch(lists.first_page + static_cast<PageId>(byte >> page_shift), stats) + offset;
     // A short run is copied as sixteen ids when the page holds them, a copy of
     // fixed size that needs no call; the ids past the run are not used.
-    if (run <= 16 && header_.page_size - (byte & offset_mask) >= 16 * sizeof(std::uint32_t))
+    if (run <= 16 && in_page >= 16)
       std::memcpy(ids, from, 16 * sizeof(std::uint32_t));
     else
       std::memcpy(ids, from, run * sizeof(std::uint32_t));

@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <cstring>
+#include <memory>
 #include <optional>
 #include <span>
 #include <stdexcept>
@@ -114,12 +115,7 @@ class ThreadRelays::Ring {
 
   // The packet an entry carries (credits == 0).
   static Packet unpack(const Entry& e) {
-    if (e.flags & boxed) {
-      Packet* box = nullptr;
-      std::memcpy(&box, e.payload, sizeof box);
-      const std::unique_ptr<Packet> owner(box);
-      return std::move(*box);
-    }
+    if (e.flags & boxed) return std::move(*take_box(e));
     Packet p;
     p.source = e.source;
     p.destination = e.destination;
@@ -154,12 +150,18 @@ class ThreadRelays::Ring {
   ~Ring() {
     for (; head_local_ != tail_; ++head_local_) {
       const Entry& e = slots_[head_slot_];
-      if (e.credits == 0 && (e.flags & boxed)) (void)unpack(e);
+      if (e.credits == 0 && (e.flags & boxed)) take_box(e);
       head_slot_ = next(head_slot_);
     }
   }
 
  private:
+  // The heap packet of a boxed entry, owned by the caller from now on.
+  static std::unique_ptr<Packet> take_box(const Entry& e) {
+    Packet* box = nullptr;
+    std::memcpy(&box, e.payload, sizeof box);
+    return std::unique_ptr<Packet>(box);
+  }
   std::size_t next(std::size_t slot) const { return slot + 1 == slots_.size() ? 0 : slot + 1; }
   // The entry at the tail, addressed to `link`; the tail moves past it.
   Entry& claim(std::uint32_t link, std::uint32_t credits) {
