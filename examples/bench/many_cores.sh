@@ -15,8 +15,10 @@
 #   3. For every built-in scene on 16, 64 and 256 nodes, the default thread
 #      count beside the fastest of a quarter, half and all of the CPUs.
 #   4. `commstime`: a cache line's round trip between two cores.
-# Last, the cases where the default thread count was more than 10% slower
-# than the fastest (OUT/summary.txt).
+# Last (OUT/summary.txt), the cases where the default thread count was more
+# than 10% slower than the fastest, and part 1's times on 4 threads or more
+# that the model of T threads, fitted to its runs on 1 and 2 threads,
+# missed by more than 25%.
 #
 # Each part has its own time limit, so one that runs long leaves the others
 # their turn; its output so far is kept. Each part's output goes to OUT
@@ -105,4 +107,18 @@ cat "$out"/threads.txt "$out"/most-threads.txt "$out"/default.txt 2>/dev/null |
        }
        END { printf "== default thread count: %d of %d cases more than 10%% slower than the fastest\n", slow, n }' |
   tee "$out/summary.txt"
+# The model's predictions for 4 threads or more against the measured times
+# (fields THREADS:MEASURED/PREDICTED on the line after a case's model).
+awk '/ machine  / { label = $1 }
+     /measured \/ model/ {
+       for (i = 1; i <= NF; i++) {
+         if ($i !~ /^[0-9]+:[0-9.]+x$/) continue
+         split($i, f, ":"); t = f[1] + 0; r = f[2]; sub(/x$/, "", r)
+         if (t < 4) continue
+         n++
+         if (r + 0 > 1.25 || r + 0 < 0.8) { off++; print "  model off by more than 25%: " label " on " t " threads, measured " r "x the prediction" }
+       }
+     }
+     END { printf "== model of T threads: %d of %d predictions (4 threads or more) off by more than 25%%\n", off, n }' \
+  "$out/threads.txt" 2>/dev/null | tee -a "$out/summary.txt"
 exit $status

@@ -4,8 +4,11 @@
 // the default thread count (threads 0, nodes::thread_count) beside the
 // fastest. For the largest thread count, how the machine's threads spent the
 // run (running, spinning, sleeping: shares of their wall time) and the
-// packets that crossed threads per packet delivered, so that a model of T
-// threads can be fitted to counts and costs measured here.
+// packets that crossed threads per packet delivered. When THREADS holds 1
+// and 2, each case's time on every count is also predicted by the model of
+// T threads (nodes::ThreadModel), fitted to the runs on 1 and 2 threads and
+// to two nodes of the same scene and caches on 1 and 2 threads, and put
+// beside the measured time.
 //
 // Every figure is the median of REPEATS wall times around the call that
 // renders (database built beforehand, on both sides). Each round runs every
@@ -32,6 +35,7 @@
 
 #include "examples/bench/bench_args.hpp"
 #include "nodes/machine/machine.hpp"
+#include "nodes/machine/thread_model.hpp"
 #include "topology/spec.hpp"
 #include "tracer/generators.hpp"
 #include "tracer/render.hpp"
@@ -123,6 +127,7 @@ struct MachineSample {
   double seconds = 0;
   double running = 0, spinning = 0, sleeping = 0, wall = 0;  // summed over threads
   std::uint64_t crossings = 0, packets = 0;
+  std::uint64_t misses = 0;  // page requests sent: the same on any thread count
   unsigned threads = 0;
 };
 
@@ -147,6 +152,7 @@ MachineSample run_machine(const Case& c, const tracer::Database& source, unsigne
   }
   for (const nodes::RelayCounters& r : result.report.relays) s.crossings += r.packets_sent;
   s.packets = result.report.network.hops.packets;
+  s.misses = result.report.svm().misses;
   if (!same(result.image.pixels(), reference)) differs = true;
   return s;
 }
@@ -162,8 +168,49 @@ struct Row {
   std::map<unsigned, std::vector<double>> machine, plain;  // by threads; 0: the default
   std::vector<MachineSample> widest;                      // the machine's runs on the most threads
   unsigned default_threads = 0;
+  std::uint64_t misses = 0;
   bool differs = false;
 };
+
+// Two nodes of a case's scene and caches, one pixel computer each, on one
+// thread and on two: what the model's latency is fitted to.
+struct LatencyRuns {
+  std::vector<double> one, two;
+  std::uint64_t misses = 0;
+};
+
+Case latency_case(const Case& c) {
+  Case f = c;
+  f.nodes = 2;
+  f.workers = 1;
+  return f;
+}
+
+std::string latency_key(const Case& c) {
+  return c.scene + (c.cache_pages ? ":c" + std::to_string(*c.cache_pages) : std::string());
+}
+
+// The model fitted to a row's runs on 1 and 2 threads and its scene's two
+// nodes, its prediction for every thread count, and measured over predicted.
+// The summary of examples/bench/many_cores.sh reads the last line's
+// THREADS:RATIO fields.
+void print_model(const Case& c, const Row& row, const LatencyRuns& fit, const std::vector<unsigned>& threads) {
+  nodes::ThreadModel model;
+  model.work_seconds = median(row.machine.at(1));
+  model.misses = static_cast<double>(row.misses);
+  model.pixel_computers = static_cast<double>(c.nodes) * c.workers;
+  model.crossing_seconds = nodes::ThreadModel::fit_crossing(model.work_seconds, median(row.machine.at(2)), model.misses);
+  model.latency_seconds = nodes::ThreadModel::fit_latency(median(fit.one), median(fit.two),
+                                                          static_cast<double>(fit.misses), model.crossing_seconds);
+  std::printf("%-12s model  ", "");
+  for (const unsigned t : threads) std::printf(" %8.3f", model.predict(t));
+  std::printf("   c %.2f us a crossing, L %.1f us (2 nodes: %.3f s on 1 thread, %.3f s on 2), %llu misses\n",
+              1e6 * model.crossing_seconds, 1e6 * model.latency_seconds, median(fit.one), median(fit.two),
+              static_cast<unsigned long long>(row.misses));
+  std::printf("%-12s measured / model", "");
+  for (const unsigned t : threads) std::printf(" %u:%.2fx", t, median(row.machine.at(t)) / model.predict(t));
+  std::printf("\n");
+}
 
 void print_row(const Case& c, const Row& row, const std::vector<unsigned>& threads) {
   const double one = median(row.machine.at(threads.front()));
@@ -201,7 +248,8 @@ const char* const usage =
     "  default: rings4:16,rings4:64,teapot:16,teapot:64 1,2,4,8,16 512 3\n"
     "  CASES: SCENE:NODES[:wWORKERS][:cCACHE_PAGES], comma-separated (a hypercube of NODES, a power of\n"
     "  two; WORKERS pixel computers a node, 1..64; CACHE_PAGES a node, default 1/8 of the database)\n"
-    "  THREADS: increasing, 1..1024; SIZE 16..4096; REPEATS 1..100\n";
+    "  THREADS: increasing, 1..1024; SIZE 16..4096; REPEATS 1..100\n"
+    "  THREADS starting 1,2: each case's time predicted by the model of T threads, beside it\n";
 
 int bench_scaling(const std::vector<std::string>& args) {
   if (args.size() > 4) throw bench::BadArgument{"too many arguments"};
@@ -211,6 +259,7 @@ int bench_scaling(const std::vector<std::string>& args) {
   const int repeats = args.size() > 3 ? static_cast<int>(bench::parse_int(args[3], 1, 100, "REPEATS")) : 3;
   std::map<std::string, tracer::Database> dbs;
   std::map<std::string, std::vector<tracer::Color>> reference;
+  bool any_differs = false;
   for (const Case& c : cases) {
     if (dbs.count(c.scene)) continue;
     dbs.emplace(c.scene, make_db(c.scene, size));  // an unknown scene fails here, before any run
@@ -221,7 +270,25 @@ int bench_scaling(const std::vector<std::string>& args) {
   for (const unsigned t : threads) std::printf(" %u", t);
   std::printf("\n");
   std::vector<Row> rows(cases.size());
-  for (int r = 0; r < repeats; ++r)
+  const bool modelled = threads.size() >= 2 && threads[0] == 1 && threads[1] == 2;
+  std::map<std::string, LatencyRuns> fits;  // by latency_key
+  for (int r = 0; r < repeats; ++r) {
+    if (modelled)
+      for (const Case& c : cases) {
+        LatencyRuns& fit = fits[latency_key(c)];
+        if (fit.one.size() > static_cast<std::size_t>(r)) continue;  // a case of the same scene and caches did it
+        const Case f = latency_case(c);
+        const tracer::Database& db = dbs.at(c.scene);
+        bool differs = false;
+        const MachineSample one = run_machine(f, db, 1, reference.at(c.scene), differs);
+        fit.one.push_back(one.seconds);
+        fit.two.push_back(run_machine(f, db, 2, reference.at(c.scene), differs).seconds);
+        fit.misses = one.misses;
+        if (differs) {
+          std::printf("%s on 2 nodes: IMAGE DIFFERS\n", c.label.c_str());
+          any_differs = true;
+        }
+      }
     for (std::size_t i = 0; i < cases.size(); ++i) {
       const Case& c = cases[i];
       const tracer::Database& db = dbs.at(c.scene);
@@ -231,18 +298,20 @@ int bench_scaling(const std::vector<std::string>& args) {
         rows[i].differs = rows[i].differs || !same(image, reference.at(c.scene));
         const MachineSample s = run_machine(c, db, t, reference.at(c.scene), rows[i].differs);
         rows[i].machine[t].push_back(s.seconds);
+        rows[i].misses = s.misses;
         if (t == threads.back()) rows[i].widest.push_back(s);
       }
       const MachineSample d = run_machine(c, db, 0, reference.at(c.scene), rows[i].differs);
       rows[i].machine[0].push_back(d.seconds);
       rows[i].default_threads = d.threads;
     }
-  bool differs = false;
+  }
   for (std::size_t i = 0; i < cases.size(); ++i) {
     print_row(cases[i], rows[i], threads);
-    differs = differs || rows[i].differs;
+    if (modelled) print_model(cases[i], rows[i], fits.at(latency_key(cases[i])), threads);
+    any_differs = any_differs || rows[i].differs;
   }
-  return differs ? 1 : 0;
+  return any_differs ? 1 : 0;
 }
 
 }  // namespace
