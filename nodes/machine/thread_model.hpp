@@ -1,23 +1,17 @@
 // nodes::ThreadModel: a machine's render time on T runtime threads,
-// predicted from what runs on one and two threads measure (docs/
-// performance.md, "A model for T threads").
-//
-// Nodes sit on threads in subcubes (Network::block_placement) and a page's
-// owner is uniform over the nodes, so e-cube routing crosses a thread
-// boundary r = log2 T times a miss on average, half each way. Each crossing
-// costs the threads c seconds of CPU, and its packet a latency L; a thread
-// with k pixel computers idles when all k wait, which a miss's round trip
-// R = r L brings about when it exceeds what the other k - 1 compute in the
-// meantime, (k - 1) t with t = W / M:
+// predicted from runs on one and two threads (docs/performance.md, "A model
+// for T threads"). Nodes sit on threads in subcubes and a page's owner is
+// uniform over the nodes, so a miss crosses threads r = log2 T times; each
+// crossing costs c of CPU and its packet a latency L; a thread of k pixel
+// computers idles when a miss's round trip R = r L exceeds what the other
+// k - 1 compute meanwhile, (k - 1) t with t = W / M:
 //
 //   time(T) = W / T + r M c / T + (M / T) max(0, R - (k - 1) t)
 //
-// W is the one-thread time, M the page misses (the same on any thread
-// count). c is fitted to two threads with many pixel computers each (no
-// idling), L to two nodes on two threads (one pixel computer each, so every
-// remote miss idles its thread). Counts other than T that are not powers of
-// two take r = log2 T as well; more threads than pixel computers count as
-// that many threads. Pure arithmetic: it runs nothing.
+// W: the one-thread time; M: page misses (the same on any thread count); c
+// fitted to two threads with many pixel computers each, L to two nodes on
+// two threads. Counts that are not powers of two take r = log2 T too; more
+// threads than pixel computers count as that many. Pure arithmetic.
 #pragma once
 
 namespace nodes {
