@@ -582,12 +582,20 @@ bool yield_requested() {
   return s && s->yield_requested();
 }
 
-void yield() {
+namespace {
+// Yields with `mark` set in the caller's properties, for the scheduler to
+// place it by (FifoScheduler::awakened clears it).
+void yield_marked(bool ProcessProps::*mark) {
   if (detail::thread_scheduler())
     if (auto* props = boost::fibers::context::active()->get_properties())
-      static_cast<ProcessProps*>(props)->yielded = true;
+      static_cast<ProcessProps*>(props)->*mark = true;
   boost::this_fiber::yield();
 }
+}  // namespace
+
+void yield() { yield_marked(&ProcessProps::yielded); }
+
+void yield_to_urgent() { yield_marked(&ProcessProps::ahead); }
 
 bool yield_to_all() {
   const Scheduler* s = detail::thread_algorithm();

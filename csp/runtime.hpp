@@ -118,6 +118,16 @@ void yield();
 // wait. Never counted as blocked.
 bool yield_to_all();
 
+// Lets the work that yield_requested() reports run, then goes on ahead of
+// every other low-priority process (FifoScheduler: the ready high-priority
+// processes and the wakes from other threads run, and the caller resumes
+// before the low-priority processes that were or became ready meanwhile);
+// yield() under schedulers without the rule. A long low-priority
+// computation that asks between small steps so answers a packet for its
+// thread within a step, without handing its turn to the thread's other
+// computations. Never counted as blocked.
+void yield_to_urgent();
+
 // True if the calling thread has work that should not wait for the caller
 // to finish a long computation: under FifoScheduler, a ready high-priority
 // process, or a process woken from another thread and not yet dispatched

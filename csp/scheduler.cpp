@@ -67,13 +67,20 @@ std::chrono::microseconds idle_spin(unsigned threads, unsigned hardware_threads)
 // on a message has little left to do before it waits again, and the ones
 // that yielded are the long computations it would otherwise queue behind.
 // A process of either priority that yields to all goes behind every one.
+// A low-priority process that yields to urgent work goes ahead of every
+// other of its priority (the front of the woken ones), behind the
+// high-priority ones (a wake from another thread has the dispatcher run
+// first, so it is among those).
 void FifoScheduler::awakened(boost::fibers::context* ctx, ProcessProps& props) noexcept {
   const bool yielded = std::exchange(props.yielded, false);
+  const bool ahead = std::exchange(props.ahead, false);
   if (ctx->is_context(boost::fibers::type::dispatcher_context)) {
     dispatcher_ = ctx;
   } else if (std::exchange(props.behind_all, false)) {
     ctx->ready_link(ready_low_);
     dispatch_soon_ = true;
+  } else if (ahead && props.process && props.process->priority == Priority::low) {
+    ready_low_woken_.push_front(*ctx);
   } else if (props.process && props.process->priority == Priority::low) {
     ctx->ready_link(yielded ? ready_low_ : ready_low_woken_);
     // A long computation offers the thread: timers due meanwhile go first.

@@ -59,6 +59,7 @@ class ProcessProps : public boost::fibers::fiber_properties {
   const bool virtual_time;             // these are VirtualProps (virtual_time.hpp)
   bool yielded = false;                // set by csp::yield(), cleared when the fiber is ready again
   bool behind_all = false;             // set by csp::yield_to_all(), cleared likewise
+  bool ahead = false;                  // set by csp::yield_to_urgent(), cleared likewise
 };
 
 // The base of the runtime's schedulers.

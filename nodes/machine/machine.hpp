@@ -117,6 +117,17 @@ struct MachineOptions {
 constexpr std::size_t min_pixel_computers_per_thread = 2;
 unsigned thread_count(const MachineOptions& options, std::size_t nodes);
 
+// Whether the pixel computers of a process that runs `local_nodes` nodes on
+// `threads` threads in real time answer a packet for their thread after any
+// pixel (csp::yield_to_urgent), rather than at their next page miss or
+// timeslice: when a thread holds at most answer_at_once_workers of them, too
+// few for the others to hide what a page request that waits there costs the
+// thread that sent it. Never on one thread of a whole machine, under virtual
+// time or under a schedule seed (the caller says which: `prioritised`, true
+// when pixel computers run at low priority and yield at all).
+constexpr std::size_t answer_at_once_workers = 4;
+bool answers_at_once(const MachineOptions& options, std::size_t local_nodes, unsigned threads, bool prioritised);
+
 // The bounds check_options() holds the fields to: a tile of at most a
 // million pixels, and at most 64 pixel computers on one node (each is a
 // process with its own stack and port).

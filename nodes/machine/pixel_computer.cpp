@@ -83,6 +83,12 @@ void PixelComputer::compute(Tile tile) {
     if (pacing_.timeslice > 0 && (i + 1) % pacing_.timeslice == 0) {
       links_.source.release();  // another worker of the node may run and evict our page
       csp::yield();
+    } else if (pacing_.answer_at_once && csp::yield_requested()) {
+      // A packet reached this thread (a page request, say, that another
+      // thread's pixel computer waits on): the relay and the servers run now,
+      // and this pixel computer goes on before the thread's others.
+      links_.source.release();
+      csp::yield_to_urgent();
     }
   }
   counters.items += tile.count;

@@ -1,7 +1,7 @@
 // A pixel computer: one fiber that asks the farmer for work, traces it
 // through its node's shared virtual memory and sends the colours back. A
-// processor runs one or more (Shape::workers_per_node), so page
-// waits of one overlap with tracing by another.
+// processor runs one or more (Shape::workers_per_node), so page waits of one
+// overlap with tracing by another.
 //
 // It reads only its own local port (Ports::first_worker + w): the farmer's
 // work and stop answers, P + 1 always owed to it (P = prefetch), and the
@@ -10,9 +10,9 @@
 // after each tile and worker_done once every answer is in, then ends; its
 // node's observer (node_observer.hpp) hears of each miss and each tile. On
 // several threads it runs at low priority and yields every `timeslice`
-// items. The protocol and why the port drains: docs/architecture.md ("The
-// path of one pixel", "The path of one page request", "Messages", "Why the
-// network cannot deadlock").
+// items, and with few pixel computers a thread lets a packet for its thread
+// be handled after any item (`answer_at_once`). The protocol and why the
+// port drains: docs/architecture.md ("The path of one pixel" and after).
 #pragma once
 
 #include <cstdint>
@@ -99,6 +99,7 @@ struct WorkerLinks {
 struct WorkerPacing {
   std::uint16_t prefetch = 0;        // tiles asked for beyond the one traced (Farming::prefetch)
   std::uint32_t timeslice = 0;       // items traced between two csp::yield()s; 0: never yield
+  bool answer_at_once = false;       // after any item, csp::yield_to_urgent() when csp::yield_requested()
   NodeObserver* observer = nullptr;  // told of each tile before its result is sent; null: nobody
   RunClock clock;                    // set: record a TileSpan per tile
 };

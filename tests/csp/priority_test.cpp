@@ -372,3 +372,71 @@ TEST(Priority, YieldToAllDeclinesUnderVirtualTime) {
 }
 
 }  // namespace
+
+namespace {
+
+// One thread. A low-priority process that yields to urgent work lets the
+// ready high-priority process run, and the one that process wakes, and then
+// goes on before the low-priority processes ready before it (woken or
+// yielded) and the one woken meanwhile; after a plain yield it would run
+// after all of them.
+TEST(Priority, AProcessThatYieldsToUrgentWorkGoesOnBeforeTheOtherLowPriorityOnes) {
+  csp::Channel<int> wake_high("wake high", 1), wake_low("wake low", 1);
+  std::vector<std::string> log;
+  csp::Runtime rt(1);
+  rt.spawn("high", 0, [in = wake_high.reader(), out = wake_low.writer(), &log]() mutable {
+    in.read();
+    log.push_back("high");
+    out.write(1);  // wakes "woken"
+  });
+  rt.spawn(
+      "woken", 0,
+      [in = wake_low.reader(), &log]() mutable {
+        in.read();
+        log.push_back("woken");
+      },
+      csp::Priority::low);
+  rt.spawn(
+      "yielded", 0,
+      [&log] {
+        csp::yield();
+        log.push_back("yielded");
+        csp::yield();  // ready, behind "computer", when that yields to urgent work
+        log.push_back("yielded again");
+      },
+      csp::Priority::low);
+  rt.spawn(
+      "computer", 0,
+      [out = wake_high.writer(), &log]() mutable {
+        csp::yield();  // sorted by its priority from here on
+        out.write(1);  // "high" is ready: the urgent work
+        log.push_back(csp::yield_requested() ? "asked" : "not asked");
+        csp::yield_to_urgent();
+        log.push_back("computer goes on");
+        csp::yield();
+        log.push_back("computer again");
+      },
+      csp::Priority::low);
+  rt.run();
+  EXPECT_EQ(log, (std::vector<std::string>{"yielded", "asked", "high", "computer goes on", "woken", "yielded again",
+                                           "computer again"}));
+}
+
+// Under virtual time the clocks order processes: yield_to_urgent() is a
+// plain yield, and the run ends as with one.
+TEST(Priority, YieldToUrgentIsAPlainYieldUnderVirtualTime) {
+  csp::RuntimeOptions options;
+  options.threads = 1;
+  options.scheduler = csp::virtual_time_scheduler();
+  std::vector<std::string> log;
+  csp::Runtime rt(options);
+  rt.spawn("other", 0, [&log] { log.push_back("other"); });
+  rt.spawn("asker", 0, [&log] {
+    csp::yield_to_urgent();
+    log.push_back("asker");
+  });
+  rt.run();
+  EXPECT_EQ(log, (std::vector<std::string>{"other", "asker"}));
+}
+
+}  // namespace

@@ -459,6 +459,43 @@ TEST(Machine, DefaultThreadsLeaveEachThreadTwoPixelComputers) {
   EXPECT_EQ(nodes::run_machine(make_db("balls:1", 1024, 16), run).report.threads, 2u);
 }
 
+// Pixel computers answer a packet for their thread at once when it holds at
+// most four of them, counted with their workers; never on one thread of a
+// whole machine or under a schedule seed (not prioritised, or seeded).
+TEST(Machine, PixelComputersAnswerAtOnceWhenTheirThreadHoldsFew) {
+  MachineOptions o;
+  EXPECT_TRUE(nodes::answers_at_once(o, 2, 2, true));
+  EXPECT_TRUE(nodes::answers_at_once(o, 8, 2, true));
+  EXPECT_FALSE(nodes::answers_at_once(o, 16, 2, true));
+  EXPECT_TRUE(nodes::answers_at_once(o, 64, 16, true));
+  EXPECT_FALSE(nodes::answers_at_once(o, 256, 16, true));
+  EXPECT_FALSE(nodes::answers_at_once(o, 2, 2, false));
+  o.shape.workers_per_node = 4;
+  EXPECT_TRUE(nodes::answers_at_once(o, 2, 2, true));
+  EXPECT_FALSE(nodes::answers_at_once(o, 4, 2, true));
+  o.shape.workers_per_node = 1;
+  o.schedule_seed = 7;
+  EXPECT_FALSE(nodes::answers_at_once(o, 2, 2, true));
+}
+
+// Answering at once changes when packets are handled, never what the run
+// computes: two nodes on two threads give the image and the statistics of
+// one thread.
+TEST(Machine, AnsweringAtOnceGivesTheImageAndStatisticsOfOneThread) {
+  const tracer::Database db = make_db("rings:1", 1024, 48);
+  MachineOptions one;
+  one.topology = topology::parse_topology("hypercube", 2);
+  one.threads.count = 1;
+  MachineOptions two = one;
+  two.threads.count = 2;
+  ASSERT_TRUE(nodes::answers_at_once(two, 2, 2, true));
+  const nodes::MachineResult a = nodes::run_machine(db, one), b = nodes::run_machine(db, two);
+  EXPECT_EQ(a.image.pixels(), b.image.pixels());
+  EXPECT_EQ(a.report.svm().misses, b.report.svm().misses);
+  EXPECT_EQ(a.report.rays().rays(), b.report.rays().rays());
+  EXPECT_EQ(b.report.threads, 2u);
+}
+
 TEST(Machine, PageCommunicationsEqualMissesWithSharedCaches) {
   const auto result = run_case({"mesh", 9, 2, 256, 2, Schedule::dynamic, 3, 1});
   EXPECT_EQ(result.report.served().pages_served, result.report.svm().misses);
