@@ -71,7 +71,8 @@ po::options_description describe_machine(Options& o, Raw& raw) {
       ("threads", po::value(&raw.threads)->default_value(0),
        "OS threads carrying the processors, 0..4096 (0: the CPUs this process may use, by its affinity and CPU "
        "quota, but at most one thread for every two pixel computers, --nodes x --workers-per-node, so that a "
-       "processor waiting for a page leaves its thread another to run; never more than --nodes); with "
+       "processor waiting for a page leaves its thread another to run, and two for two or three nodes; never "
+       "more than --nodes); with "
        "--single, threads tracing rows (at most the image's rows); the database is built on as many")
       ("cache-pages", po::value(&raw.cache_pages),
        "remote pages cached per node (default: 1/8 of the database, at least 64 pages)")

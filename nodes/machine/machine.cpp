@@ -289,7 +289,7 @@ unsigned thread_count(const MachineOptions& options, std::size_t nodes) {
   const std::size_t cpus =
       options.threads.cpus ? options.threads.cpus : std::max(1u, std::thread::hardware_concurrency());
   const std::size_t workers = static_cast<std::size_t>(std::max(options.shape.workers_per_node, 1));
-  const std::size_t by_workers = std::max<std::size_t>(nodes * workers / min_pixel_computers_per_thread, 1);
+  const std::size_t by_workers = std::max<std::size_t>(nodes * workers / min_pixel_computers_per_thread, 2);
   return static_cast<unsigned>(std::min({cpus, by_workers, nodes}));
 }
 

@@ -112,7 +112,9 @@ struct MachineOptions {
 // The OS threads that carry `nodes` nodes of a run: threads.count when given,
 // else the CPUs, but no more than one thread for every
 // min_pixel_computers_per_thread pixel computers (nodes x workers), so that
-// a pixel computer waiting for a page leaves its thread another to run;
+// a pixel computer waiting for a page leaves its thread another to run,
+// though two threads whenever two nodes and two CPUs are there (two nodes
+// on two threads, answering at once, beat one thread on every scene);
 // never more than the nodes.
 constexpr std::size_t min_pixel_computers_per_thread = 2;
 unsigned thread_count(const MachineOptions& options, std::size_t nodes);

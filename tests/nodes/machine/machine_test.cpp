@@ -429,8 +429,9 @@ TEST(Machine, DefaultCacheIsAnEighthOfTheDatabaseButNeverTooSmallForARay) {
 }
 
 // --threads 0 takes the CPUs, but leaves each thread two pixel computers,
-// so that one waiting for a page does not idle its thread; a number given
-// is taken as it is, at most one thread a node.
+// so that one waiting for a page does not idle its thread, save that two
+// nodes get two threads when two CPUs are there; a number given is taken as
+// it is, at most one thread a node.
 TEST(Machine, DefaultThreadsLeaveEachThreadTwoPixelComputers) {
   MachineOptions o;
   o.threads.cpus = 16;
@@ -438,7 +439,8 @@ TEST(Machine, DefaultThreadsLeaveEachThreadTwoPixelComputers) {
   EXPECT_EQ(nodes::thread_count(o, 64), 16u);
   EXPECT_EQ(nodes::thread_count(o, 256), 16u);
   EXPECT_EQ(nodes::thread_count(o, 5), 2u);
-  EXPECT_EQ(nodes::thread_count(o, 2), 1u);
+  EXPECT_EQ(nodes::thread_count(o, 3), 2u);
+  EXPECT_EQ(nodes::thread_count(o, 2), 2u);
   EXPECT_EQ(nodes::thread_count(o, 1), 1u);
   o.shape.workers_per_node = 4;
   EXPECT_EQ(nodes::thread_count(o, 16), 16u);
@@ -446,7 +448,10 @@ TEST(Machine, DefaultThreadsLeaveEachThreadTwoPixelComputers) {
   o.threads.cpus = 2;
   o.shape.workers_per_node = 1;
   EXPECT_EQ(nodes::thread_count(o, 16), 2u);
-  EXPECT_EQ(nodes::thread_count(o, 3), 1u);
+  EXPECT_EQ(nodes::thread_count(o, 3), 2u);
+  o.threads.cpus = 1;
+  EXPECT_EQ(nodes::thread_count(o, 2), 1u);
+  o.threads.cpus = 2;
   o.threads.count = 16;
   o.threads.cpus = 0;
   EXPECT_EQ(nodes::thread_count(o, 16), 16u);
