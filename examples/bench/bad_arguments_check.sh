@@ -52,6 +52,7 @@ expect 2 packet_bench 0
 expect 2 network_bench abc
 expect 2 scaling_bench teapot:3
 expect 2 scaling_bench teapot:16 2,1
+expect 2 scaling_bench teapot:16:a2
 expect 1 nff_bench --read /nonexistent
 
 # many_cores.sh, a script beside this one: the same rules, for a missing or

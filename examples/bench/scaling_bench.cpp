@@ -17,7 +17,7 @@
 // renderer's; a difference is printed and makes the exit status 1.
 //
 // usage: scaling_bench [CASES [THREADS [SIZE [REPEATS]]]]
-//   CASES: SCENE:NODES[:wWORKERS][:cCACHE_PAGES], e.g. rings4:64:c64
+//   CASES: SCENE:NODES[:wWORKERS][:cCACHE_PAGES][:a0|:a1], e.g. rings4:64:c64
 //   default: rings4:16,rings4:64,teapot:16,teapot:64 1,2,4,8,16 512 3
 //   THREADS: increasing counts, 1..1024 (more than the cores oversubscribes
 //   them); SIZE 16..4096; REPEATS 1..100; a bad argument: usage, exit 2
@@ -50,6 +50,7 @@ struct Case {
   int nodes = 16;
   int workers = 1;                          // :wW
   std::optional<std::uint32_t> cache_pages;  // :cC; none: the default
+  std::optional<bool> answer_at_once;       // :a1 or :a0; none: the machine's rule (nodes::answers_at_once)
 };
 
 std::vector<std::string> split(const std::string& text) {
@@ -59,8 +60,8 @@ std::vector<std::string> split(const std::string& text) {
   return parts;
 }
 
-// SCENE:NODES[:wWORKERS][:cCACHE_PAGES]; a scene spec may hold colons of
-// its own, so the fields are taken from the end.
+// SCENE:NODES[:wWORKERS][:cCACHE_PAGES][:a0|:a1]; a scene spec may hold
+// colons of its own, so the fields are taken from the end.
 Case parse_case(const std::string& item) {
   Case c;
   c.label = item;
@@ -68,11 +69,13 @@ Case parse_case(const std::string& item) {
   for (;;) {
     const auto colon = rest.rfind(':');
     if (colon == std::string::npos || colon == 0)
-      throw bench::BadArgument{"CASES: expected SCENE:NODES[:wWORKERS][:cCACHE_PAGES], got '" + item + "'"};
+      throw bench::BadArgument{"CASES: expected SCENE:NODES[:wWORKERS][:cCACHE_PAGES][:a0|:a1], got '" + item + "'"};
     const std::string field = rest.substr(colon + 1);
     rest.resize(colon);
     if (!field.empty() && field[0] == 'w') {
       c.workers = static_cast<int>(bench::parse_int(field.substr(1), 1, 64, "CASES' WORKERS"));
+    } else if (field == "a0" || field == "a1") {
+      c.answer_at_once = field == "a1";
     } else if (!field.empty() && field[0] == 'c') {
       c.cache_pages = static_cast<std::uint32_t>(bench::parse_int(field.substr(1), 1, 1 << 24, "CASES' CACHE_PAGES"));
     } else {
@@ -139,6 +142,7 @@ MachineSample run_machine(const Case& c, const tracer::Database& source, unsigne
   options.threads.count = threads;  // 0: the default rule
   options.shape.workers_per_node = c.workers;
   if (c.cache_pages) options.cache.pages = c.cache_pages;
+  options.threads.answer_at_once = c.answer_at_once;
   const auto start = Clock::now();
   const nodes::MachineResult result = nodes::run_machine(std::move(db), options);
   MachineSample s;
@@ -187,7 +191,8 @@ Case latency_case(const Case& c) {
 }
 
 std::string latency_key(const Case& c) {
-  return c.scene + (c.cache_pages ? ":c" + std::to_string(*c.cache_pages) : std::string());
+  return c.scene + (c.cache_pages ? ":c" + std::to_string(*c.cache_pages) : std::string()) +
+         (c.answer_at_once ? (*c.answer_at_once ? ":a1" : ":a0") : "");
 }
 
 // The model fitted to a row's runs on 1 and 2 threads and its scene's two
@@ -246,8 +251,10 @@ void print_row(const Case& c, const Row& row, const std::vector<unsigned>& threa
 const char* const usage =
     "usage: scaling_bench [CASES [THREADS [SIZE [REPEATS]]]]\n"
     "  default: rings4:16,rings4:64,teapot:16,teapot:64 1,2,4,8,16 512 3\n"
-    "  CASES: SCENE:NODES[:wWORKERS][:cCACHE_PAGES], comma-separated (a hypercube of NODES, a power of\n"
-    "  two; WORKERS pixel computers a node, 1..64; CACHE_PAGES a node, default 1/8 of the database)\n"
+    "  CASES: SCENE:NODES[:wWORKERS][:cCACHE_PAGES][:a0|:a1], comma-separated (a hypercube of NODES, a\n"
+    "  power of two; WORKERS pixel computers a node, 1..64; CACHE_PAGES a node, default 1/8 of the\n"
+    "  database; a1 or a0: pixel computers answer a packet for their thread at once, or not, whatever\n"
+    "  the machine's rule says)\n"
     "  THREADS: increasing, 1..1024; SIZE 16..4096; REPEATS 1..100\n"
     "  THREADS starting 1,2: each case's time predicted by the model of T threads, beside it\n";
 

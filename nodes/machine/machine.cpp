@@ -297,8 +297,10 @@ unsigned thread_count(const MachineOptions& options, std::size_t nodes) {
 // 10-20% faster answering at once; 16 and 64 nodes (8 and 32 a thread): up
 // to 5% slower, the switches costing more than the wait they save.
 bool answers_at_once(const MachineOptions& options, std::size_t local_nodes, unsigned threads, bool prioritised) {
+  if (!prioritised || options.schedule_seed) return false;
+  if (options.threads.answer_at_once) return *options.threads.answer_at_once;
   const std::size_t workers = local_nodes * static_cast<std::size_t>(std::max(options.shape.workers_per_node, 1));
-  return prioritised && !options.schedule_seed && workers <= answer_at_once_workers * std::max(threads, 1u);
+  return workers <= answer_at_once_workers * std::max(threads, 1u);
 }
 
 std::uint32_t default_cache_pages(const tracer::DatabaseHeader& header) {

@@ -79,6 +79,7 @@ struct Threads {
   bool relay_between = true;     // links between threads through relays (NetworkOptions::relay_between_threads)
   bool forward_in_place = true;  // routers of one thread route in place (NetworkOptions); real time only
   bool shared_cores = false;     // other processes share the cores (csp::RuntimeOptions::shared_cores)
+  std::optional<bool> answer_at_once;  // pixel computers answer at once (answers_at_once); none: by the rule
 };
 
 // The machine's shape beside its topology: the pixel computers on each node,
@@ -126,7 +127,8 @@ unsigned thread_count(const MachineOptions& options, std::size_t nodes);
 // few for the others to hide what a page request that waits there costs the
 // thread that sent it. Never on one thread of a whole machine, under virtual
 // time or under a schedule seed (the caller says which: `prioritised`, true
-// when pixel computers run at low priority and yield at all).
+// when pixel computers run at low priority and yield at all); else
+// threads.answer_at_once when set (to measure the rule), else the rule.
 constexpr std::size_t answer_at_once_workers = 4;
 bool answers_at_once(const MachineOptions& options, std::size_t local_nodes, unsigned threads, bool prioritised);
 

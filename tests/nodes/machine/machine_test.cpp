@@ -479,6 +479,12 @@ TEST(Machine, PixelComputersAnswerAtOnceWhenTheirThreadHoldsFew) {
   EXPECT_TRUE(nodes::answers_at_once(o, 2, 2, true));
   EXPECT_FALSE(nodes::answers_at_once(o, 4, 2, true));
   o.shape.workers_per_node = 1;
+  o.threads.answer_at_once = true;  // set to measure the rule: taken where pixel computers yield at all
+  EXPECT_TRUE(nodes::answers_at_once(o, 256, 16, true));
+  EXPECT_FALSE(nodes::answers_at_once(o, 256, 16, false));
+  o.threads.answer_at_once = false;
+  EXPECT_FALSE(nodes::answers_at_once(o, 2, 2, true));
+  o.threads.answer_at_once.reset();
   o.schedule_seed = 7;
   EXPECT_FALSE(nodes::answers_at_once(o, 2, 2, true));
 }
