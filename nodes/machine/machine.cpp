@@ -619,8 +619,7 @@ Executed execute(const tracer::DatabaseHeader& header, const topology::Topology&
   const double wall_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
 
   Executed executed;
-  MachineResult& result = executed.result;
-  MachineReport& report = result.report;
+  MachineReport& report = executed.result.report;
   report = machine_report(runtime, net, timing, header, options, cache_pages, items.count, nodes);
   report.wall_seconds = wall_seconds;
   if (recorder && !split) report.recording = recording_of(*recorder, topology, report);
@@ -632,7 +631,7 @@ Executed execute(const tracer::DatabaseHeader& header, const topology::Topology&
     report.farmer.steals = host.plan->steals();
     report.collected = host.frame->received();
     report.owners = std::move(host.owners);
-    result.image = assemble_image(header, items.grid, host.frame->take_colors());
+    executed.result.image = assemble_image(header, items.grid, host.frame->take_colors());
   }
   return executed;
 }
