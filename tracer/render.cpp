@@ -668,6 +668,7 @@ bool Tracer::traverse_grid(const Ray& ray, float t_min, float& t_max_io, Hit* hi
 }
 
 std::optional<Hit> Tracer::closest_hit(const Ray& ray, float t_min, float t_max, RayStats& stats) {
+  if (ray_hook_) ray_hook_(ray_hook_context_);
   if (header_.primitive_count == 0) return std::nullopt;
   Hit hit;
   const bool found = header_.accel == Accel::bvh
@@ -677,6 +678,7 @@ std::optional<Hit> Tracer::closest_hit(const Ray& ray, float t_min, float t_max,
 }
 
 bool Tracer::occluded(const Ray& ray, float t_min, float t_max, RayStats& stats) {
+  if (ray_hook_) ray_hook_(ray_hook_context_);
   if (header_.primitive_count == 0) return false;
   return header_.accel == Accel::bvh ? traverse_bvh<true>(ray, t_min, t_max, nullptr, stats)
                                      : traverse_grid<true>(ray, t_min, t_max, nullptr, stats);

@@ -66,6 +66,15 @@ class Tracer {
   std::optional<Hit> closest_hit(const Ray& ray, float t_min, float t_max, RayStats& stats);
   bool occluded(const Ray& ray, float t_min, float t_max, RayStats& stats);
 
+  // Called before every ray the two queries above cast, with `context`; none
+  // by default. It may suspend the caller, provided nothing else reads this
+  // Tracer's PageSource meanwhile: the page read last stays in use.
+  using RayHook = void (*)(void* context);
+  void set_ray_hook(RayHook hook, void* context) {
+    ray_hook_ = hook;
+    ray_hook_context_ = context;
+  }
+
  private:
   // Where record `index` of a section lies; valid until the next page read.
   const std::byte* locate(Section section, std::uint64_t index, std::size_t size, RayStats& stats);
@@ -124,6 +133,8 @@ class Tracer {
   static constexpr std::size_t kMailboxSlots = 1024;
   std::vector<std::uint64_t> mailbox_;
   std::uint32_t ray_id_ = 0;
+  RayHook ray_hook_ = nullptr;
+  void* ray_hook_context_ = nullptr;
 };
 
 // Renders a whole frame sequentially into row-major pixels (y = 0 at the top);

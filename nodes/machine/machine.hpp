@@ -131,6 +131,10 @@ unsigned thread_count(const MachineOptions& options, std::size_t nodes);
 // threads.answer_at_once when set (to measure the rule), else the rule.
 constexpr std::size_t answer_at_once_workers = 4;
 bool answers_at_once(const MachineOptions& options, std::size_t local_nodes, unsigned threads, bool prioritised);
+// Whether they also do so before every ray: when they answer at once and
+// each is alone on its thread, where nothing else hides even the rest of a
+// pixel (nor reads its pages meanwhile).
+bool answers_between_rays(const MachineOptions& options, std::size_t local_nodes, unsigned threads, bool prioritised);
 
 // The bounds check_options() holds the fields to: a tile of at most a
 // million pixels, and at most 64 pixel computers on one node (each is a

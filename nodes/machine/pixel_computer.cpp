@@ -41,7 +41,16 @@ Packet WorkerPort::page_reply() {
 }
 
 PixelComputer::PixelComputer(const TraceWork& work, const WorkerLinks& links, WorkerPacing pacing)
-    : links_(links), pacing_(std::move(pacing)), tracer_(work.header, links.source, work.options), grid_(work.grid) {}
+    : links_(links), pacing_(std::move(pacing)), tracer_(work.header, links.source, work.options), grid_(work.grid) {
+  // Alone on its thread, nothing else reads this pixel computer's pages while
+  // it lets the relay and the servers run, so it may do so between rays.
+  if (pacing_.answer_between_rays)
+    tracer_.set_ray_hook(
+        [](void*) {
+          if (csp::yield_requested()) csp::yield_to_urgent();
+        },
+        nullptr);
+}
 
 void PixelComputer::run() {
   SvmSource& source = links_.source;

@@ -100,6 +100,7 @@ struct WorkerPacing {
   std::uint16_t prefetch = 0;        // tiles asked for beyond the one traced (Farming::prefetch)
   std::uint32_t timeslice = 0;       // items traced between two csp::yield()s; 0: never yield
   bool answer_at_once = false;       // after any item, csp::yield_to_urgent() when csp::yield_requested()
+  bool answer_between_rays = false;  // the same before every ray (Tracer::set_ray_hook): alone on its thread
   NodeObserver* observer = nullptr;  // told of each tile before its result is sent; null: nobody
   RunClock clock;                    // set: record a TileSpan per tile
 };

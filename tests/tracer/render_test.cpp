@@ -1,6 +1,7 @@
 // Renders of a small scene: independent of page size, of the page cache, of
 // how pixels are split; BVH and grid agree; SPD mode counts rays as specified.
-// A lit polygon of thousands of vertices does not shadow itself.
+// A lit polygon of thousands of vertices does not shadow itself. A ray hook
+// runs before every ray and changes nothing.
 #include "tracer/render.hpp"
 
 #include <gtest/gtest.h>
@@ -91,6 +92,27 @@ TEST(Render, PixelsDoNotDependOnTraceOrder) {
   for (int y = kSize - 1; y >= 0; y -= 3)
     for (int x = kSize - 1; x >= 0; x -= 5)
       EXPECT_EQ(tracer.trace_pixel(x, y, stats), frame[std::size_t(y) * kSize + x]);
+}
+
+// The ray hook is called once before every ray cast, eye, shadow and
+// secondary alike, and changes nothing of the render: same pixels, same
+// counts, the same pages read.
+TEST(Render, TheRayHookRunsBeforeEveryRayAndChangesNothing) {
+  const Scene scene = testing::showcase_scene(kSize);
+  const Database db = build_database(scene);
+  InMemoryPageSource pages(db);
+  RayStats plain_stats, hooked_stats;
+  Tracer plain(db.header, pages), hooked(db.header, pages);
+  std::uint64_t calls = 0;
+  hooked.set_ray_hook([](void* count) { ++*static_cast<std::uint64_t*>(count); }, &calls);
+  for (int y = 0; y < kSize; ++y)
+    for (int x = 0; x < kSize; ++x)
+      ASSERT_EQ(hooked.trace_pixel(x, y, hooked_stats), plain.trace_pixel(x, y, plain_stats)) << x << ", " << y;
+  EXPECT_EQ(calls, hooked_stats.rays());
+  EXPECT_GT(hooked_stats.shadow + hooked_stats.reflected + hooked_stats.refracted, 0u);
+  EXPECT_EQ(hooked_stats.box_tests, plain_stats.box_tests);
+  EXPECT_EQ(hooked_stats.page_calls, plain_stats.page_calls);
+  EXPECT_EQ(hooked_stats.distinct_pages, plain_stats.distinct_pages);
 }
 
 TEST(Render, BvhAndGridGiveTheSameImage) {

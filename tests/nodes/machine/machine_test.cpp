@@ -489,6 +489,21 @@ TEST(Machine, PixelComputersAnswerAtOnceWhenTheirThreadHoldsFew) {
   EXPECT_FALSE(nodes::answers_at_once(o, 2, 2, true));
 }
 
+// And before every ray too, where each thread holds one pixel computer.
+TEST(Machine, APixelComputerAloneOnItsThreadAnswersBetweenRays) {
+  MachineOptions o;
+  EXPECT_TRUE(nodes::answers_between_rays(o, 2, 2, true));
+  EXPECT_TRUE(nodes::answers_between_rays(o, 16, 16, true));
+  EXPECT_FALSE(nodes::answers_between_rays(o, 4, 2, true));  // two a thread: after every pixel only
+  EXPECT_TRUE(nodes::answers_at_once(o, 4, 2, true));
+  EXPECT_FALSE(nodes::answers_between_rays(o, 2, 2, false));
+  o.shape.workers_per_node = 2;  // two on each node's thread
+  EXPECT_FALSE(nodes::answers_between_rays(o, 2, 2, true));
+  o.shape.workers_per_node = 1;
+  o.threads.answer_at_once = false;
+  EXPECT_FALSE(nodes::answers_between_rays(o, 2, 2, true));
+}
+
 // Answering at once changes when packets are handled, never what the run
 // computes: two nodes on two threads give the image and the statistics of
 // one thread.
