@@ -204,7 +204,8 @@ void print_model(const Case& c, const Row& row, const LatencyRuns& fit, const st
   model.work_seconds = median(row.machine.at(1));
   model.misses = static_cast<double>(row.misses);
   model.pixel_computers = static_cast<double>(c.nodes) * c.workers;
-  model.crossing_seconds = nodes::ThreadModel::fit_crossing(model.work_seconds, median(row.machine.at(2)), model.misses);
+  model.crossing_seconds =
+      nodes::ThreadModel::fit_crossing(model.work_seconds, median(row.machine.at(2)), model.misses);
   model.latency_seconds = nodes::ThreadModel::fit_latency(median(fit.one), median(fit.two),
                                                           static_cast<double>(fit.misses), model.crossing_seconds);
   std::printf("%-12s model  ", "");

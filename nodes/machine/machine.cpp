@@ -298,7 +298,8 @@ unsigned thread_count(const MachineOptions& options, std::size_t nodes) {
   if (options.threads.count) return static_cast<unsigned>(std::min<std::size_t>(options.threads.count, nodes));
   const std::size_t cpus =
       options.threads.cpus ? options.threads.cpus : std::max(1u, std::thread::hardware_concurrency());
-  const std::size_t by_workers = std::max<std::size_t>(pixel_computers(options, nodes) / min_pixel_computers_per_thread, 2);
+  const std::size_t by_workers =
+      std::max<std::size_t>(pixel_computers(options, nodes) / min_pixel_computers_per_thread, 2);
   return static_cast<unsigned>(std::min({cpus, by_workers, nodes}));
 }
 
