@@ -228,8 +228,17 @@ void FifoScheduler::wake_if_sleeping() noexcept {
 
 Arrivals::~Arrivals() { detach(); }
 
+// The fence keeps the producer's publish ahead of the read of the mark. A
+// mark read as set may be one the scheduler is clearing after its handler
+// ran (take_arrivals: handler, then the clear); the handler's process then
+// takes the work after the clear, and sees it only if the publish was
+// visible before the mark was read. Without the fence a store may wait in
+// its core past a later load (x86 keeps stores in order with each other,
+// not with loads): the read found the old mark, the clear came, the
+// process took the ring as it was, and the work stayed there unsignalled.
 void Arrivals::signal() noexcept {
-  if (marked_.load(std::memory_order_seq_cst) || marked_.exchange(true, std::memory_order_seq_cst)) return;
+  std::atomic_thread_fence(std::memory_order_seq_cst);
+  if (marked_.load(std::memory_order_relaxed) || marked_.exchange(true, std::memory_order_seq_cst)) return;
   if (FifoScheduler* s = scheduler_.load(std::memory_order_seq_cst)) s->wake_if_sleeping();
 }
 

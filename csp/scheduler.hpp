@@ -122,8 +122,9 @@ class FifoScheduler;
 // Contract:
 //  - A producer, on any thread, publishes its work (a release store or
 //    stronger), then calls signal(). The first signal after the handler
-//    last ran costs one atomic exchange, and a system call only if the
-//    owner's thread sleeps; later ones, until the handler runs, cost a load.
+//    last ran costs a fence and one atomic exchange, and a system call only
+//    if the owner's thread sleeps; later ones, until the handler runs, cost
+//    a fence and a load.
 //  - One process of a FifoScheduler thread attaches a handler (attach(),
 //    from that process). The scheduler calls it on that thread at the next
 //    switch after a signal, never while the attaching process runs (it
