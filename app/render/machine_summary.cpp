@@ -158,6 +158,7 @@ Json json_relays(const nodes::MachineReport& r) {
   for (const nodes::RelayCounters& t : r.relays)
     relays.push_back({{"packets_sent", t.packets_sent},
                       {"packets_received", t.packets_received},
+                      {"sent_in_place", t.sent_in_place},
                       {"wakes", t.wakes},
                       {"signals", t.signals}});
   return relays;
@@ -210,19 +211,21 @@ void print_thread_use(std::ostream& out, const std::vector<csp::ThreadUse>& thre
   out << std::setprecision(3);
 }
 
-// What crossed between threads through the relays: packets, and the wakes
-// and signals they took (packets per wake is the batching).
+// What crossed between threads through the relays: packets, of which the
+// routers put in the rings themselves, and the wakes and signals they took
+// (packets per wake is the batching).
 void print_relays(std::ostream& out, const nodes::MachineReport& r) {
   if (r.relays.empty()) return;
-  std::uint64_t packets = 0, wakes = 0, signals = 0;
+  std::uint64_t packets = 0, in_place = 0, wakes = 0, signals = 0;
   for (const auto& t : r.relays) {
     packets += t.packets_sent;
+    in_place += t.sent_in_place;
     wakes += t.wakes;
     signals += t.signals;
   }
-  out << "between threads " << packets << " packets on " << r.relayed_links << " relayed links, in " << wakes
-      << " relay wakes (" << std::setprecision(2) << (wakes ? static_cast<double>(packets) / wakes : 0.0)
-      << " per wake) and " << signals << " signals\n"
+  out << "between threads " << packets << " packets on " << r.relayed_links << " relayed links (" << in_place
+      << " put in by routers), in " << wakes << " relay wakes (" << std::setprecision(2)
+      << (wakes ? static_cast<double>(packets) / wakes : 0.0) << " per wake) and " << signals << " signals\n"
       << std::setprecision(3);
 }
 

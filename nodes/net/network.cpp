@@ -91,6 +91,7 @@ void Network::wire_node(csp::Runtime& runtime, NodeId node) {
         const std::size_t link = relays_->add(thread_of(node), thread_of(m), cut_queues_.back().reader(),
                                               link_in_[m][back * classes_ + c].writer());
         relayed_inputs_.push_back(RelayedInput{link, m, back * classes_ + c});
+        relayed_outputs_.push_back(RelayedOutput{link, node, ends.outputs.size()});
         ends.outputs.push_back(cut_queues_.back().writer());
         continue;
       }
@@ -114,9 +115,12 @@ void Network::wire_node(csp::Runtime& runtime, NodeId node) {
 }
 
 // Every link queue between two routers of this process and thread, by the
-// numbering of wire_node, and every relayed link's delivery.
+// numbering of wire_node, every relayed link's delivery and, with
+// send_across_in_place, every relayed link's sending.
 void Network::forward_in_place() {
   for (const RelayedInput& r : relayed_inputs_) relays_->deliver_in_place(r.link, *routers_[r.node], r.input);
+  if (options_.send_across_in_place)
+    for (const RelayedOutput& r : relayed_outputs_) routers_[r.node]->send_across(r.queue, relays_->sender(r.link));
   for (NodeId node = 0; node < topology_.size(); ++node) {
     if (!is_local(node)) continue;
     const auto neighbours = topology_.neighbours(node);

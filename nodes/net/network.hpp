@@ -53,6 +53,13 @@ struct NetworkOptions {
   // neighbour could take them at once, and in_place_injector() routes a
   // local process's packet so (router.hpp). Without a link model only.
   bool forward_in_place = false;
+  // With both of the above: a router's step puts a packet for a link to
+  // another thread straight into the relays' ring and signals that thread
+  // (ThreadRelays::sender) when the link's queue is empty and credits are
+  // left, instead of waking its thread's relay to move it. Cheaper where
+  // packets cross one at a time; where many cross, the relays gather them
+  // and signal once a batch.
+  bool send_across_in_place = false;
 };
 
 // One direction and buffer class of a link whose ends run in different processes.
@@ -154,6 +161,12 @@ class Network {
     std::size_t input;  // by that router's input
   };
   std::vector<RelayedInput> relayed_inputs_;
+  struct RelayedOutput {
+    std::size_t link;   // the relays' link
+    NodeId node;        // whose router sends on it
+    std::size_t queue;  // by that router's output queue
+  };
+  std::vector<RelayedOutput> relayed_outputs_;
   std::atomic<std::uint64_t> routes_to_trace_;  // RouterConfig::routes_to_trace
   std::array<bool, 256> kinds_to_trace_{};      // RouterConfig::kinds_to_trace, from trace_kinds
 };

@@ -77,6 +77,13 @@ void Router::receive_in_place(std::size_t port, PortReceiver& receiver) {
   lanes_[link_queues_ + port].receiver = &receiver;
 }
 
+void Router::send_across(std::size_t queue, PortReceiver& sender) {
+  if (queue >= link_queues_ || lanes_[queue].next)
+    throw std::logic_error("router " + std::to_string(self_) + ": no link queue " + std::to_string(queue) +
+                           " to another thread");
+  lanes_[queue].receiver = &sender;
+}
+
 bool Router::inject_in_place(Packet& packet) {
   const std::size_t source = ends_.inputs.size();  // the injection channel
   std::size_t queue = 0;
@@ -194,7 +201,8 @@ bool Router::try_send(std::size_t queue, Packet& packet) {
 }
 
 // The channel write of try_send, and its counts; or a delivery taken in
-// place by the port's receiver, counted first, as it happens after.
+// place by the port's receiver, or a packet by a relayed link's sender,
+// counted first, as the far side may read it at once.
 bool Router::write_out(std::size_t queue, Packet& packet) {
   const std::size_t bytes = packet.bytes();
   const std::uint16_t hops = packet.hops;
@@ -205,7 +213,7 @@ bool Router::write_out(std::size_t queue, Packet& packet) {
   const double left_at = log_ && recorded ? config_.recorder->now() : 0.0;
   std::optional<RouteRecord> route;
   if (queue >= link_queues_ && packet.traced) route = RouteRecord{packet.id, packet.kind, packet.route};
-  PortReceiver* receiver = lanes_[queue].receiver;  // null for link queues
+  PortReceiver* receiver = lanes_[queue].receiver;
   if (receiver && receiver->takes_at_once(packet)) {
     count_sent(queue, bytes, hops, kind, recorded, id, left_at, route);
     receiver->take(packet);

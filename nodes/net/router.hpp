@@ -113,6 +113,11 @@ class Router {
   // Before run(): deliveries to local `port` go to `receiver` whenever it
   // takes them at once, counted as deliveries; otherwise into the port.
   void receive_in_place(std::size_t port, PortReceiver& receiver);
+  // Before run(): output queue `queue`, a link whose far end is on another
+  // thread, goes to `sender` whenever it takes a packet at once (the
+  // relays' sender(), thread_relay.hpp), counted as forwarded; otherwise
+  // into the queue.
+  void send_across(std::size_t queue, PortReceiver& sender);
 
  private:
   struct Pending {
@@ -124,7 +129,7 @@ class Router {
     std::uint32_t held_for = 0;        // pending packets waiting for this output
     std::uint32_t next_input = 0;
     Router* next = nullptr;            // set: the queue is next's input next_input, on this thread
-    PortReceiver* receiver = nullptr;  // a delivery queue's receiver in place; null: its reader reads
+    PortReceiver* receiver = nullptr;  // who takes in place: a port's receiver, a relayed link's sender; or none
   };
 
   void build_alt();

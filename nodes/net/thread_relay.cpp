@@ -22,6 +22,7 @@ struct ThreadRelays::Link {
   csp::Out<Packet> into;
   Router* router = nullptr;  // the router `into` feeds, when its step may be taken in place
   std::size_t input = 0;     // into's input number at that router
+  std::size_t credits = 0;   // packets the sending side may still put in the ring (from_thread's)
 
   // Delivers the packet (true) or leaves it untouched (false: no room).
   bool deliver(Packet& packet) {
@@ -188,7 +189,7 @@ class ThreadRelays::Relay {
   Relay(ThreadRelays& relays, unsigned thread) : relays_(relays), thread_(thread) {
     for (std::size_t i = 0; i < relays_.links_.size(); ++i) {
       const Link& l = relays_.links_[i];
-      if (l.from_thread == thread_) outgoing_.push_back(Outgoing{i, relays_.capacity_});
+      if (l.from_thread == thread_) outgoing_.push_back(Outgoing{i});
       if (l.to_thread == thread_) incoming_.push_back(Incoming{i});
     }
     out_index_.assign(relays_.links_.size(), none);
@@ -236,8 +237,7 @@ class ThreadRelays::Relay {
   static constexpr int max_rounds = 8;  // yields before a flush, while other high-priority work is ready
   struct Outgoing {
     std::size_t link;
-    std::size_t credits;
-    std::size_t guard = 0;
+    std::size_t guard = 0;  // enabled while the link has credits
   };
   // Packets waiting for room in a link's input: at most K, in arrival
   // order from `head`. A vector, which takes no memory until a link first
@@ -305,9 +305,9 @@ class ThreadRelays::Relay {
       if (from == thread_) continue;
       relays_.ring(from, thread_).drain([this](const Ring::Entry& e) {
         if (e.credits > 0) {
-          Outgoing& o = outgoing_[out_index_[e.link]];
-          if (o.credits == 0) alt_.enable(o.guard, true);
-          o.credits += e.credits;
+          Link& l = relays_.links_[e.link];
+          if (l.credits == 0) alt_.enable(outgoing_[out_index_[e.link]].guard, true);
+          l.credits += e.credits;
           return;
         }
         Incoming& i = incoming_[in_index_[e.link]];
@@ -327,15 +327,15 @@ class ThreadRelays::Relay {
   void send(Outgoing& o) {
     Link& l = relays_.links_[o.link];
     Ring& ring = relays_.ring(thread_, l.to_thread);
-    ring.reserve(o.credits);
+    ring.reserve(l.credits);
     const auto link = static_cast<std::uint32_t>(o.link);
-    const std::size_t n = l.queue.try_read_each(o.credits, [&](Packet& p) { ring.put(link, p); });
+    const std::size_t n = l.queue.try_read_each(l.credits, [&](Packet& p) { ring.put(link, p); });
     if (n == 0) return;
     ring.publish();
     relays_.counters_[thread_].packets_sent += n;
-    o.credits -= n;
+    l.credits -= n;
     touched_[l.to_thread] = true;
-    if (o.credits == 0) alt_.enable(o.guard, false);
+    if (l.credits == 0) alt_.enable(o.guard, false);
   }
 
   // A credit owed for a packet delivered; a link that comes to owe half its
@@ -393,6 +393,41 @@ class ThreadRelays::Relay {
   std::size_t token_guard_ = 0;
 };
 
+// A relayed link's sending router's step in place, past the queue and the
+// relay: the packet goes into the ring as the relay's send() would put it,
+// under one of the link's credits, and the far thread is signalled at once
+// (the relay signals once a batch; a router's step makes no batch). Taken
+// only with the queue empty, so no packet of the link is overtaken, and
+// with two credits or more, so the relay keeps the last one and its guard
+// on the queue stays enabled exactly while credits are left. Both ends of
+// the queue, the credits and the ring's producer side belong to the link's
+// sending thread, where this runs.
+class ThreadRelays::Sender final : public PortReceiver {
+ public:
+  Sender(ThreadRelays& relays, std::size_t link) : relays_(relays), link_(link) {}
+  bool takes_at_once(const Packet&) const override {
+    const Link& l = relays_.links_[link_];
+    return l.credits >= 2 && !l.queue.ready_hint() && !relays_.rings_.empty();
+  }
+  void take(Packet& packet) override {
+    Link& l = relays_.links_[link_];
+    Ring& ring = relays_.ring(l.from_thread, l.to_thread);
+    ring.reserve(1);
+    ring.put(static_cast<std::uint32_t>(link_), packet);
+    ring.publish();
+    --l.credits;
+    RelayCounters& counters = relays_.counters_[l.from_thread];
+    ++counters.packets_sent;
+    ++counters.sent_in_place;
+    ++counters.signals;
+    relays_.arrivals_[l.to_thread]->signal();
+  }
+
+ private:
+  ThreadRelays& relays_;
+  const std::size_t link_;
+};
+
 ThreadRelays::ThreadRelays(unsigned threads, std::size_t capacity)
     : threads_(threads), capacity_(capacity), counters_(threads) {
   for (unsigned t = 0; t < threads_; ++t) {
@@ -406,11 +441,19 @@ ThreadRelays::~ThreadRelays() = default;
 
 std::size_t ThreadRelays::links() const { return links_.size(); }
 
+PortReceiver& ThreadRelays::sender(std::size_t link) {
+  if (link >= links_.size()) throw std::out_of_range("thread relay: no link " + std::to_string(link));
+  if (senders_.size() < links_.size()) senders_.resize(links_.size());
+  if (!senders_[link]) senders_[link] = std::make_unique<Sender>(*this, link);
+  return *senders_[link];
+}
+
 std::size_t ThreadRelays::add(unsigned from_thread, unsigned to_thread, csp::In<Packet> queue,
                               csp::Out<Packet> into) {
   if (from_thread == to_thread || from_thread >= threads_ || to_thread >= threads_)
     throw std::invalid_argument("thread relay: a relayed link joins two different threads of the runtime");
   links_.push_back(Link{from_thread, to_thread, std::move(queue), std::move(into)});
+  links_.back().credits = capacity_;
   return links_.size() - 1;
 }
 

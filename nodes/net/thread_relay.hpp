@@ -4,8 +4,11 @@
 // costs an enqueue and no wake-up of the other thread (docs/architecture.md,
 // "Why the network cannot deadlock", gives the protocol and its argument).
 //
+// A sending router's step may put a packet in the ring itself (sender()),
+// under the same credits, when the link's queue is empty.
+//
 // Invariants: per link and buffer class, at most K packets in the sending
-// router's queue, K in the ring or staged (the sending relay's credits), and
+// router's queue, K in the ring or staged (the sending side's credits), and
 // K in the receiving router's input; a ring never fills (its capacity is the
 // credits that can be out on it); a relay blocks on nothing but its one ALT,
 // so the channel dependencies are the unrelayed network's. A relay that
@@ -25,6 +28,7 @@
 
 namespace nodes {
 
+class PortReceiver;
 class Router;
 
 // What one thread's relay carried; read after the run. A cache line of
@@ -35,6 +39,7 @@ struct alignas(64) RelayCounters {
   std::uint64_t packets_received = 0;  // packets it took from rings
   std::uint64_t wakes = 0;             // times it woke to work
   std::uint64_t signals = 0;           // signals it gave other threads (batches sent)
+  std::uint64_t sent_in_place = 0;     // of packets_sent, put in by a router's step (sender())
 };
 
 class ThreadRelays {
@@ -53,6 +58,13 @@ class ThreadRelays {
   // step the receiving relay then takes in place when the router could
   // take the packet at once (router.hpp), rather than write it into `into`.
   void deliver_in_place(std::size_t link, Router& router, std::size_t input);
+  // Before spawn(): what link `link`'s sending router may hand a packet to
+  // in place of writing its queue (Router::send_across). It takes the
+  // packet into the ring at once, signalling the far thread, when the queue
+  // is empty and the link holds two credits or more; the last credit stays
+  // with the relay, which so keeps the queue's guard enabled exactly while
+  // credits are left. Used on the link's sending thread, while the relays run.
+  PortReceiver& sender(std::size_t link);
   std::size_t links() const;
   // One relay process per thread that has links; under a FifoScheduler only.
   void spawn(csp::Runtime& runtime);
@@ -72,11 +84,13 @@ class ThreadRelays {
   struct Link;
   class Ring;
   class Relay;
+  class Sender;
   Ring& ring(unsigned from, unsigned to) { return *rings_[from * threads_ + to]; }
 
   const unsigned threads_;
   const std::size_t capacity_;
   std::vector<Link> links_;
+  std::vector<std::unique_ptr<Sender>> senders_;  // per link, made by sender()
   std::vector<std::unique_ptr<Ring>> rings_;  // [from * threads + to]
   std::vector<std::unique_ptr<csp::Arrivals>> arrivals_;  // per thread
   std::vector<csp::Channel<char>> tokens_;  // per thread: the handler's wake-up for its relay

@@ -140,6 +140,8 @@ TEST_F(MachineCli, DefaultMachineWritesImageAndJsonWithMachineFields) {
     const Json& relay = m.at("relays")[t];
     relay_sent += relay.at("packets_sent").get<double>();
     relay_received += relay.at("packets_received").get<double>();
+    // Routers put in some of them themselves (the default), never more than were put in.
+    EXPECT_LE(relay.at("sent_in_place").get<double>(), relay.at("packets_sent").get<double>());
     // A relay wakes once as it starts, then only to a signal from the other thread's relay.
     EXPECT_GE(relay.at("wakes").get<double>(), 1);
     EXPECT_LE(relay.at("wakes").get<double>(), 1 + m.at("relays")[1 - t].at("signals").get<double>());

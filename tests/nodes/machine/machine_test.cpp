@@ -65,6 +65,7 @@ struct Case {
   bool spd = false;  // SPD procedure: items are the (size + 1)^2 pixel corners
   bool record_tiles = false;
   bool forward_in_place = true;
+  bool send_in_place = true;
 };
 
 nodes::MachineResult run_case(const Case& c) {
@@ -81,6 +82,7 @@ nodes::MachineResult run_case(const Case& c) {
   options.trace.spd_procedure = c.spd;
   options.observe.record_tiles = c.record_tiles;
   options.threads.forward_in_place = c.forward_in_place;
+  options.threads.send_in_place = c.send_in_place;
   return nodes::run_machine(std::move(db), options);
 }
 
@@ -180,6 +182,48 @@ TEST(Machine, RelaysCarryEveryPacketBetweenThreadsOnce) {
   EXPECT_EQ(plain.report.relayed_links, 0u);
   EXPECT_TRUE(same_bits(plain.image.pixels(), relayed.image.pixels()));
   EXPECT_TRUE(same_bits(relayed.image.pixels(), cached_reference(c.scene, c.size)));
+}
+
+// Routers that put packets for another thread into the relays' rings
+// themselves (the default), or leave every one to their thread's relay: the
+// same image, and under a static schedule (each node's pixels fixed, so its
+// misses too) the same packets on every link and the same misses; only the
+// relays' counts say who moved them.
+TEST(Machine, RoutersSendingAcrossThreadsInPlaceChangeNothingButWhoMovesPackets) {
+  for (const unsigned threads : {2u, 3u})
+    for (const char* topology : {"hypercube", "torus"}) {
+      Case c{topology, 16, 2, 256, 4, Schedule::static_split, 1, threads};
+      SCOPED_TRACE(describe(c));
+      c.send_in_place = false;
+      const auto relays = run_case(c);
+      c.send_in_place = true;
+      const auto routers = run_case(c);
+      EXPECT_TRUE(same_bits(relays.image.pixels(), routers.image.pixels()));
+      EXPECT_TRUE(same_bits(routers.image.pixels(), cached_reference(c.scene, c.size)));
+      const auto& a = relays.report.network;
+      const auto& b = routers.report.network;
+      ASSERT_EQ(a.links.size(), b.links.size());
+      for (std::size_t l = 0; l < a.links.size(); ++l) {
+        EXPECT_EQ(a.links[l].packets, b.links[l].packets) << l;
+        EXPECT_EQ(a.links[l].bytes, b.links[l].bytes) << l;
+      }
+      EXPECT_EQ(a.hops.total_hops, b.hops.total_hops);
+      EXPECT_EQ(relays.report.svm().misses, routers.report.svm().misses);
+      EXPECT_EQ(relays.report.served().pages_served, routers.report.served().pages_served);
+      std::uint64_t sent = 0, in_place = 0, sent_alone = 0, in_place_alone = 0;
+      for (const auto& r : routers.report.relays) {
+        sent += r.packets_sent;
+        in_place += r.sent_in_place;
+      }
+      for (const auto& r : relays.report.relays) {
+        sent_alone += r.packets_sent;
+        in_place_alone += r.sent_in_place;
+      }
+      EXPECT_EQ(sent, sent_alone);
+      EXPECT_EQ(in_place_alone, 0u);
+      EXPECT_GT(in_place, 0u);
+      EXPECT_LE(in_place, sent);
+    }
 }
 
 // Router steps and page serves taken in place by the senders on the

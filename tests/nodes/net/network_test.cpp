@@ -73,7 +73,8 @@ struct Received {
 // the last receiver to finish shuts the network down.
 std::vector<Received> run_plan(const topology::Topology& t, const Plan& plan,
                                NetworkOptions options, NetworkStats* stats = nullptr,
-                               std::size_t payload = 16, unsigned threads = 2) {
+                               std::size_t payload = 16, unsigned threads = 2,
+                               std::vector<nodes::RelayCounters>* relays = nullptr) {
   csp::Runtime runtime(threads);
   Network net(runtime, t, options);
   const std::vector<std::size_t> expected = packets_to_each(plan);
@@ -100,6 +101,8 @@ std::vector<Received> run_plan(const topology::Topology& t, const Plan& plan,
   }
   runtime.run();
   if (stats) *stats = net.stats();
+  if (relays)
+    for (unsigned k = 0; k < threads; ++k) relays->push_back(net.relay_counters(k));
   return received;
 }
 
@@ -204,6 +207,56 @@ TEST(Network, RoutingInPlaceTakesTheSameLinksAsTheRoutersThemselves) {
           EXPECT_EQ(taken_by_routers, 0u);
           EXPECT_GT(taken, 0u);
         }
+  }
+}
+
+// Routers that put packets for another thread into the relays' rings
+// themselves change who moves a packet, not where it goes: every packet
+// arrives once and in order over the same links. They do so only with two
+// credits or more left on the link (K = 1 leaves it all to the relays), and
+// every packet one thread's relay side puts in a ring the other takes out.
+TEST(Network, RoutersPutPacketsForOtherThreadsIntoTheRingsThemselves) {
+  for (const char* spec : {"hypercube:4", "torus:5x3", "complete:7"}) {
+    const auto t = topology::parse_topology(spec);
+    const Plan plan = random_plan(t.size(), 200, 41);
+    for (const unsigned threads : {2u, 3u})
+      for (const std::size_t buffers : {std::size_t{1}, std::size_t{4}}) {
+        SCOPED_TRACE(std::string(spec) + " threads " + std::to_string(threads) + " buffers " +
+                     std::to_string(buffers));
+        NetworkOptions options;
+        options.buffer_capacity = buffers;
+        options.relay_between_threads = true;
+        options.forward_in_place = true;
+        NetworkStats by_relays, by_routers;
+        std::vector<nodes::RelayCounters> relays_alone, relays_and_routers;
+        expect_each_delivered_once(t, plan, run_plan(t, plan, options, &by_relays, 16, threads, &relays_alone));
+        options.send_across_in_place = true;
+        expect_each_delivered_once(t, plan,
+                                   run_plan(t, plan, options, &by_routers, 16, threads, &relays_and_routers));
+        ASSERT_EQ(by_routers.links.size(), by_relays.links.size());
+        for (std::size_t l = 0; l < by_routers.links.size(); ++l)
+          EXPECT_EQ(by_routers.links[l].packets, by_relays.links[l].packets) << l;
+        EXPECT_EQ(by_routers.hops.total_hops, by_relays.hops.total_hops);
+        std::uint64_t sent = 0, received = 0, in_place = 0, sent_alone = 0, in_place_alone = 0;
+        for (const auto& r : relays_and_routers) {
+          sent += r.packets_sent;
+          received += r.packets_received;
+          in_place += r.sent_in_place;
+        }
+        for (const auto& r : relays_alone) {
+          sent_alone += r.packets_sent;
+          in_place_alone += r.sent_in_place;
+        }
+        EXPECT_EQ(sent, received);
+        EXPECT_EQ(sent, sent_alone);
+        EXPECT_EQ(in_place_alone, 0u);
+        if (buffers == 1) {
+          EXPECT_EQ(in_place, 0u);
+        } else {
+          EXPECT_GT(in_place, 0u);
+          EXPECT_LE(in_place, sent);
+        }
+      }
   }
 }
 

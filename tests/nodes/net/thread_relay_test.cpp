@@ -1,6 +1,8 @@
 // ThreadRelays (nodes/net/thread_relay.hpp) driven directly, without
 // routers: each relayed link has a sender process that writes its queue on
-// one runtime thread and a receiver process that reads its input on
+// one runtime thread (on about half the links, seeded, it hands a packet
+// to the relays' sender() instead whenever that takes it at once, as a
+// router's step does) and a receiver process that reads its input on
 // another, and both pause before each packet for a seeded random number of
 // yields, now and then a short sleep, so that the relays meet packets and
 // credits in many orders. (The relays need csp::Arrivals, which only
@@ -39,6 +41,7 @@
 #include <vector>
 
 #include "csp/csp.hpp"
+#include "nodes/net/router.hpp"
 #include "tests/support/seeded_runs.hpp"
 
 namespace {
@@ -63,6 +66,7 @@ struct LinkPlan {
   Pauses send, receive;
   csp::Priority send_priority = csp::Priority::high;
   csp::Priority receive_priority = csp::Priority::high;
+  bool in_place = false;  // the sender hands packets to the relays' sender() when it takes them at once
 };
 
 struct Case {
@@ -102,6 +106,7 @@ Case draw_case(std::uint64_t seed, std::uint64_t min_packets, std::uint64_t max_
   LinkPlan& slow = c.links[c.slow];
   slow.receive = Pauses{0, 1, microseconds(20 + rng() % 80)};
   slow.packets = std::max<std::uint64_t>(slow.packets, 2 * c.bound() + rng() % (2 * c.bound()));
+  for (LinkPlan& l : c.links) l.in_place = rng() % 2 == 0;
   return c;
 }
 
@@ -159,6 +164,7 @@ struct LinkState {
   std::atomic<std::uint64_t> received{0};    // packets the receiver has read
   std::atomic<std::uint64_t> held_at_stall{0};  // writes completed when the sender found the link full
   std::atomic<bool> stalled{false};          // set once held_at_stall is
+  nodes::PortReceiver* sender = nullptr;     // the relays' sender(), for a link that sends in place
 };
 
 // One case's runtime, relays and links; the tests spawn the processes.
@@ -169,6 +175,8 @@ class Harness {
       links_.push_back(std::make_unique<LinkState>(i, c.capacity));
       relays_.add(c.links[i].from, c.links[i].to, links_[i]->queue.reader(), links_[i]->input.writer());
     }
+    for (std::size_t i = 0; i < c.links.size(); ++i)
+      if (c.links[i].in_place) links_[i]->sender = &relays_.sender(i);
   }
 
   csp::Runtime& runtime() { return runtime_; }
@@ -238,11 +246,18 @@ void check_held(const Case& c, std::size_t l, LinkState& link, std::uint64_t rea
 }
 
 // Sends the link's packets from `first` on, pausing before each.
+// A link that sends in place hands each packet to the relays' sender when
+// it takes it at once, as a router's step would, and writes the rest.
 void send_from(LinkState& link, std::size_t l, std::uint64_t first, std::uint64_t count, Pacer& pacer) {
   csp::Out<Packet> out = link.queue.writer();
   for (std::uint64_t id = first; id < count; ++id) {
     pacer.pause();
-    out.write(make_packet(l, id));
+    Packet p = make_packet(l, id);
+    if (link.sender && link.sender->takes_at_once(p)) {
+      link.sender->take(p);
+    } else {
+      out.write(std::move(p));
+    }
     link.written.fetch_add(1, std::memory_order_release);
   }
 }
