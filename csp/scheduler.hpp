@@ -138,7 +138,10 @@ class FifoScheduler;
 //    threads is never mistaken for a deadlock.
 //  - detach() (same process, before it ends) stops the calls; signals after
 //    it are ignored.
-class Arrivals {
+//  - Each Arrivals takes cache lines of its own: the mark is written by the
+//    signalling threads and by the owner's, and two threads' Arrivals side
+//    by side would send each other's line back and forth too.
+class alignas(64) Arrivals {
  public:
   Arrivals() = default;
   Arrivals(const Arrivals&) = delete;

@@ -22,7 +22,6 @@ struct ThreadRelays::Link {
   csp::Out<Packet> into;
   Router* router = nullptr;  // the router `into` feeds, when its step may be taken in place
   std::size_t input = 0;     // into's input number at that router
-  std::size_t credits = 0;   // packets the sending side may still put in the ring (from_thread's)
 
   // Delivers the packet (true) or leaves it untouched (false: no room).
   bool deliver(Packet& packet) {
@@ -189,7 +188,7 @@ class ThreadRelays::Relay {
   Relay(ThreadRelays& relays, unsigned thread) : relays_(relays), thread_(thread) {
     for (std::size_t i = 0; i < relays_.links_.size(); ++i) {
       const Link& l = relays_.links_[i];
-      if (l.from_thread == thread_) outgoing_.push_back(Outgoing{i});
+      if (l.from_thread == thread_) outgoing_.push_back(Outgoing{i, relays_.capacity_});
       if (l.to_thread == thread_) incoming_.push_back(Incoming{i});
     }
     out_index_.assign(relays_.links_.size(), none);
@@ -198,6 +197,10 @@ class ThreadRelays::Relay {
     for (std::size_t k = 0; k < incoming_.size(); ++k) in_index_[incoming_[k].link] = k;
     touched_.assign(relays_.threads_, false);
   }
+
+  // Where link `link`'s credits are kept, for its Sender; the link is one
+  // this thread sends on.
+  std::size_t* credits_of(std::size_t link) { return &outgoing_.at(out_index_.at(link)).credits; }
 
   void run() {
     csp::Arrivals& arrivals = *relays_.arrivals_[thread_];
@@ -235,9 +238,15 @@ class ThreadRelays::Relay {
  private:
   static constexpr std::size_t none = static_cast<std::size_t>(-1);
   static constexpr int max_rounds = 8;  // yields before a flush, while other high-priority work is ready
+  // A link this thread sends on. Its credits are written on this thread
+  // only (by the relay, and by the link's Sender), and kept here rather
+  // than in the Link, which the far thread's relay reads: a count written
+  // at every packet beside fields the other core reads would take their
+  // cache line from it each time.
   struct Outgoing {
     std::size_t link;
-    std::size_t guard = 0;  // enabled while the link has credits
+    std::size_t credits;
+    std::size_t guard = 0;  // enabled while credits are left
   };
   // Packets waiting for room in a link's input: at most K, in arrival
   // order from `head`. A vector, which takes no memory until a link first
@@ -305,9 +314,9 @@ class ThreadRelays::Relay {
       if (from == thread_) continue;
       relays_.ring(from, thread_).drain([this](const Ring::Entry& e) {
         if (e.credits > 0) {
-          Link& l = relays_.links_[e.link];
-          if (l.credits == 0) alt_.enable(outgoing_[out_index_[e.link]].guard, true);
-          l.credits += e.credits;
+          Outgoing& o = outgoing_[out_index_[e.link]];
+          if (o.credits == 0) alt_.enable(o.guard, true);
+          o.credits += e.credits;
           return;
         }
         Incoming& i = incoming_[in_index_[e.link]];
@@ -327,15 +336,15 @@ class ThreadRelays::Relay {
   void send(Outgoing& o) {
     Link& l = relays_.links_[o.link];
     Ring& ring = relays_.ring(thread_, l.to_thread);
-    ring.reserve(l.credits);
+    ring.reserve(o.credits);
     const auto link = static_cast<std::uint32_t>(o.link);
-    const std::size_t n = l.queue.try_read_each(l.credits, [&](Packet& p) { ring.put(link, p); });
+    const std::size_t n = l.queue.try_read_each(o.credits, [&](Packet& p) { ring.put(link, p); });
     if (n == 0) return;
     ring.publish();
     relays_.counters_[thread_].packets_sent += n;
-    l.credits -= n;
+    o.credits -= n;
     touched_[l.to_thread] = true;
-    if (l.credits == 0) alt_.enable(o.guard, false);
+    if (o.credits == 0) alt_.enable(o.guard, false);
   }
 
   // A credit owed for a packet delivered; a link that comes to owe half its
@@ -383,7 +392,7 @@ class ThreadRelays::Relay {
 
   ThreadRelays& relays_;
   const unsigned thread_;
-  std::vector<Outgoing> outgoing_;
+  std::vector<Outgoing> outgoing_;  // never resized after construction: Senders hold their credits' address
   std::vector<Incoming> incoming_;
   std::vector<std::size_t> out_index_, in_index_;  // per link: its place above, or none
   std::vector<std::pair<bool, std::size_t>> guard_owner_;  // per guard: (outgoing?, place)
@@ -405,9 +414,10 @@ class ThreadRelays::Relay {
 class ThreadRelays::Sender final : public PortReceiver {
  public:
   Sender(ThreadRelays& relays, std::size_t link) : relays_(relays), link_(link) {}
+  // At spawn(): the sending relay's count of the link's credits.
+  void bind(std::size_t* credits) { credits_ = credits; }
   bool takes_at_once(const Packet&) const override {
-    const Link& l = relays_.links_[link_];
-    return l.credits >= 2 && !l.queue.ready_hint() && !relays_.rings_.empty();
+    return credits_ && *credits_ >= 2 && !relays_.links_[link_].queue.ready_hint();
   }
   void take(Packet& packet) override {
     Link& l = relays_.links_[link_];
@@ -415,7 +425,7 @@ class ThreadRelays::Sender final : public PortReceiver {
     ring.reserve(1);
     ring.put(static_cast<std::uint32_t>(link_), packet);
     ring.publish();
-    --l.credits;
+    --*credits_;
     RelayCounters& counters = relays_.counters_[l.from_thread];
     ++counters.packets_sent;
     ++counters.sent_in_place;
@@ -426,6 +436,7 @@ class ThreadRelays::Sender final : public PortReceiver {
  private:
   ThreadRelays& relays_;
   const std::size_t link_;
+  std::size_t* credits_ = nullptr;  // null until spawn(): nothing is taken before
 };
 
 ThreadRelays::ThreadRelays(unsigned threads, std::size_t capacity)
@@ -453,7 +464,6 @@ std::size_t ThreadRelays::add(unsigned from_thread, unsigned to_thread, csp::In<
   if (from_thread == to_thread || from_thread >= threads_ || to_thread >= threads_)
     throw std::invalid_argument("thread relay: a relayed link joins two different threads of the runtime");
   links_.push_back(Link{from_thread, to_thread, std::move(queue), std::move(into)});
-  links_.back().credits = capacity_;
   return links_.size() - 1;
 }
 
@@ -481,6 +491,9 @@ void ThreadRelays::spawn(csp::Runtime& runtime) {
   for (unsigned t = 0; t < threads_; ++t) {
     if (!has_links[t]) continue;
     auto relay = std::make_shared<Relay>(*this, t);
+    for (std::size_t link = 0; link < senders_.size(); ++link)
+      if (senders_[link] && links_[link].from_thread == t) senders_[link]->bind(relay->credits_of(link));
+    spawned_.push_back(relay);
     runtime.spawn("thread relay " + std::to_string(t), t, [relay] { relay->run(); });
   }
 }

@@ -95,6 +95,10 @@ class ThreadRelays {
   std::vector<std::unique_ptr<csp::Arrivals>> arrivals_;  // per thread
   std::vector<csp::Channel<char>> tokens_;  // per thread: the handler's wake-up for its relay
   std::vector<RelayCounters> counters_;     // per thread, written by its relay
+  // The relays spawned, kept until this ends: a link's Sender counts on its
+  // relay's credits, and may be asked after the relay's process has ended
+  // (a poisoned network's senders write on until they meet the poison).
+  std::vector<std::shared_ptr<Relay>> spawned_;
 };
 
 }  // namespace nodes
