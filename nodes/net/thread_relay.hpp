@@ -3,9 +3,7 @@
 // over lock-free single-producer rings, so that a packet crossing threads
 // costs an enqueue and no wake-up of the other thread (docs/architecture.md,
 // "Why the network cannot deadlock", gives the protocol and its argument).
-//
-// A sending router's step may put a packet in the ring itself (sender()),
-// under the same credits, when the link's queue is empty.
+// A sending router's step may put a packet in the ring itself (sender()).
 //
 // Invariants: per link and buffer class, at most K packets in the sending
 // router's queue, K in the ring or staged (the sending side's credits), and
