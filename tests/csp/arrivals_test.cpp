@@ -1,7 +1,8 @@
 // csp::Arrivals: work signalled from other threads reaches its process
 // (also when its thread sleeps), in order, once; the handler never runs
 // while its own process runs; work in transit is not taken for a deadlock;
-// schedulers without the rule and code outside a Runtime attach nothing.
+// schedulers without the rule and code outside a Runtime attach nothing;
+// work published by a release store alone is never stranded.
 #include <gtest/gtest.h>
 
 #include <atomic>
@@ -119,6 +120,59 @@ TEST(Arrivals, HandlerNeverRunsWhileItsOwnProcessRuns) {
   EXPECT_EQ(in_owner.load(), 0);
   ASSERT_EQ(got.size(), static_cast<std::size_t>(n));
   for (int i = 0; i < n; ++i) ASSERT_EQ(got[i], i);
+}
+
+// The contract's own publish, a release store and no lock, in bursts of
+// two with a varying pause between: the second signal of a burst finds the
+// first's mark set, at every point of the consumer's scheduler taking it
+// (running the handler, clearing the mark). The consumer must still see the
+// second item, for which the handler may not run again. The producer waits
+// for each burst's acknowledgement a bounded time and then ends, so an item
+// stranded unsignalled ends the run as a deadlock rather than a hang.
+// (Arrivals::signal's fence, whose absence could strand one, is not shown
+// by this test: without it, 6 million bursts here stranded none.)
+TEST(Arrivals, AReleaseStoreBeforeASignalThatFindsTheMarkSetIsSeen) {
+  constexpr int bursts = 20000;
+  csp::Arrivals arrivals;
+  std::atomic<int> latest{0};   // the producer's publish
+  std::atomic<int> acked{0};    // the consumer's acknowledgement
+  csp::Channel<char> token("token", 1);
+  bool complete = false;
+  csp::Runtime rt(2);
+  rt.spawn("consumer", 0, [&] {
+    ASSERT_TRUE(arrivals.attach([w = token.writer()]() mutable {
+      char t = 't';
+      (void)w.try_write(t);
+    }));
+    auto r = token.reader();
+    for (;;) {
+      const int seen = latest.load(std::memory_order_acquire);
+      acked.store(seen, std::memory_order_release);
+      if (seen == 2 * bursts) break;
+      (void)r.read();
+    }
+    arrivals.detach();
+    complete = true;
+  });
+  rt.spawn("producer", 1, [&] {
+    for (int b = 1; b <= bursts; ++b) {
+      latest.store(2 * b - 1, std::memory_order_release);
+      arrivals.signal();
+      // A varying pause, so that the second signal meets the consumer's
+      // scheduler at every point of its taking the first.
+      const auto pause = std::chrono::nanoseconds((static_cast<std::uint32_t>(b) * 2654435761u) >> 21);
+      for (const auto until = std::chrono::steady_clock::now() + pause; std::chrono::steady_clock::now() < until;) {
+      }
+      latest.store(2 * b, std::memory_order_release);
+      arrivals.signal();
+      const auto deadline = std::chrono::steady_clock::now() + 2s;
+      while (acked.load(std::memory_order_acquire) < 2 * b)
+        if (std::chrono::steady_clock::now() > deadline) return;  // stranded: the run ends as a deadlock
+    }
+  });
+  ASSERT_NO_THROW(rt.run());
+  EXPECT_TRUE(complete);
+  EXPECT_EQ(acked.load(), 2 * bursts);
 }
 
 TEST(Arrivals, NothingAttachesOutsideARuntimeOrUnderVirtualTime) {
