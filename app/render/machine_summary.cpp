@@ -216,16 +216,12 @@ void print_thread_use(std::ostream& out, const std::vector<csp::ThreadUse>& thre
 // (packets per wake is the batching).
 void print_relays(std::ostream& out, const nodes::MachineReport& r) {
   if (r.relays.empty()) return;
-  std::uint64_t packets = 0, in_place = 0, wakes = 0, signals = 0;
-  for (const auto& t : r.relays) {
-    packets += t.packets_sent;
-    in_place += t.sent_in_place;
-    wakes += t.wakes;
-    signals += t.signals;
-  }
-  out << "between threads " << packets << " packets on " << r.relayed_links << " relayed links (" << in_place
-      << " put in by routers), in " << wakes << " relay wakes (" << std::setprecision(2)
-      << (wakes ? static_cast<double>(packets) / wakes : 0.0) << " per wake) and " << signals << " signals\n"
+  nodes::RelayCounters all;
+  for (const auto& t : r.relays) all += t;
+  out << "between threads " << all.packets_sent << " packets on " << r.relayed_links << " relayed links ("
+      << all.sent_in_place << " put in by routers), in " << all.wakes << " relay wakes (" << std::setprecision(2)
+      << (all.wakes ? static_cast<double>(all.packets_sent) / all.wakes : 0.0) << " per wake) and " << all.signals
+      << " signals\n"
       << std::setprecision(3);
 }
 

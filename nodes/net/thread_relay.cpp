@@ -183,6 +183,43 @@ class ThreadRelays::Ring {
   std::size_t head_slot_ = 0;                 // the consumer's: head_local_ modulo the slots
 };
 
+// A relayed link's sending router's step in place, past the queue and the
+// relay: the packet goes into the ring as the relay's send() would put it,
+// under one of the link's credits, and the far thread is signalled at once
+// (the relay signals once a batch; a router's step makes no batch). Taken
+// only with the queue empty, so no packet of the link is overtaken, and
+// with two credits or more, so the relay keeps the last one and its guard
+// on the queue stays enabled exactly while credits are left. Both ends of
+// the queue, the credits and the ring's producer side belong to the link's
+// sending thread, where this runs.
+class ThreadRelays::Sender final : public PortReceiver {
+ public:
+  Sender(ThreadRelays& relays, std::size_t link) : relays_(relays), link_(link) {}
+  // By the sending thread's relay as it is made: its count of the link's credits.
+  void bind(std::size_t* credits) { credits_ = credits; }
+  bool takes_at_once(const Packet&) const override {
+    return credits_ && *credits_ >= 2 && !relays_.links_[link_].queue.ready_hint();
+  }
+  void take(Packet& packet) override {
+    Link& l = relays_.links_[link_];
+    Ring& ring = relays_.ring(l.from_thread, l.to_thread);
+    ring.reserve(1);
+    ring.put(static_cast<std::uint32_t>(link_), packet);
+    ring.publish();
+    --*credits_;
+    RelayCounters& counters = relays_.counters_[l.from_thread];
+    ++counters.packets_sent;
+    ++counters.sent_in_place;
+    ++counters.signals;
+    relays_.arrivals_[l.to_thread]->signal();
+  }
+
+ private:
+  ThreadRelays& relays_;
+  const std::size_t link_;
+  std::size_t* credits_ = nullptr;  // null until spawn(): nothing is taken before
+};
+
 class ThreadRelays::Relay {
  public:
   Relay(ThreadRelays& relays, unsigned thread) : relays_(relays), thread_(thread) {
@@ -196,11 +233,10 @@ class ThreadRelays::Relay {
     for (std::size_t k = 0; k < outgoing_.size(); ++k) out_index_[outgoing_[k].link] = k;
     for (std::size_t k = 0; k < incoming_.size(); ++k) in_index_[incoming_[k].link] = k;
     touched_.assign(relays_.threads_, false);
+    // outgoing_ is complete: its entries stay where they are from now on.
+    for (Outgoing& o : outgoing_)
+      if (o.link < relays_.senders_.size() && relays_.senders_[o.link]) relays_.senders_[o.link]->bind(&o.credits);
   }
-
-  // Where link `link`'s credits are kept, for its Sender; the link is one
-  // this thread sends on.
-  std::size_t* credits_of(std::size_t link) { return &outgoing_.at(out_index_.at(link)).credits; }
 
   void run() {
     csp::Arrivals& arrivals = *relays_.arrivals_[thread_];
@@ -402,42 +438,14 @@ class ThreadRelays::Relay {
   std::size_t token_guard_ = 0;
 };
 
-// A relayed link's sending router's step in place, past the queue and the
-// relay: the packet goes into the ring as the relay's send() would put it,
-// under one of the link's credits, and the far thread is signalled at once
-// (the relay signals once a batch; a router's step makes no batch). Taken
-// only with the queue empty, so no packet of the link is overtaken, and
-// with two credits or more, so the relay keeps the last one and its guard
-// on the queue stays enabled exactly while credits are left. Both ends of
-// the queue, the credits and the ring's producer side belong to the link's
-// sending thread, where this runs.
-class ThreadRelays::Sender final : public PortReceiver {
- public:
-  Sender(ThreadRelays& relays, std::size_t link) : relays_(relays), link_(link) {}
-  // At spawn(): the sending relay's count of the link's credits.
-  void bind(std::size_t* credits) { credits_ = credits; }
-  bool takes_at_once(const Packet&) const override {
-    return credits_ && *credits_ >= 2 && !relays_.links_[link_].queue.ready_hint();
-  }
-  void take(Packet& packet) override {
-    Link& l = relays_.links_[link_];
-    Ring& ring = relays_.ring(l.from_thread, l.to_thread);
-    ring.reserve(1);
-    ring.put(static_cast<std::uint32_t>(link_), packet);
-    ring.publish();
-    --*credits_;
-    RelayCounters& counters = relays_.counters_[l.from_thread];
-    ++counters.packets_sent;
-    ++counters.sent_in_place;
-    ++counters.signals;
-    relays_.arrivals_[l.to_thread]->signal();
-  }
-
- private:
-  ThreadRelays& relays_;
-  const std::size_t link_;
-  std::size_t* credits_ = nullptr;  // null until spawn(): nothing is taken before
-};
+RelayCounters& RelayCounters::operator+=(const RelayCounters& o) {
+  packets_sent += o.packets_sent;
+  packets_received += o.packets_received;
+  wakes += o.wakes;
+  signals += o.signals;
+  sent_in_place += o.sent_in_place;
+  return *this;
+}
 
 ThreadRelays::ThreadRelays(unsigned threads, std::size_t capacity)
     : threads_(threads), capacity_(capacity), counters_(threads) {
@@ -491,8 +499,6 @@ void ThreadRelays::spawn(csp::Runtime& runtime) {
   for (unsigned t = 0; t < threads_; ++t) {
     if (!has_links[t]) continue;
     auto relay = std::make_shared<Relay>(*this, t);
-    for (std::size_t link = 0; link < senders_.size(); ++link)
-      if (senders_[link] && links_[link].from_thread == t) senders_[link]->bind(relay->credits_of(link));
     spawned_.push_back(relay);
     runtime.spawn("thread relay " + std::to_string(t), t, [relay] { relay->run(); });
   }

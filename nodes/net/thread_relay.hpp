@@ -38,6 +38,7 @@ struct alignas(64) RelayCounters {
   std::uint64_t wakes = 0;             // times it woke to work
   std::uint64_t signals = 0;           // signals it gave other threads (batches sent)
   std::uint64_t sent_in_place = 0;     // of packets_sent, put in by a router's step (sender())
+  RelayCounters& operator+=(const RelayCounters& o);  // every count summed, as over a run's threads
 };
 
 class ThreadRelays {

@@ -237,24 +237,17 @@ TEST(Network, RoutersPutPacketsForOtherThreadsIntoTheRingsThemselves) {
         for (std::size_t l = 0; l < by_routers.links.size(); ++l)
           EXPECT_EQ(by_routers.links[l].packets, by_relays.links[l].packets) << l;
         EXPECT_EQ(by_routers.hops.total_hops, by_relays.hops.total_hops);
-        std::uint64_t sent = 0, received = 0, in_place = 0, sent_alone = 0, in_place_alone = 0;
-        for (const auto& r : relays_and_routers) {
-          sent += r.packets_sent;
-          received += r.packets_received;
-          in_place += r.sent_in_place;
-        }
-        for (const auto& r : relays_alone) {
-          sent_alone += r.packets_sent;
-          in_place_alone += r.sent_in_place;
-        }
-        EXPECT_EQ(sent, received);
-        EXPECT_EQ(sent, sent_alone);
-        EXPECT_EQ(in_place_alone, 0u);
+        nodes::RelayCounters both, alone;
+        for (const auto& r : relays_and_routers) both += r;
+        for (const auto& r : relays_alone) alone += r;
+        EXPECT_EQ(both.packets_sent, both.packets_received);
+        EXPECT_EQ(both.packets_sent, alone.packets_sent);
+        EXPECT_EQ(alone.sent_in_place, 0u);
         if (buffers == 1) {
-          EXPECT_EQ(in_place, 0u);
+          EXPECT_EQ(both.sent_in_place, 0u);
         } else {
-          EXPECT_GT(in_place, 0u);
-          EXPECT_LE(in_place, sent);
+          EXPECT_GT(both.sent_in_place, 0u);
+          EXPECT_LE(both.sent_in_place, both.packets_sent);
         }
       }
   }

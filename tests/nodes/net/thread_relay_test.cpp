@@ -211,11 +211,7 @@ class Harness {
 
   nodes::RelayCounters totals() const {
     nodes::RelayCounters sum;
-    for (unsigned t = 0; t < case_.threads; ++t) {
-      const nodes::RelayCounters& c = relays_.counters(t);
-      sum.packets_sent += c.packets_sent;
-      sum.packets_received += c.packets_received;
-    }
+    for (unsigned t = 0; t < case_.threads; ++t) sum += relays_.counters(t);
     return sum;
   }
 
