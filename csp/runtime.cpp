@@ -411,7 +411,9 @@ void Runtime::Impl::run_process(Process& p, const std::function<void()>& body) {
 }
 
 Runtime::Runtime(unsigned threads) : Runtime(RuntimeOptions{threads, RuntimeOptions{}.stack_size, {}, false, {}}) {}
-Runtime::Runtime(RuntimeOptions options) : impl_(std::make_unique<Impl>(std::move(options))) {}
+Runtime::Runtime(RuntimeOptions options) : impl_(std::make_unique<Impl>(std::move(options))) {
+  detail::prepare_fences();
+}
 Runtime::~Runtime() = default;
 
 unsigned Runtime::threads() const { return impl_->options.threads; }

@@ -2,9 +2,17 @@
 // priority, then yielded; when idle, a short spin, then a sleep.
 #include "csp/scheduler.hpp"
 
+#include <mutex>
 #include <stdexcept>
+#include <system_error>
 #include <thread>
 #include <utility>
+
+#ifdef __linux__
+#include <linux/membarrier.h>
+#include <sys/syscall.h>
+#include <unistd.h>
+#endif
 
 #include <boost/fiber/detail/cpu_relax.hpp>
 
@@ -18,6 +26,67 @@ thread_local void* properties_reserve = nullptr;
 }  // namespace
 
 constinit thread_local std::uint64_t detail::sleepers_woken_here = 0;
+
+namespace {
+// The fences' mode, decided once a process. Registering for membarrier(2)'s
+// private expedited command waits for the OS (some 10 ms), so a thread of
+// its own does it while the runtime goes on with full fences; the mode then
+// leaves `pending` once. A sleeper that saw `pending` cannot know which side
+// a producer took, so it bounds its sleep (see sleep_until_notified).
+enum class FenceMode : int { pending, asymmetric, symmetric };
+std::atomic<FenceMode> fence_mode{FenceMode::pending};
+
+bool register_membarrier() noexcept {
+#ifdef __linux__
+  const long commands = ::syscall(SYS_membarrier, MEMBARRIER_CMD_QUERY, 0, 0);
+  return commands > 0 && (commands & MEMBARRIER_CMD_PRIVATE_EXPEDITED) &&
+         ::syscall(SYS_membarrier, MEMBARRIER_CMD_REGISTER_PRIVATE_EXPEDITED, 0, 0) == 0;
+#else
+  return false;
+#endif
+}
+}  // namespace
+
+void detail::prepare_fences() noexcept {
+  static std::once_flag once;
+  std::call_once(once, [] {
+    try {
+      std::thread([] {
+        fence_mode.store(register_membarrier() ? FenceMode::asymmetric : FenceMode::symmetric);
+      }).detach();
+    } catch (const std::system_error&) {
+      fence_mode.store(FenceMode::symmetric);
+    }
+  });
+}
+
+bool detail::fences_decided() noexcept { return fence_mode.load() != FenceMode::pending; }
+
+void detail::light_fence() noexcept {
+  if (fence_mode.load(std::memory_order_relaxed) == FenceMode::asymmetric) {
+    std::atomic_signal_fence(std::memory_order_seq_cst);
+  } else {
+    std::atomic_thread_fence(std::memory_order_seq_cst);
+  }
+}
+
+// A full barrier here, and on every running thread of the process where
+// the producers may take the light side. False when it cannot be sure the
+// two sides paired: the mode was still pending, or the call failed.
+bool detail::heavy_fence() noexcept {
+  std::atomic_thread_fence(std::memory_order_seq_cst);
+  switch (fence_mode.load(std::memory_order_seq_cst)) {
+    case FenceMode::symmetric:
+      return true;
+    case FenceMode::asymmetric:
+#ifdef __linux__
+      return ::syscall(SYS_membarrier, MEMBARRIER_CMD_PRIVATE_EXPEDITED, 0, 0) == 0;
+#endif
+    case FenceMode::pending:
+      break;
+  }
+  return false;
+}
 constinit thread_local boost::fibers::scheduler* detail::runtime_scheduler_here = nullptr;
 constinit thread_local Scheduler* detail::runtime_algorithm_here = nullptr;
 
@@ -97,7 +166,9 @@ void FifoScheduler::awakened(boost::fibers::context* ctx, ProcessProps& props) n
 void FifoScheduler::take_arrivals() noexcept {
   if (boost::fibers::context::active() == arrivals_->owner_) return;
   arrivals_->handler_();
-  arrivals_->marked_.store(false, std::memory_order_seq_cst);
+  arrivals_->handler_outstanding_ = true;
+  // Cleared only if set: a store would take the line from the signallers.
+  if (arrivals_->marked_.load(std::memory_order_relaxed)) arrivals_->marked_.store(false, std::memory_order_seq_cst);
 }
 
 // The dispatcher is kept aside rather than queued with the others: so a
@@ -105,7 +176,9 @@ void FifoScheduler::take_arrivals() noexcept {
 // of the queue, a timer that fell due during a long computation fires when
 // the computation offers the thread, and most switches read no clock.
 boost::fibers::context* FifoScheduler::pick_next() noexcept {
-  if (arrivals_ && arrivals_->marked_.load(std::memory_order_relaxed)) take_arrivals();
+  if (arrivals_ && (arrivals_->marked_.load(std::memory_order_relaxed) ||
+                    (!arrivals_->handler_outstanding_ && arrivals_->polled())))
+    take_arrivals();
   const bool none_ready = ready_.empty() && ready_low_woken_.empty() && ready_low_.empty();
   if (dispatcher_ && (none_ready || take_notification() || std::exchange(dispatch_soon_, false) ||
                       ++picks_since_dispatch_ >= dispatch_period)) {
@@ -160,12 +233,19 @@ bool FifoScheduler::spin_until_notified(std::chrono::steady_clock::time_point st
 bool FifoScheduler::sleep_until_notified(std::chrono::steady_clock::time_point when) noexcept {
   std::unique_lock<std::mutex> lk(mutex_);
   sleeping_.store(true, std::memory_order_seq_cst);
+  // A producer of a polled source publishes, then looks at sleeping_ with
+  // only the light side of the fence between: this side's heavy one makes
+  // either that look see the store above or the check below see the work.
+  // Where it cannot (a failed membarrier), the sleep is cut to a poll's period.
+  auto until = when;
+  if (arrivals_ && !arrivals_->sources_.empty() && !detail::heavy_fence())
+    until = std::min(when, std::chrono::steady_clock::now() + std::chrono::milliseconds(1));
   const auto woken = [this] { return notified_.load(std::memory_order_seq_cst) || arrival_pending(); };
   bool notified = true;
-  if (when == std::chrono::steady_clock::time_point::max()) {
+  if (until == std::chrono::steady_clock::time_point::max()) {
     wakeup_.wait(lk, woken);
   } else {
-    notified = wakeup_.wait_until(lk, when, woken);
+    notified = wakeup_.wait_until(lk, until, woken);
   }
   sleeping_.store(false, std::memory_order_relaxed);
   notified_.store(false, std::memory_order_relaxed);
@@ -212,7 +292,8 @@ void FifoScheduler::notify() noexcept {
 
 bool FifoScheduler::yield_requested() const noexcept {
   return notified_.load(std::memory_order_relaxed) || !ready_.empty() ||
-         (arrivals_ && arrivals_->marked_.load(std::memory_order_relaxed));
+         (arrivals_ && (arrivals_->marked_.load(std::memory_order_relaxed) ||
+                        (!arrivals_->handler_outstanding_ && arrivals_->polled())));
 }
 
 bool FifoScheduler::others_ready() const noexcept {
@@ -242,12 +323,24 @@ void Arrivals::signal() noexcept {
   if (FifoScheduler* s = scheduler_.load(std::memory_order_seq_cst)) s->wake_if_sleeping();
 }
 
-bool Arrivals::attach(std::function<void()> handler) {
+// The light side of the asymmetric fence (see sleep_until_notified). A
+// sleeper already notified is not notified again: it wakes, and polls
+// until it next sleeps, when its heavy fence shows it this publish.
+void Arrivals::poke() noexcept {
+  detail::light_fence();
+  if (FifoScheduler* s = scheduler_.load(std::memory_order_relaxed);
+      s && s->sleeping_.load(std::memory_order_relaxed) && !s->notified_.load(std::memory_order_relaxed))
+    s->notify();
+}
+
+bool Arrivals::attach(std::function<void()> handler, std::vector<Source> sources) {
   auto* s = dynamic_cast<FifoScheduler*>(detail::thread_algorithm());
   detail::Process* p = detail::current_process();
   if (!s || !p || !p->tracker) return false;
   if (s->arrivals_) throw std::logic_error("csp: a runtime thread takes one Arrivals at a time");
   handler_ = std::move(handler);
+  sources_ = std::move(sources);
+  handler_outstanding_ = false;
   owner_ = boost::fibers::context::active();
   s->arrivals_ = this;
   p->tracker->watch(p->thread, this);

@@ -21,6 +21,7 @@
 #include <functional>
 #include <memory>
 #include <mutex>
+#include <vector>
 
 #include <boost/fiber/algo/algorithm.hpp>
 #include <boost/fiber/context.hpp>
@@ -141,27 +142,67 @@ class FifoScheduler;
 //  - Each Arrivals takes cache lines of its own: the mark is written by the
 //    signalling threads and by the owner's, and two threads' Arrivals side
 //    by side would send each other's line back and forth too.
+//
+// Polled sources, the cheaper way (what a busy thread pays nothing for):
+//  - A source is a pair of counters, `produced` advanced by one producer
+//    (a release store, after the work it counts is written) and `consumed`
+//    by the attached process as it takes that work; the source holds work
+//    while they differ. They are given to attach() and read by the owner's
+//    scheduler at every switch, while it spins, and before it sleeps.
+//  - So a producer of a polled source calls poke(), not signal(): no mark,
+//    no cache line of the owner's taken, only a look at whether the owner's
+//    thread sleeps. That look is ordered after the publish by a fence whose
+//    cost the sleeper pays (an asymmetric fence: the OS's membarrier where
+//    it has one; a full fence on the producer's side where it does not).
+//  - The scheduler calls the handler when a source holds work, once, until
+//    the attached process calls taking(), which it does before it takes the
+//    sources' work: what comes after that is seen at the next switch.
+//  - The deadlock detector counts a source that holds work as a mark.
 class alignas(64) Arrivals {
  public:
+  struct Source {
+    const std::atomic<std::uint64_t>* produced;
+    const std::atomic<std::uint64_t>* consumed;
+  };
+
   Arrivals() = default;
   Arrivals(const Arrivals&) = delete;
   Arrivals& operator=(const Arrivals&) = delete;
   ~Arrivals();
 
   void signal() noexcept;
+  // After a publish on one of the polled sources: wakes the owner's thread
+  // if it sleeps. Any thread.
+  void poke() noexcept;
   // False (nothing attached) if the calling thread's scheduler takes no
-  // arrivals (the virtual-time one), or outside a Runtime.
-  bool attach(std::function<void()> handler);
+  // arrivals (the virtual-time one), or outside a Runtime. `sources` are
+  // polled until detach().
+  bool attach(std::function<void()> handler, std::vector<Source> sources = {});
   void detach() noexcept;
-  // Attached and signalled since the handler last ran.
+  // By the attached process, before it takes its sources' work: the
+  // handler may be called again for work that comes after.
+  void taking() noexcept { handler_outstanding_ = false; }
+  // Attached, and signalled since the handler last ran or a source holds work.
   bool pending() const noexcept {
-    return marked_.load(std::memory_order_seq_cst) && scheduler_.load(std::memory_order_seq_cst) != nullptr;
+    return scheduler_.load(std::memory_order_seq_cst) != nullptr &&
+           (marked_.load(std::memory_order_seq_cst) || polled());
   }
 
  private:
   friend class FifoScheduler;
+  // Some source holds work. Any thread: the sources do not change while attached.
+  bool polled() const noexcept {
+    for (const Source& s : sources_)
+      if (s.produced->load(std::memory_order_acquire) != s.consumed->load(std::memory_order_acquire)) return true;
+    return false;
+  }
+  // Three cache lines: the mark, written by signallers and the owner's
+  // thread; what a producer reads, written only at attach and detach; and
+  // what the owner's thread alone reads and writes.
   std::atomic<bool> marked_{false};
-  std::atomic<FifoScheduler*> scheduler_{nullptr};  // set while attached
+  alignas(64) std::atomic<FifoScheduler*> scheduler_{nullptr};  // set while attached
+  std::vector<Source> sources_;
+  alignas(64) bool handler_outstanding_ = false;  // called for a source, taking() not yet
   std::function<void()> handler_;
   boost::fibers::context* owner_ = nullptr;
   void* tracker_ = nullptr;  // the detail::Tracker it is registered with
@@ -210,7 +251,11 @@ class FifoScheduler final : public Scheduler {
   static constexpr unsigned dispatch_period = 32;
   static constexpr int os_yields_before_sleep = 16;
 
-  bool arrival_pending() const noexcept { return arrivals_ && arrivals_->marked_.load(std::memory_order_seq_cst); }
+  // Work for the handler: a mark, or a source's work it has not been called for.
+  bool arrival_pending() const noexcept {
+    return arrivals_ && (arrivals_->marked_.load(std::memory_order_seq_cst) ||
+                         (!arrivals_->handler_outstanding_ && arrivals_->polled()));
+  }
   void take_arrivals() noexcept;
   void wake_if_sleeping() noexcept;
 
@@ -227,9 +272,12 @@ class FifoScheduler final : public Scheduler {
   bool dispatch_soon_ = false;  // a low-priority process yielded since the dispatcher last ran
   std::mutex mutex_;  // orders notify() against the check before sleeping
   std::condition_variable wakeup_;
-  std::atomic<bool> notified_{false};  // a wake from another thread not yet dispatched
-  std::atomic<bool> sleeping_{false};  // set under mutex_ while the thread sleeps, or is about to
-  const std::chrono::microseconds spin_limit_;
+  // Each on a cache line of its own, apart from what the thread writes at
+  // every switch: notified_ is written by other threads, and sleeping_,
+  // written only around a sleep, is read by every producer's poke().
+  alignas(64) std::atomic<bool> notified_{false};  // a wake from another thread not yet dispatched
+  alignas(64) std::atomic<bool> sleeping_{false};  // set under mutex_ while the thread sleeps, or is about to
+  alignas(64) const std::chrono::microseconds spin_limit_;
   std::chrono::steady_clock::duration* idle_ = nullptr;
   ThreadTimes* times_ = nullptr;
   Arrivals* arrivals_ = nullptr;  // attached on this thread
@@ -258,6 +306,20 @@ Process* current_process();
 // woke (detail/wait.hpp), those that found the other thread asleep. Read
 // and reset by the runtime thread itself.
 extern constinit thread_local std::uint64_t sleepers_woken_here;
+
+// An asymmetric fence for polled Arrivals: a store then a load on each side
+// (a producer's publish and its look at whether the owner sleeps; the
+// owner's mark that it sleeps and its last poll) are ordered as if both
+// used full fences. The light side costs a compiler fence where the OS
+// offers membarrier(2), else a full fence; the heavy side the system call
+// (a few microseconds), and says false if it could not be sure of the
+// pairing (then the sleeper polls). prepare_fences(), called as a Runtime
+// is made, starts finding out which the OS offers; until then both sides
+// are full fences.
+void prepare_fences() noexcept;
+bool fences_decided() noexcept;  // prepare_fences() has found out (for tests)
+void light_fence() noexcept;
+bool heavy_fence() noexcept;
 
 }  // namespace detail
 

@@ -111,6 +111,9 @@ class ThreadRelays::Ring {
     e.payload_size = static_cast<std::uint8_t>(packet.payload.size());
   }
   void put_credits(std::uint32_t link, std::uint32_t credits) { claim(link, credits); }
+  // The counters the consumer's scheduler polls (csp::Arrivals): entries
+  // published, and taken.
+  csp::Arrivals::Source source() const { return {&tail_published_, &head_}; }
   void publish() { tail_published_.store(tail_, std::memory_order_release); }
 
   // The packet an entry carries (credits == 0).
@@ -211,7 +214,7 @@ class ThreadRelays::Sender final : public PortReceiver {
     ++counters.packets_sent;
     ++counters.sent_in_place;
     ++counters.signals;
-    relays_.arrivals_[l.to_thread]->signal();
+    relays_.arrivals_[l.to_thread]->poke();
   }
 
  private:
@@ -240,21 +243,29 @@ class ThreadRelays::Relay {
 
   void run() {
     csp::Arrivals& arrivals = *relays_.arrivals_[thread_];
-    if (!arrivals.attach([token = relays_.tokens_[thread_].writer()]() mutable {
-          char t = 0;
-          try {
-            (void)token.try_write(t);
-          } catch (const csp::Poisoned&) {
-            // The network is shutting down; the relay ends on its own.
-          }
-        }))
+    std::vector<csp::Arrivals::Source> sources;
+    for (unsigned from = 0; from < relays_.threads_; ++from)
+      if (from != thread_) sources.push_back(relays_.ring(from, thread_).source());
+    if (!arrivals.attach(
+            [token = relays_.tokens_[thread_].writer()]() mutable {
+              char t = 0;
+              try {
+                (void)token.try_write(t);
+              } catch (const csp::Poisoned&) {
+                // The network is shutting down; the relay ends on its own.
+              }
+            },
+            std::move(sources)))
       throw std::logic_error("thread relay: the runtime's scheduler takes no arrivals");
     struct Detach {
       csp::Arrivals& a;
       ~Detach() { a.detach(); }
     } detach{arrivals};
     build_alt();
-    take_arrivals();  // anything signalled before the attach
+    // Anything put in before the attach, and the credits for what of it
+    // was delivered: nothing may wake this relay again for them.
+    take_arrivals();
+    flush();
     for (;;) {
       handle(alt_.select());
       take_ready();
@@ -345,6 +356,7 @@ class ThreadRelays::Relay {
 
   // Everything the rings into this thread hold.
   void take_arrivals() {
+    relays_.arrivals_[thread_]->taking();
     ++relays_.counters_[thread_].wakes;
     for (unsigned from = 0; from < relays_.threads_; ++from) {
       if (from == thread_) continue;
@@ -421,7 +433,7 @@ class ThreadRelays::Relay {
     for (unsigned t = 0; t < relays_.threads_; ++t) {
       if (!touched_[t]) continue;
       touched_[t] = false;
-      relays_.arrivals_[t]->signal();
+      relays_.arrivals_[t]->poke();
       ++relays_.counters_[thread_].signals;
     }
   }

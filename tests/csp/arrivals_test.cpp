@@ -11,6 +11,7 @@
 #include <deque>
 #include <mutex>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include "csp/csp.hpp"
@@ -173,6 +174,142 @@ TEST(Arrivals, AReleaseStoreBeforeASignalThatFindsTheMarkSetIsSeen) {
   ASSERT_NO_THROW(rt.run());
   EXPECT_TRUE(complete);
   EXPECT_EQ(acked.load(), 2 * bursts);
+}
+
+// Work handed over a polled source: a locked queue, a count of items put
+// (the producer's, published after the item) and of items taken (the
+// consumer's), and a poke.
+struct PolledHandoff {
+  std::mutex mutex;
+  std::deque<int> items;
+  std::atomic<std::uint64_t> produced{0}, consumed{0};
+  std::uint64_t taken = 0;
+  std::uint64_t takings = 0;  // the consumer's calls of taking()
+  csp::Arrivals arrivals;
+  std::atomic<int> handler_calls{0};
+
+  void put(int v) {
+    {
+      std::lock_guard lk(mutex);
+      items.push_back(v);
+    }
+    produced.store(produced.load(std::memory_order_relaxed) + 1, std::memory_order_release);
+    arrivals.poke();
+  }
+  // The consumer's side: takes all there is, then waits on the token, until
+  // n; after each wake it first yields `dawdle` times.
+  std::vector<int> consume(csp::Channel<char>& token, int n, int dawdle = 0) {
+    std::vector<int> got;
+    const bool attached = arrivals.attach(
+        [this, w = token.writer()]() mutable {
+          ++handler_calls;
+          char t = 't';
+          (void)w.try_write(t);
+        },
+        {{&produced, &consumed}});
+    EXPECT_TRUE(attached);
+    auto r = token.reader();
+    for (;;) {
+      arrivals.taking();
+      ++takings;
+      std::deque<int> batch;
+      {
+        std::lock_guard lk(mutex);
+        batch = std::exchange(items, {});
+      }
+      taken += batch.size();
+      consumed.store(taken, std::memory_order_release);
+      for (int v : batch) got.push_back(v);
+      if (static_cast<int>(got.size()) >= n) break;
+      (void)r.read();
+      for (int k = 0; k < dawdle; ++k) csp::yield();
+    }
+    arrivals.detach();
+    return got;
+  }
+};
+
+// A poke costs the producer no mark, so a consumer whose thread is asleep
+// learns of the work only through the look at its scheduler's sleep that
+// the asymmetric fence orders after the publish. Each item here comes after
+// a pause longer than the consumer's spin, so its thread has gone to sleep
+// (or is going) at every put: hundreds of sleeps and wakes, none lost.
+TEST(Arrivals, PolledWorkReachesItsProcessInOrderWhenItsThreadSleepsAtEveryItem) {
+  constexpr int n = 600;
+  PolledHandoff h;
+  csp::Channel<char> token("token", 1);
+  std::vector<int> got;
+  csp::Runtime rt(2);
+  // Until the OS has said which fences it offers, a sleeper also polls
+  // every millisecond, which would hide a lost wake-up.
+  for (const auto until = std::chrono::steady_clock::now() + 5s;
+       !csp::detail::fences_decided() && std::chrono::steady_clock::now() < until;)
+    std::this_thread::sleep_for(1ms);
+  ASSERT_TRUE(csp::detail::fences_decided());
+  rt.spawn("consumer", 0, [&] { got = h.consume(token, n); });
+  rt.spawn("producer", 1, [&] {
+    for (int i = 0; i < n; ++i) {
+      // From 0 to 300 us: a put at every point of the consumer's spin and sleep.
+      csp::sleep_for(std::chrono::microseconds((i * 37) % 300));
+      h.put(i);
+    }
+  });
+  ASSERT_NO_THROW(rt.run());
+  ASSERT_EQ(got.size(), static_cast<std::size_t>(n));
+  for (int i = 0; i < n; ++i) ASSERT_EQ(got[i], i);
+  EXPECT_FALSE(h.arrivals.pending());
+  EXPECT_GT(rt.thread_use()[0].sleeps, std::uint64_t{n / 10}) << "the consumer's thread hardly slept: the test tests little";
+}
+
+// Many puts in a row: all arrive in order, and the handler is called once
+// a taking() at most, not at every switch while the work waits (the
+// consumer, woken, lets its neighbour switch a few times before it takes).
+TEST(Arrivals, PolledWorkCallsTheHandlerOnceUntilTheProcessTakesIt) {
+  constexpr int n = 20000;
+  PolledHandoff h;
+  csp::Channel<char> token("token", 1);
+  std::vector<int> got;
+  std::atomic<bool> done{false};
+  std::uint64_t wakes = 0;
+  csp::Runtime rt(2);
+  rt.spawn("consumer", 0, [&] {
+    got = h.consume(token, n, 3);
+    done = true;
+  });
+  rt.spawn("neighbour", 0, [&] {
+    while (!done) csp::yield();  // switches on the consumer's thread, each a chance to call the handler
+  });
+  rt.spawn("producer", 1, [&] {
+    // In bursts of 100, each taken before the next: the consumer waits
+    // on its token between them.
+    for (int i = 0; i < n; ++i) {
+      h.put(i);
+      if (i % 100 == 99)
+        while (h.consumed.load(std::memory_order_acquire) < static_cast<std::uint64_t>(i + 1)) csp::yield();
+    }
+  });
+  ASSERT_NO_THROW(rt.run());
+  ASSERT_EQ(got.size(), static_cast<std::size_t>(n));
+  for (int i = 0; i < n; ++i) ASSERT_EQ(got[i], i);
+  wakes = h.handler_calls.load();
+  EXPECT_LE(wakes, h.takings);
+  EXPECT_GE(wakes, static_cast<std::uint64_t>(n / 100));  // once a burst at least
+}
+
+// The producer ends right after its last put, while the consumer waits on
+// its token and its thread has nothing to run: the polled source holding
+// work keeps the run going.
+TEST(Arrivals, PolledWorkInTransitIsNotADeadlock) {
+  for (int round = 0; round < 200; ++round) {
+    PolledHandoff h;
+    csp::Channel<char> token("token", 1);
+    std::vector<int> got;
+    csp::Runtime rt(2);
+    rt.spawn("consumer", 0, [&] { got = h.consume(token, 1); });
+    rt.spawn("producer", 1, [&] { h.put(round); });
+    ASSERT_NO_THROW(rt.run()) << "round " << round;
+    ASSERT_EQ(got, std::vector<int>{round});
+  }
 }
 
 TEST(Arrivals, NothingAttachesOutsideARuntimeOrUnderVirtualTime) {
