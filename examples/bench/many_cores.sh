@@ -18,10 +18,14 @@
 #   5. The rule by which pixel computers answer a packet for their thread at
 #      once (at most four a thread), against forcing it on or off
 #      (scaling_bench's :a1 and :a0), at half and all of the CPUs.
+#   6. Threads that poll the relays' rings (the default) against relays
+#      that signal each batch (scaling_bench's :s), at half and all of the
+#      CPUs.
 # Last (OUT/summary.txt), the cases where the default thread count was more
 # than 10% slower than the fastest, part 1's times on 4 threads or more
 # that the model of T threads, fitted to its runs on 1 and 2 threads,
-# missed by more than 25%, and part 5's times with the rule and without.
+# missed by more than 25%, and parts 5's and 6's times beside the
+# default's.
 #
 # Each part has its own time limit, so one that runs long leaves the others
 # their turn; its output so far is kept. Each part's output goes to OUT
@@ -103,6 +107,8 @@ part commstime 20 $commstime 50000 3
 halfall=$(printf '%s\n' "$half" "$cpus" | sort -nu | paste -sd,)
 # shellcheck disable=SC2086
 part answer-at-once 60 $scaling rings4:16,rings4:16:a0,rings4:64,rings4:64:a1,teapot:256,teapot:256:a1 "$halfall" 512 3
+# shellcheck disable=SC2086
+part signal 60 $scaling rings4:16,rings4:16:s,rings4:64,rings4:64:s,teapot:64,teapot:64:s "$halfall" 512 3
 
 # The default thread count against the fastest, over every case of the
 # runs above: the cases where it is more than 10% slower.
@@ -127,18 +133,26 @@ awk '/ machine  / { label = $1 }
      }
      END { printf "== model of T threads: %d of %d predictions (4 threads or more) off by more than 25%%\n", off, n }' \
   "$out/threads.txt" 2>/dev/null | tee -a "$out/summary.txt"
-# Each case forced on or off (:a1, :a0) against the same case by the rule.
-awk '/per thread count:/ { sub(/.*per thread count: */, ""); nt = split($0, threads, " ") }
+# Each case with a suffix (SUFFIX, a regular expression) against the same
+# case without it: forced (:a1, :a0) against the rule, signalled (:s)
+# against polled.
+beside() {
+  awk -v suffix="$2" -v title="$3" \
+    '/per thread count:/ { sub(/.*per thread count: */, ""); nt = split($0, threads, " ") }
      / machine  / { for (i = 1; i <= nt; i++) time[$1, i] = $(2 + i); labels[++n] = $1 }
      END {
-       print "== answering at once, forced (:a1 on, :a0 off) against the rule:"
+       print "== " title ":"
        for (j = 1; j <= n; j++) {
          l = labels[j]
-         if (l !~ /:a[01]$/) continue
-         base = substr(l, 1, length(l) - 3)
+         if (l !~ (suffix "$")) continue
+         base = l
+         sub(suffix "$", "", base)
          for (i = 1; i <= nt; i++)
            if ((base, i) in time && time[base, i] > 0)
-             printf "  %s on %s threads: %.3f s, by the rule %.3f s (%.2fx)\n", l, threads[i], time[l, i], time[base, i], time[l, i] / time[base, i]
+             printf "  %s on %s threads: %.3f s, by default %.3f s (%.2fx)\n", l, threads[i], time[l, i], time[base, i], time[l, i] / time[base, i]
        }
-     }' "$out/answer-at-once.txt" 2>/dev/null | tee -a "$out/summary.txt"
+     }' "$out/$1.txt" 2>/dev/null | tee -a "$out/summary.txt"
+}
+beside answer-at-once ':a[01]' 'answering at once, forced (:a1 on, :a0 off) against the rule'
+beside signal ':s' 'relays signalling each batch (:s) against threads polling their rings'
 exit $status

@@ -17,7 +17,7 @@
 // renderer's; a difference is printed and makes the exit status 1.
 //
 // usage: scaling_bench [CASES [THREADS [SIZE [REPEATS]]]]
-//   CASES: SCENE:NODES[:wWORKERS][:cCACHE_PAGES][:a0|:a1], e.g. rings4:64:c64
+//   CASES: SCENE:NODES[:wWORKERS][:cCACHE_PAGES][:a0|:a1][:s], e.g. rings4:64:c64
 //   default: rings4:16,rings4:64,teapot:16,teapot:64 1,2,4,8,16 512 3
 //   THREADS: increasing counts, 1..1024 (more than the cores oversubscribes
 //   them); SIZE 16..4096; REPEATS 1..100; a bad argument: usage, exit 2
@@ -51,6 +51,7 @@ struct Case {
   int workers = 1;                          // :wW
   std::optional<std::uint32_t> cache_pages;  // :cC; none: the default
   std::optional<bool> answer_at_once;       // :a1 or :a0; none: the machine's rule (nodes::answers_at_once)
+  bool signal = false;                      // :s, the relays signal each batch (MachineOptions::threads.poll_rings off)
 };
 
 std::vector<std::string> split(const std::string& text) {
@@ -60,7 +61,7 @@ std::vector<std::string> split(const std::string& text) {
   return parts;
 }
 
-// SCENE:NODES[:wWORKERS][:cCACHE_PAGES][:a0|:a1]; a scene spec may hold
+// SCENE:NODES[:wWORKERS][:cCACHE_PAGES][:a0|:a1][:s]; a scene spec may hold
 // colons of its own, so the fields are taken from the end.
 Case parse_case(const std::string& item) {
   Case c;
@@ -69,13 +70,16 @@ Case parse_case(const std::string& item) {
   for (;;) {
     const auto colon = rest.rfind(':');
     if (colon == std::string::npos || colon == 0)
-      throw bench::BadArgument{"CASES: expected SCENE:NODES[:wWORKERS][:cCACHE_PAGES][:a0|:a1], got '" + item + "'"};
+      throw bench::BadArgument{"CASES: expected SCENE:NODES[:wWORKERS][:cCACHE_PAGES][:a0|:a1][:s], got '" + item +
+                               "'"};
     const std::string field = rest.substr(colon + 1);
     rest.resize(colon);
     if (!field.empty() && field[0] == 'w') {
       c.workers = static_cast<int>(bench::parse_int(field.substr(1), 1, 64, "CASES' WORKERS"));
     } else if (field == "a0" || field == "a1") {
       c.answer_at_once = field == "a1";
+    } else if (field == "s") {
+      c.signal = true;
     } else if (!field.empty() && field[0] == 'c') {
       c.cache_pages = static_cast<std::uint32_t>(bench::parse_int(field.substr(1), 1, 1 << 24, "CASES' CACHE_PAGES"));
     } else {
@@ -143,6 +147,7 @@ MachineSample run_machine(const Case& c, const tracer::Database& source, unsigne
   options.shape.workers_per_node = c.workers;
   if (c.cache_pages) options.cache.pages = c.cache_pages;
   options.threads.answer_at_once = c.answer_at_once;
+  options.threads.poll_rings = !c.signal;
   const auto start = Clock::now();
   const nodes::MachineResult result = nodes::run_machine(std::move(db), options);
   MachineSample s;
@@ -192,7 +197,7 @@ Case latency_case(const Case& c) {
 
 std::string latency_key(const Case& c) {
   return c.scene + (c.cache_pages ? ":c" + std::to_string(*c.cache_pages) : std::string()) +
-         (c.answer_at_once ? (*c.answer_at_once ? ":a1" : ":a0") : "");
+         (c.answer_at_once ? (*c.answer_at_once ? ":a1" : ":a0") : "") + (c.signal ? ":s" : "");
 }
 
 // The model fitted to a row's runs on 1 and 2 threads and its scene's two
@@ -252,10 +257,11 @@ void print_row(const Case& c, const Row& row, const std::vector<unsigned>& threa
 const char* const usage =
     "usage: scaling_bench [CASES [THREADS [SIZE [REPEATS]]]]\n"
     "  default: rings4:16,rings4:64,teapot:16,teapot:64 1,2,4,8,16 512 3\n"
-    "  CASES: SCENE:NODES[:wWORKERS][:cCACHE_PAGES][:a0|:a1], comma-separated (a hypercube of NODES, a\n"
+    "  CASES: SCENE:NODES[:wWORKERS][:cCACHE_PAGES][:a0|:a1][:s], comma-separated (a hypercube of NODES, a\n"
     "  power of two; WORKERS pixel computers a node, 1..64; CACHE_PAGES a node, default 1/8 of the\n"
     "  database; a1 or a0: pixel computers answer a packet for their thread at once, or not, whatever\n"
-    "  the machine's rule says)\n"
+    "  the machine's rule says; s: the thread relays signal each batch instead of the threads polling\n"
+    "  their rings)\n"
     "  THREADS: increasing, 1..1024; SIZE 16..4096; REPEATS 1..100\n"
     "  THREADS starting 1,2: each case's time predicted by the model of T threads, beside it\n";
 

@@ -424,6 +424,7 @@ NetworkOptions network_options(const MachineOptions& options, const MachineTimin
   net.relay_between_threads = options.threads.relay_between && !timing;
   net.forward_in_place = options.threads.forward_in_place && !timing;
   net.send_across_in_place = options.threads.send_in_place && net.relay_between_threads && net.forward_in_place;
+  net.relay_wake = options.threads.poll_rings ? RelayWake::poll : RelayWake::signal;
   if (share.plan) {
     net.local = [share](NodeId n) { return share.runs(n); };
     net.placement = [first = share.first_node(), local_nodes, threads](NodeId n) {

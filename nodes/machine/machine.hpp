@@ -79,6 +79,7 @@ struct Threads {
   bool relay_between = true;     // links between threads through relays (NetworkOptions::relay_between_threads)
   bool forward_in_place = true;  // routers of one thread route in place (NetworkOptions); real time only
   bool send_in_place = true;     // with both: routers put packets into the relays' rings (send_across_in_place)
+  bool poll_rings = true;        // threads poll the relays' rings (RelayWake::poll), or are signalled
   bool shared_cores = false;     // other processes share the cores (csp::RuntimeOptions::shared_cores)
   std::optional<bool> answer_at_once;  // pixel computers answer at once (answers_at_once); none: by the rule
 };

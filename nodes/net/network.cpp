@@ -38,7 +38,7 @@ Network::Network(csp::Runtime& runtime, topology::Topology topology, NetworkOpti
     throw std::invalid_argument("network: a link model cannot be relayed between threads");
   for (const std::uint8_t kind : options_.trace_kinds) kinds_to_trace_[kind] = true;
   if (options_.relay_between_threads && threads_ > 1)
-    relays_ = std::make_unique<ThreadRelays>(threads_, options_.buffer_capacity);
+    relays_ = std::make_unique<ThreadRelays>(threads_, options_.buffer_capacity, options_.relay_wake);
   const std::size_t n = topology_.size();
   link_in_.resize(n);
   ports_.resize(n);

@@ -54,12 +54,13 @@ struct NetworkOptions {
   // local process's packet so (router.hpp). Without a link model only.
   bool forward_in_place = false;
   // With both of the above: a router's step puts a packet for a link to
-  // another thread straight into the relays' ring and signals that thread
+  // another thread straight into the relays' ring and tells that thread
   // (ThreadRelays::sender) when the link's queue is empty and credits are
-  // left, instead of waking its thread's relay to move it. Cheaper where
-  // packets cross one at a time; where many cross, the relays gather them
-  // and signal once a batch.
+  // left, instead of waking its thread's relay to move it.
   bool send_across_in_place = false;
+  // How the relays tell a thread of entries in its rings (RelayWake): its
+  // scheduler polls them, or each batch signals it.
+  RelayWake relay_wake = RelayWake::poll;
 };
 
 // One direction and buffer class of a link whose ends run in different processes.

@@ -214,7 +214,7 @@ class ThreadRelays::Sender final : public PortReceiver {
     ++counters.packets_sent;
     ++counters.sent_in_place;
     ++counters.signals;
-    relays_.arrivals_[l.to_thread]->poke();
+    relays_.tell(l.to_thread);
   }
 
  private:
@@ -244,7 +244,7 @@ class ThreadRelays::Relay {
   void run() {
     csp::Arrivals& arrivals = *relays_.arrivals_[thread_];
     std::vector<csp::Arrivals::Source> sources;
-    for (unsigned from = 0; from < relays_.threads_; ++from)
+    for (unsigned from = 0; from < relays_.threads_ && relays_.wake_ == RelayWake::poll; ++from)
       if (from != thread_) sources.push_back(relays_.ring(from, thread_).source());
     if (!arrivals.attach(
             [token = relays_.tokens_[thread_].writer()]() mutable {
@@ -433,7 +433,7 @@ class ThreadRelays::Relay {
     for (unsigned t = 0; t < relays_.threads_; ++t) {
       if (!touched_[t]) continue;
       touched_[t] = false;
-      relays_.arrivals_[t]->poke();
+      relays_.tell(t);
       ++relays_.counters_[thread_].signals;
     }
   }
@@ -459,8 +459,8 @@ RelayCounters& RelayCounters::operator+=(const RelayCounters& o) {
   return *this;
 }
 
-ThreadRelays::ThreadRelays(unsigned threads, std::size_t capacity)
-    : threads_(threads), capacity_(capacity), counters_(threads) {
+ThreadRelays::ThreadRelays(unsigned threads, std::size_t capacity, RelayWake wake)
+    : threads_(threads), capacity_(capacity), wake_(wake), counters_(threads) {
   for (unsigned t = 0; t < threads_; ++t) {
     arrivals_.push_back(std::make_unique<csp::Arrivals>());
     // Written by the scheduler's arrivals callback, which must not allocate.

@@ -11,8 +11,8 @@
 // credits that can be out on it); a relay blocks on nothing but its one ALT,
 // so the channel dependencies are the unrelayed network's. A relay that
 // wakes takes everything ready, lets what it made ready run, takes what that
-// sent, and signals each thread it wrote to once. The deadlock detector sees
-// packets in a ring as work (csp::Arrivals). Network::shutdown() ends them.
+// sent, and tells each thread it wrote to once (RelayWake). Packets in a
+// ring are work to the deadlock detector. Network::shutdown() ends them.
 #pragma once
 
 #include <atomic>
@@ -41,9 +41,14 @@ struct alignas(64) RelayCounters {
   RelayCounters& operator+=(const RelayCounters& o);  // every count summed, as over a run's threads
 };
 
+// How a thread learns that a ring into it holds entries: its scheduler
+// polls the rings' counters and the producers only wake it if it sleeps
+// (csp::Arrivals::poke), or each batch marks it (csp::Arrivals::signal).
+enum class RelayWake { poll, signal };
+
 class ThreadRelays {
  public:
-  ThreadRelays(unsigned threads, std::size_t capacity);
+  ThreadRelays(unsigned threads, std::size_t capacity, RelayWake wake = RelayWake::poll);
   ~ThreadRelays();
   ThreadRelays(const ThreadRelays&) = delete;
   ThreadRelays& operator=(const ThreadRelays&) = delete;
@@ -86,8 +91,18 @@ class ThreadRelays {
   class Sender;
   Ring& ring(unsigned from, unsigned to) { return *rings_[from * threads_ + to]; }
 
+  // Tells thread t that a ring into it holds entries, as wake_ says.
+  void tell(unsigned t) {
+    if (wake_ == RelayWake::poll) {
+      arrivals_[t]->poke();
+    } else {
+      arrivals_[t]->signal();
+    }
+  }
+
   const unsigned threads_;
   const std::size_t capacity_;
+  const RelayWake wake_;
   std::vector<Link> links_;
   std::vector<std::unique_ptr<Sender>> senders_;  // per link, made by sender()
   std::vector<std::unique_ptr<Ring>> rings_;  // [from * threads + to]

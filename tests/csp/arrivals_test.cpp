@@ -259,7 +259,8 @@ TEST(Arrivals, PolledWorkReachesItsProcessInOrderWhenItsThreadSleepsBetweenItems
   ASSERT_EQ(got.size(), static_cast<std::size_t>(n));
   for (int i = 0; i < n; ++i) ASSERT_EQ(got[i], i);
   EXPECT_FALSE(h.arrivals.pending());
-  EXPECT_GT(rt.thread_use()[0].sleeps, std::uint64_t{n / 4}) << "the consumer's thread hardly slept: the test tests little";
+  EXPECT_GT(rt.thread_use()[0].sleeps, std::uint64_t{n / 4})
+      << "the consumer's thread hardly slept: the test tests little";
 }
 
 // Many puts in a row: all arrive in order, and the handler is called once

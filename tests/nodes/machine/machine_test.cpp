@@ -66,6 +66,7 @@ struct Case {
   bool record_tiles = false;
   bool forward_in_place = true;
   bool send_in_place = true;
+  bool poll_rings = true;
 };
 
 nodes::MachineResult run_case(const Case& c) {
@@ -83,6 +84,7 @@ nodes::MachineResult run_case(const Case& c) {
   options.observe.record_tiles = c.record_tiles;
   options.threads.forward_in_place = c.forward_in_place;
   options.threads.send_in_place = c.send_in_place;
+  options.threads.poll_rings = c.poll_rings;
   return nodes::run_machine(std::move(db), options);
 }
 
@@ -217,6 +219,35 @@ TEST(Machine, RoutersSendingAcrossThreadsInPlaceChangeNothingButWhoMovesPackets)
       EXPECT_EQ(alone.sent_in_place, 0u);
       EXPECT_GT(both.sent_in_place, 0u);
       EXPECT_LE(both.sent_in_place, both.packets_sent);
+    }
+}
+
+// Threads that poll the relays' rings (the default), or relays that signal
+// each batch: under a static schedule the same image, packets on every
+// link, misses and pages served, every packet between threads carried.
+TEST(Machine, PollingOrSignallingTheRingsChangesNothingButHowThreadsLearn) {
+  for (const unsigned threads : {2u, 3u})
+    for (const char* topology : {"hypercube", "complete"}) {
+      Case c{topology, 16, 2, 256, 4, Schedule::static_split, 1, threads};
+      SCOPED_TRACE(describe(c));
+      c.poll_rings = false;
+      const auto signalled = run_case(c);
+      c.poll_rings = true;
+      const auto polled = run_case(c);
+      EXPECT_TRUE(same_bits(signalled.image.pixels(), polled.image.pixels()));
+      EXPECT_TRUE(same_bits(polled.image.pixels(), cached_reference(c.scene, c.size)));
+      const auto& a = signalled.report.network;
+      const auto& b = polled.report.network;
+      ASSERT_EQ(a.links.size(), b.links.size());
+      for (std::size_t l = 0; l < a.links.size(); ++l) EXPECT_EQ(a.links[l].packets, b.links[l].packets) << l;
+      EXPECT_EQ(signalled.report.svm().misses, polled.report.svm().misses);
+      EXPECT_EQ(signalled.report.served().pages_served, polled.report.served().pages_served);
+      nodes::RelayCounters s, p;
+      for (const auto& r : signalled.report.relays) s += r;
+      for (const auto& r : polled.report.relays) p += r;
+      EXPECT_EQ(s.packets_sent, p.packets_sent);
+      EXPECT_EQ(p.packets_sent, p.packets_received);
+      EXPECT_GT(p.packets_sent, 0u);
     }
 }
 

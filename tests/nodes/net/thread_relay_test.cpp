@@ -2,10 +2,11 @@
 // routers: each relayed link has a sender process that writes its queue on
 // one runtime thread (on about half the links, seeded, it hands a packet
 // to the relays' sender() instead whenever that takes it at once, as a
-// router's step does) and a receiver process that reads its input on
-// another, and both pause before each packet for a seeded random number of
-// yields, now and then a short sleep, so that the relays meet packets and
-// credits in many orders. (The relays need csp::Arrivals, which only
+// router's step does; on a quarter of the seeds the relays signal each
+// batch instead of the threads polling their rings) and a receiver process
+// that reads its input on another, and both pause before each packet for a
+// seeded random number of yields, now and then a short sleep, so that the
+// relays meet packets and credits in many orders. (The relays need csp::Arrivals, which only
 // FifoScheduler gives, so the delays come from the links' ends rather than
 // from csp::SeededScheduler.)
 //
@@ -75,6 +76,7 @@ struct Case {
   bool shared_cores = false;
   std::vector<LinkPlan> links;
   std::size_t slow = 0;  // the link whose receiver sleeps before every packet
+  nodes::RelayWake wake = nodes::RelayWake::poll;
   std::uint64_t bound() const { return 3 * capacity; }  // packets one link can hold
 };
 
@@ -83,7 +85,8 @@ std::string describe(const Case& c) {
   for (const LinkPlan& l : c.links) packets += l.packets;
   return "threads=" + std::to_string(c.threads) + " K=" + std::to_string(c.capacity) +
          " links=" + std::to_string(c.links.size()) + " packets=" + std::to_string(packets) +
-         " slow link " + std::to_string(c.slow) + (c.shared_cores ? " shared cores" : "");
+         " slow link " + std::to_string(c.slow) + (c.shared_cores ? " shared cores" : "") +
+         (c.wake == nodes::RelayWake::signal ? " signalled" : "");
 }
 
 // Every ordered pair of threads joined by one or two links, each carrying
@@ -107,6 +110,7 @@ Case draw_case(std::uint64_t seed, std::uint64_t min_packets, std::uint64_t max_
   slow.receive = Pauses{0, 1, microseconds(20 + rng() % 80)};
   slow.packets = std::max<std::uint64_t>(slow.packets, 2 * c.bound() + rng() % (2 * c.bound()));
   for (LinkPlan& l : c.links) l.in_place = rng() % 2 == 0;
+  c.wake = rng() % 4 == 0 ? nodes::RelayWake::signal : nodes::RelayWake::poll;
   return c;
 }
 
@@ -170,7 +174,7 @@ struct LinkState {
 // One case's runtime, relays and links; the tests spawn the processes.
 class Harness {
  public:
-  explicit Harness(const Case& c) : case_(c), runtime_(options(c)), relays_(c.threads, c.capacity) {
+  explicit Harness(const Case& c) : case_(c), runtime_(options(c)), relays_(c.threads, c.capacity, c.wake) {
     for (std::size_t i = 0; i < c.links.size(); ++i) {
       links_.push_back(std::make_unique<LinkState>(i, c.capacity));
       relays_.add(c.links[i].from, c.links[i].to, links_[i]->queue.reader(), links_[i]->input.writer());
