@@ -15,6 +15,7 @@
 #include <string>
 #include <thread>
 #include <tuple>
+#include <utility>
 
 #include "tests/nodes/machine/test_database.hpp"
 #include "topology/spec.hpp"
@@ -186,11 +187,35 @@ TEST(Machine, RelaysCarryEveryPacketBetweenThreadsOnce) {
   EXPECT_TRUE(same_bits(relayed.image.pixels(), cached_reference(c.scene, c.size)));
 }
 
+// Two runs of one case under a static schedule (each node's pixels fixed,
+// so its misses too) that differ only in how packets cross threads: the
+// same image as the plain renderer's, the same packets and bytes on every
+// link, hops, misses and pages served. Returns the relays' counts of each.
+std::pair<nodes::RelayCounters, nodes::RelayCounters> expect_same_traffic(const Case& c,
+                                                                          const nodes::MachineResult& x,
+                                                                          const nodes::MachineResult& y) {
+  EXPECT_TRUE(same_bits(x.image.pixels(), y.image.pixels()));
+  EXPECT_TRUE(same_bits(y.image.pixels(), cached_reference(c.scene, c.size)));
+  const auto& a = x.report.network;
+  const auto& b = y.report.network;
+  EXPECT_EQ(a.links.size(), b.links.size());
+  for (std::size_t l = 0; l < std::min(a.links.size(), b.links.size()); ++l) {
+    EXPECT_EQ(a.links[l].packets, b.links[l].packets) << l;
+    EXPECT_EQ(a.links[l].bytes, b.links[l].bytes) << l;
+  }
+  EXPECT_EQ(a.hops.total_hops, b.hops.total_hops);
+  EXPECT_EQ(x.report.svm().misses, y.report.svm().misses);
+  EXPECT_EQ(x.report.served().pages_served, y.report.served().pages_served);
+  std::pair<nodes::RelayCounters, nodes::RelayCounters> counts;
+  for (const auto& r : x.report.relays) counts.first += r;
+  for (const auto& r : y.report.relays) counts.second += r;
+  EXPECT_EQ(counts.first.packets_sent, counts.second.packets_sent);
+  return counts;
+}
+
 // Routers that put packets for another thread into the relays' rings
-// themselves (the default), or leave every one to their thread's relay: the
-// same image, and under a static schedule (each node's pixels fixed, so its
-// misses too) the same packets on every link and the same misses; only the
-// relays' counts say who moved them.
+// themselves (the default), or leave every one to their thread's relay:
+// the same traffic; only the relays' counts say who moved the packets.
 TEST(Machine, RoutersSendingAcrossThreadsInPlaceChangeNothingButWhoMovesPackets) {
   for (const unsigned threads : {2u, 3u})
     for (const char* topology : {"hypercube", "torus"}) {
@@ -200,22 +225,7 @@ TEST(Machine, RoutersSendingAcrossThreadsInPlaceChangeNothingButWhoMovesPackets)
       const auto relays = run_case(c);
       c.send_in_place = true;
       const auto routers = run_case(c);
-      EXPECT_TRUE(same_bits(relays.image.pixels(), routers.image.pixels()));
-      EXPECT_TRUE(same_bits(routers.image.pixels(), cached_reference(c.scene, c.size)));
-      const auto& a = relays.report.network;
-      const auto& b = routers.report.network;
-      ASSERT_EQ(a.links.size(), b.links.size());
-      for (std::size_t l = 0; l < a.links.size(); ++l) {
-        EXPECT_EQ(a.links[l].packets, b.links[l].packets) << l;
-        EXPECT_EQ(a.links[l].bytes, b.links[l].bytes) << l;
-      }
-      EXPECT_EQ(a.hops.total_hops, b.hops.total_hops);
-      EXPECT_EQ(relays.report.svm().misses, routers.report.svm().misses);
-      EXPECT_EQ(relays.report.served().pages_served, routers.report.served().pages_served);
-      nodes::RelayCounters both, alone;
-      for (const auto& r : routers.report.relays) both += r;
-      for (const auto& r : relays.report.relays) alone += r;
-      EXPECT_EQ(both.packets_sent, alone.packets_sent);
+      const auto [alone, both] = expect_same_traffic(c, relays, routers);
       EXPECT_EQ(alone.sent_in_place, 0u);
       EXPECT_GT(both.sent_in_place, 0u);
       EXPECT_LE(both.sent_in_place, both.packets_sent);
@@ -223,8 +233,7 @@ TEST(Machine, RoutersSendingAcrossThreadsInPlaceChangeNothingButWhoMovesPackets)
 }
 
 // Threads that poll the relays' rings (the default), or relays that signal
-// each batch: under a static schedule the same image, packets on every
-// link, misses and pages served, every packet between threads carried.
+// each batch: the same traffic, every packet between threads carried.
 TEST(Machine, PollingOrSignallingTheRingsChangesNothingButHowThreadsLearn) {
   for (const unsigned threads : {2u, 3u})
     for (const char* topology : {"hypercube", "complete"}) {
@@ -234,19 +243,9 @@ TEST(Machine, PollingOrSignallingTheRingsChangesNothingButHowThreadsLearn) {
       const auto signalled = run_case(c);
       c.poll_rings = true;
       const auto polled = run_case(c);
-      EXPECT_TRUE(same_bits(signalled.image.pixels(), polled.image.pixels()));
-      EXPECT_TRUE(same_bits(polled.image.pixels(), cached_reference(c.scene, c.size)));
-      const auto& a = signalled.report.network;
-      const auto& b = polled.report.network;
-      ASSERT_EQ(a.links.size(), b.links.size());
-      for (std::size_t l = 0; l < a.links.size(); ++l) EXPECT_EQ(a.links[l].packets, b.links[l].packets) << l;
-      EXPECT_EQ(signalled.report.svm().misses, polled.report.svm().misses);
-      EXPECT_EQ(signalled.report.served().pages_served, polled.report.served().pages_served);
-      nodes::RelayCounters s, p;
-      for (const auto& r : signalled.report.relays) s += r;
-      for (const auto& r : polled.report.relays) p += r;
-      EXPECT_EQ(s.packets_sent, p.packets_sent);
+      const auto [s, p] = expect_same_traffic(c, signalled, polled);
       EXPECT_EQ(p.packets_sent, p.packets_received);
+      EXPECT_EQ(s.packets_sent, s.packets_received);
       EXPECT_GT(p.packets_sent, 0u);
     }
 }
