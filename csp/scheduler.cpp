@@ -176,9 +176,7 @@ void FifoScheduler::take_arrivals() noexcept {
 // of the queue, a timer that fell due during a long computation fires when
 // the computation offers the thread, and most switches read no clock.
 boost::fibers::context* FifoScheduler::pick_next() noexcept {
-  if (arrivals_ && (arrivals_->marked_.load(std::memory_order_relaxed) ||
-                    (!arrivals_->handler_outstanding_ && arrivals_->polled())))
-    take_arrivals();
+  if (arrivals_ && arrivals_->due(std::memory_order_relaxed)) take_arrivals();
   const bool none_ready = ready_.empty() && ready_low_woken_.empty() && ready_low_.empty();
   if (dispatcher_ && (none_ready || take_notification() || std::exchange(dispatch_soon_, false) ||
                       ++picks_since_dispatch_ >= dispatch_period)) {
@@ -236,7 +234,8 @@ bool FifoScheduler::sleep_until_notified(std::chrono::steady_clock::time_point w
   // A producer of a polled source publishes, then looks at sleeping_ with
   // only the light side of the fence between: this side's heavy one makes
   // either that look see the store above or the check below see the work.
-  // Where it cannot (a failed membarrier), the sleep is cut to a poll's period.
+  // Where it cannot be sure (the fences' mode not yet decided, or a failed
+  // membarrier), the sleep is cut to a poll's period.
   auto until = when;
   if (arrivals_ && !arrivals_->sources_.empty() && !detail::heavy_fence())
     until = std::min(when, std::chrono::steady_clock::now() + std::chrono::milliseconds(1));
@@ -292,8 +291,7 @@ void FifoScheduler::notify() noexcept {
 
 bool FifoScheduler::yield_requested() const noexcept {
   return notified_.load(std::memory_order_relaxed) || !ready_.empty() ||
-         (arrivals_ && (arrivals_->marked_.load(std::memory_order_relaxed) ||
-                        (!arrivals_->handler_outstanding_ && arrivals_->polled())));
+         (arrivals_ && arrivals_->due(std::memory_order_relaxed));
 }
 
 bool FifoScheduler::others_ready() const noexcept {

@@ -190,6 +190,11 @@ class alignas(64) Arrivals {
 
  private:
   friend class FifoScheduler;
+  // Work for the handler: a mark (read with `order`), or a source's work it
+  // has not been called for. The owner's thread only.
+  bool due(std::memory_order order) const noexcept {
+    return marked_.load(order) || (!handler_outstanding_ && polled());
+  }
   // Some source holds work. Any thread: the sources do not change while attached.
   bool polled() const noexcept {
     for (const Source& s : sources_)
@@ -251,11 +256,7 @@ class FifoScheduler final : public Scheduler {
   static constexpr unsigned dispatch_period = 32;
   static constexpr int os_yields_before_sleep = 16;
 
-  // Work for the handler: a mark, or a source's work it has not been called for.
-  bool arrival_pending() const noexcept {
-    return arrivals_ && (arrivals_->marked_.load(std::memory_order_seq_cst) ||
-                         (!arrivals_->handler_outstanding_ && arrivals_->polled()));
-  }
+  bool arrival_pending() const noexcept { return arrivals_ && arrivals_->due(std::memory_order_seq_cst); }
   void take_arrivals() noexcept;
   void wake_if_sleeping() noexcept;
 
