@@ -188,8 +188,8 @@ class ThreadRelays::Ring {
 
 // A relayed link's sending router's step in place, past the queue and the
 // relay: the packet goes into the ring as the relay's send() would put it,
-// under one of the link's credits, and the far thread is signalled at once
-// (the relay signals once a batch; a router's step makes no batch). Taken
+// under one of the link's credits, and the far thread is told at once
+// (the relay tells once a batch; a router's step makes no batch). Taken
 // only with the queue empty, so no packet of the link is overtaken, and
 // with two credits or more, so the relay keeps the last one and its guard
 // on the queue stays enabled exactly while credits are left. Both ends of
@@ -213,8 +213,7 @@ class ThreadRelays::Sender final : public PortReceiver {
     RelayCounters& counters = relays_.counters_[l.from_thread];
     ++counters.packets_sent;
     ++counters.sent_in_place;
-    ++counters.signals;
-    relays_.tell(l.to_thread);
+    relays_.tell(l.from_thread, l.to_thread);
   }
 
  private:
@@ -243,9 +242,10 @@ class ThreadRelays::Relay {
 
   void run() {
     csp::Arrivals& arrivals = *relays_.arrivals_[thread_];
-    std::vector<csp::Arrivals::Source> sources;
-    for (unsigned from = 0; from < relays_.threads_ && relays_.wake_ == RelayWake::poll; ++from)
-      if (from != thread_) sources.push_back(relays_.ring(from, thread_).source());
+    std::vector<csp::Arrivals::Source> sources;  // none when the relays signal
+    if (relays_.wake_ == RelayWake::poll)
+      for (unsigned from = 0; from < relays_.threads_; ++from)
+        if (from != thread_) sources.push_back(relays_.ring(from, thread_).source());
     if (!arrivals.attach(
             [token = relays_.tokens_[thread_].writer()]() mutable {
               char t = 0;
@@ -433,8 +433,7 @@ class ThreadRelays::Relay {
     for (unsigned t = 0; t < relays_.threads_; ++t) {
       if (!touched_[t]) continue;
       touched_[t] = false;
-      relays_.tell(t);
-      ++relays_.counters_[thread_].signals;
+      relays_.tell(thread_, t);
     }
   }
 

@@ -91,12 +91,14 @@ class ThreadRelays {
   class Sender;
   Ring& ring(unsigned from, unsigned to) { return *rings_[from * threads_ + to]; }
 
-  // Tells thread t that a ring into it holds entries, as wake_ says.
-  void tell(unsigned t) {
+  // Thread `from` tells thread `to` that a ring into it holds entries, as
+  // wake_ says, and counts it among from's signals.
+  void tell(unsigned from, unsigned to) {
+    ++counters_[from].signals;
     if (wake_ == RelayWake::poll) {
-      arrivals_[t]->poke();
+      arrivals_[to]->poke();
     } else {
-      arrivals_[t]->signal();
+      arrivals_[to]->signal();
     }
   }
 
